@@ -1,0 +1,27 @@
+# Two entry points for a fresh machine (see README): `make demo` and `make test`.
+PYTHON ?= python3
+VENV := .venv
+BIN := $(VENV)/bin
+
+.PHONY: demo test install examples clean
+
+$(BIN)/pianobot: pyproject.toml
+	$(PYTHON) -m venv $(VENV)
+	$(BIN)/pip install --quiet --upgrade pip
+	$(BIN)/pip install --quiet -e ".[test]"
+	touch $(BIN)/pianobot
+
+install: $(BIN)/pianobot
+
+demo: install
+	$(BIN)/pianobot inspect examples/midi/twinkle.mid
+	$(BIN)/pianobot score examples/midi/twinkle.mid examples/midi/twinkle.mid --no-notes
+
+test: install
+	$(BIN)/python -m pytest
+
+examples: install
+	$(BIN)/python examples/make_examples.py
+
+clean:
+	rm -rf $(VENV) *.egg-info

@@ -1,0 +1,164 @@
+"""The `pianobot` command line: thin wrappers that read arguments, call the library and print.
+
+Every :class:`PianobotError` becomes one red line on stderr and exit code 2; warnings about
+repaired input are printed in yellow and do not stop the command.
+"""
+
+from __future__ import annotations
+
+import functools
+import json
+import warnings
+from pathlib import Path
+from typing import Optional
+
+import typer
+from rich.console import Console
+
+from pianobot import __version__, display
+from pianobot.errors import PianobotError, PianobotWarning
+from pianobot.files import atomic_write
+from pianobot.metrics import DEFAULT_ONSET_TOLERANCE, compare, plot_report
+from pianobot.music import midi_io
+from pianobot.music.instrument import HandSpec, KeyboardSpec, check_playable
+from pianobot.music.load import LoadOptions, load_piece
+from pianobot.music.phrases import DEFAULT_MAX_NOTES, split_phrases
+from pianobot.music.piece import parse_pitch, pitch_name
+
+app = typer.Typer(
+    help="Teach a simulated robot hand with touch sensors to play the piano from MIDI files.",
+    no_args_is_help=True,
+    add_completion=False,
+    pretty_exceptions_enable=False,
+)
+out = Console()
+err = Console(stderr=True)
+
+EXIT_BAD_INPUT = 2
+
+
+def friendly(command):
+    """Turn PianobotError into one red line + exit 2, and show warnings in yellow."""
+
+    @functools.wraps(command)
+    def wrapper(*args, **kwargs):
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", PianobotWarning)
+            try:
+                return command(*args, **kwargs)
+            except PianobotError as e:
+                err.print(f"[red]error:[/red] {e}", markup=True, highlight=False, soft_wrap=True)
+                raise typer.Exit(EXIT_BAD_INPUT) from None
+            except KeyboardInterrupt:
+                err.print("[yellow]interrupted[/yellow]")
+                raise typer.Exit(130) from None
+            finally:
+                for w in caught:
+                    if issubclass(w.category, PianobotWarning):
+                        err.print(f"[yellow]warning:[/yellow] {w.message}", highlight=False, soft_wrap=True)
+
+    return wrapper
+
+
+# -- shared options --------------------------------------------------------------------------
+Track = typer.Option(None, "--track", help="Read only this track (index or name); default: merge all tracks.")
+Tempo = typer.Option(None, "--tempo", help="Re-time the piece at this constant tempo in bpm (the paper uses 60).")
+Transpose = typer.Option(0, "--transpose", help="Shift every note by this many semitones.")
+Fingering = typer.Option(
+    None, "--fingering", help="PIG fingering file for the notes (default: <song>_fingering.txt beside the .mid, if any)."
+)
+LowestNote = typer.Option(
+    pitch_name(KeyboardSpec.lowest), "--lowest-note", help="Lowest key of the keyboard (name like C4, or MIDI number)."
+)
+Keys = typer.Option(KeyboardSpec.count, "--keys", help="Number of keys on the keyboard.")
+Thumb = typer.Option(False, "--thumb", help="Let the hand use its thumb (finger 1) too.")
+PhraseNotes = typer.Option(DEFAULT_MAX_NOTES, "--phrase-notes", help="Most notes in one phrase (one policy each).")
+
+
+def make_options(track, tempo, transpose, fingering) -> LoadOptions:
+    return LoadOptions(track=track, tempo=tempo, transpose=transpose, fingering=fingering)
+
+
+def make_instrument(lowest_note: str, keys: int, thumb: bool) -> tuple[KeyboardSpec, HandSpec]:
+    hand = HandSpec(fingers=(1,) + HandSpec.fingers if thumb else HandSpec.fingers)
+    return KeyboardSpec(lowest=parse_pitch(lowest_note), count=keys), hand
+
+
+# -- commands --------------------------------------------------------------------------------
+@app.command()
+@friendly
+def inspect(
+    song: Path = typer.Argument(..., help="A .mid file (or a PIG fingering .txt file)."),
+    track: Optional[str] = Track,
+    tempo: Optional[float] = Tempo,
+    transpose: int = Transpose,
+    fingering: Optional[Path] = Fingering,
+    lowest_note: str = LowestNote,
+    keys: int = Keys,
+    thumb: bool = Thumb,
+    phrase_notes: int = PhraseNotes,
+):
+    """Show a piece's tracks, notes with fingering, phrases, and whether the hand can play it."""
+    keyboard, hand = make_instrument(lowest_note, keys, thumb)
+    piece = load_piece(song, make_options(track, tempo, transpose, fingering))
+    if song.suffix.lower() != ".txt":
+        out.print(display.tracks_table(midi_io.describe_tracks(song)))
+    phrases = split_phrases(piece, phrase_notes)
+    out.print(display.notes_table(piece, phrases))
+    out.print(display.phrases_table(phrases))
+    polyphony, _ = piece.max_polyphony()
+    fingered = sum(n.finger is not None for n in piece.notes)
+    low, high = min(n.pitch for n in piece.notes), max(n.pitch for n in piece.notes)
+    out.print(
+        f"duration {piece.duration:.2f} s at {piece.bpm:.0f} bpm; range {pitch_name(low)}-{pitch_name(high)}; "
+        f"at most {polyphony} notes at once; {fingered}/{len(piece)} notes fingered"
+    )
+    check_playable(piece, keyboard, hand)
+    out.print(f"[green]playable[/green] on {keyboard.describe()} with fingers {hand.describe()}")
+
+
+@app.command()
+@friendly
+def score(
+    played: Path = typer.Argument(..., help="The performance, a .mid file (e.g. written by `pianobot play`)."),
+    reference: Path = typer.Argument(..., help="The reference score, a .mid file."),
+    onset_tolerance: float = typer.Option(
+        DEFAULT_ONSET_TOLERANCE, "--onset-tolerance", help="Seconds within which a played onset matches the reference."
+    ),
+    json_path: Optional[Path] = typer.Option(None, "--json", help="Also write every figure and the per-note table to this JSON file."),
+    plot: Optional[Path] = typer.Option(None, "--plot", help="Draw both piano rolls with the errors marked to this PNG file."),
+    notes: bool = typer.Option(True, "--notes/--no-notes", help="Print the per-note table."),
+):
+    """Compare a performance with its reference: note F1, velocity and timing errors, fingering."""
+    if not 0 < onset_tolerance <= 1:
+        raise PianobotError(f"--onset-tolerance {onset_tolerance}: give seconds between 0 and 1, e.g. 0.05")
+    if plot is not None and plot.suffix.lower() != ".png":
+        raise PianobotError(f"--plot {plot}: the plot is a PNG image, name the file *.png")
+    reference_piece = load_piece(reference)
+    played_piece = midi_io.read_midi(played)
+    report = compare(reference_piece, played_piece, onset_tolerance=onset_tolerance)
+    tables = display.report_tables(report)
+    display.print_all(out, tables if notes else tables[:1])
+    if json_path is not None:
+        atomic_write(json_path, json.dumps(report.to_dict(), indent=2) + "\n")
+        out.print(f"figures written to {json_path}")
+    if plot is not None:
+        plot_report(reference_piece, played_piece, report, plot)
+        out.print(f"piano rolls drawn to {plot}")
+
+
+def _version(value: bool):
+    if value:
+        out.print(f"pianobot {__version__}")
+        raise typer.Exit()
+
+
+@app.callback()
+def main(
+    version: bool = typer.Option(False, "--version", callback=_version, is_eager=True, help="Show the version and exit."),
+):
+    """pianobot: teach a simulated robot hand to play the piano from MIDI files."""
+
+
+if __name__ == "__main__":
+    app()

@@ -1,0 +1,101 @@
+"""Rich tables for the terminal: what `inspect` and `score` print."""
+
+from __future__ import annotations
+
+from rich.console import Console
+from rich.table import Table
+
+from pianobot.metrics import Report
+from pianobot.music.midi_io import TrackInfo
+from pianobot.music.phrases import Phrase
+from pianobot.music.piece import FINGER_NAMES, Piece
+
+
+def _finger(finger: int | None) -> str:
+    return "-" if finger is None else f"{finger} {FINGER_NAMES[finger]}"
+
+
+def _opt(value, fmt: str) -> str:
+    return "n/a" if value is None else format(value, fmt)
+
+
+def tracks_table(tracks: list[TrackInfo]) -> Table:
+    table = Table(title="tracks")
+    for column in ("track", "name", "notes", "channels"):
+        table.add_column(column)
+    for t in tracks:
+        table.add_row(str(t.index), t.name or "-", str(t.notes), ",".join(map(str, t.channels)) or "-")
+    return table
+
+
+def notes_table(piece: Piece, phrases: list[Phrase]) -> Table:
+    phrase_of = {id(n): p.index for p in phrases for n in p.notes}
+    table = Table(title=f"{len(piece)} notes")
+    for column in ("#", "onset s", "pitch", "duration s", "velocity", "finger", "phrase"):
+        table.add_column(column, justify="right" if column != "finger" else "left")
+    for i, n in enumerate(piece.notes):
+        table.add_row(
+            str(i), f"{n.onset:.3f}", n.name, f"{n.duration:.3f}", str(n.velocity), _finger(n.finger),
+            str(phrase_of.get(id(n), "-")),
+        )
+    return table
+
+
+def phrases_table(phrases: list[Phrase]) -> Table:
+    table = Table(title=f"{len(phrases)} phrases")
+    for column in ("phrase", "hash", "notes", "start s", "end s", "pitches"):
+        table.add_column(column)
+    for p in phrases:
+        table.add_row(
+            str(p.index), p.hash, str(len(p.notes)), f"{p.start:.3f}", f"{p.end:.3f}",
+            " ".join(n.name for n in p.notes),
+        )
+    return table
+
+
+def report_tables(report: Report) -> list[Table]:
+    summary = Table(title="performance against reference", show_header=False)
+    summary.add_column("figure")
+    summary.add_column("value", justify="right")
+    rows = [
+        ("notes (reference / played / matched)", f"{report.reference_notes} / {report.played_notes} / {report.matched_notes}"),
+        ("note precision", f"{report.precision:.3f}"),
+        ("note recall", f"{report.recall:.3f}"),
+        ("note F1", f"{report.f1:.3f}"),
+        ("note F1 with offsets", f"{report.f1_with_offsets:.3f}"),
+        ("velocity-aware note F1 (mir_eval)", f"{report.velocity_f1:.3f}"),
+        ("velocity mean abs. error (MIDI)", _opt(report.velocity_mae, ".2f")),
+        ("velocity max error (MIDI)", _opt(report.velocity_max_error, "d")),
+        ("onset error mean (ms)", _opt(None if report.onset_error_mean is None else report.onset_error_mean * 1000, ".1f")),
+        ("onset error max (ms)", _opt(None if report.onset_error_max is None else report.onset_error_max * 1000, ".1f")),
+        ("key-press F1 per step (RoboPianist)", f"{report.step_f1:.3f}"),
+        ("fingering accuracy", _opt(report.fingering_accuracy, ".3f")),
+        ("onset tolerance (ms)", f"{report.onset_tolerance * 1000:.0f}"),
+    ]
+    for name, value in rows:
+        summary.add_row(name, value)
+
+    notes = Table(title="per note")
+    for column in ("pitch", "target onset", "played onset", "target vel", "played vel", "vel error", "finger target/played", "status"):
+        notes.add_column(column)
+    for row in report.rows:
+        ref, out = row.reference, row.played
+        status = "missed" if out is None else "extra" if ref is None else "ok"
+        style = "red" if status != "ok" else None
+        notes.add_row(
+            (ref or out).name,
+            _opt(ref and ref.onset, ".3f"),
+            _opt(out and out.onset, ".3f"),
+            _opt(ref and ref.velocity, "d"),
+            _opt(out and out.velocity, "d"),
+            _opt(row.velocity_error, "+d"),
+            f"{_finger(ref and ref.finger)} / {_finger(out and out.finger)}",
+            status,
+            style=style,
+        )
+    return [summary, notes]
+
+
+def print_all(console: Console, tables: list[Table]) -> None:
+    for table in tables:
+        console.print(table)

@@ -1,0 +1,33 @@
+"""Writing files so that a failed run never leaves a half-written or clobbered file behind."""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from pathlib import Path
+
+from pianobot.errors import PianobotError
+
+
+def atomic_write(path: str | os.PathLike, data: bytes | str) -> Path:
+    """Write ``data`` to ``path`` via a temporary file in the same folder and an atomic rename.
+
+    Either the whole new file is there afterwards, or the old one (if any) is untouched.
+    """
+    path = Path(path)
+    if path.is_dir():
+        raise PianobotError(f"{path} is a folder: give a file name to write to")
+    if not path.parent.exists():
+        raise PianobotError(f"folder {path.parent} does not exist: create it first or choose another path")
+    payload = data.encode() if isinstance(data, str) else data
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        with os.fdopen(fd, "wb") as f:
+            f.write(payload)
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    return path

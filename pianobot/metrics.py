@@ -1,0 +1,234 @@
+"""How well a performance matches its reference: pure functions of two pieces.
+
+Note-level figures come from mir_eval's transcription metrics (notes match one-to-one when the
+pitch agrees and the onsets are within the tolerance); velocity and onset errors are measured
+over those matched pairs in plain MIDI units and seconds. The per-step key-press F1 is
+RoboPianist's: at each control step compare the set of keys that should be down with the set
+that is down (an empty step scores 1), then average over steps. See docs/metrics.md.
+"""
+
+from __future__ import annotations
+
+import io
+import warnings
+from dataclasses import asdict, dataclass
+
+import mir_eval
+import numpy as np
+
+from pianobot.files import atomic_write
+from pianobot.music.piece import Note, Piece
+from pianobot.music.tensor import ScoreSpec, note_steps
+
+DEFAULT_ONSET_TOLERANCE = 0.05
+"""Seconds; mir_eval's and the MIREX standard."""
+
+
+@dataclass(frozen=True)
+class NoteRow:
+    """One line of the per-note table: a reference note and what was played for it."""
+
+    reference: Note | None
+    """None for a played note that the reference does not have (an extra note)."""
+    played: Note | None
+    """None for a reference note that was not played (a missed note)."""
+
+    @property
+    def velocity_error(self) -> int | None:
+        if self.reference is None or self.played is None:
+            return None
+        return self.played.velocity - self.reference.velocity
+
+    @property
+    def onset_error(self) -> float | None:
+        if self.reference is None or self.played is None:
+            return None
+        return round(self.played.onset - self.reference.onset, 6)
+
+
+@dataclass(frozen=True)
+class Report:
+    """Every figure `pianobot score` shows."""
+
+    reference_notes: int
+    played_notes: int
+    matched_notes: int
+    precision: float
+    recall: float
+    f1: float
+    f1_with_offsets: float
+    velocity_f1: float
+    velocity_mae: float | None
+    velocity_max_error: int | None
+    onset_error_mean: float | None
+    onset_error_max: float | None
+    step_precision: float
+    step_recall: float
+    step_f1: float
+    fingering_accuracy: float | None
+    onset_tolerance: float
+    rows: tuple[NoteRow, ...]
+
+    def summary(self) -> dict:
+        """The summary figures (everything but the per-note rows)."""
+        out = asdict(self)
+        del out["rows"]
+        return out
+
+    def to_dict(self) -> dict:
+        """Summary plus per-note rows, as plain JSON-ready data."""
+        out = self.summary()
+        out["notes"] = [
+            {
+                "pitch": (row.reference or row.played).name,
+                "target_onset": row.reference.onset if row.reference else None,
+                "played_onset": row.played.onset if row.played else None,
+                "onset_error": row.onset_error,
+                "target_velocity": row.reference.velocity if row.reference else None,
+                "played_velocity": row.played.velocity if row.played else None,
+                "velocity_error": row.velocity_error,
+                "target_finger": row.reference.finger if row.reference else None,
+                "played_finger": row.played.finger if row.played else None,
+                "status": "missed" if row.played is None else "extra" if row.reference is None else "matched",
+            }
+            for row in self.rows
+        ]
+        return out
+
+
+def _arrays(piece: Piece) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    intervals = np.array([[n.onset, n.offset] for n in piece.notes], dtype=float).reshape(-1, 2)
+    pitches = mir_eval.util.midi_to_hz(np.array([n.pitch for n in piece.notes], dtype=float))
+    velocities = np.array([n.velocity for n in piece.notes], dtype=float)
+    return intervals, pitches, velocities
+
+
+def key_press_f1(reference: Piece, played: Piece, control_hz: float = 20.0) -> tuple[float, float, float]:
+    """RoboPianist's per-step key-press precision, recall and F1, averaged over control steps."""
+    spec = ScoreSpec(control_hz=control_hz)
+    spans = {"ref": note_steps(reference, spec), "out": note_steps(played, spec)}
+    steps = max((e for s in spans.values() for _, _, e in s), default=0)
+    if steps == 0:
+        return 1.0, 1.0, 1.0
+    rolls = {}
+    for name, notes in spans.items():
+        roll = np.zeros((steps, 128), dtype=bool)
+        for note, start, end in notes:
+            roll[start:end, note.pitch] = True
+        rolls[name] = roll
+    tp = (rolls["ref"] & rolls["out"]).sum(axis=1)
+    fp = (~rolls["ref"] & rolls["out"]).sum(axis=1)
+    fn = (rolls["ref"] & ~rolls["out"]).sum(axis=1)
+    precision = np.where(tp + fp > 0, tp / np.maximum(tp + fp, 1), 1.0)
+    recall = np.where(tp + fn > 0, tp / np.maximum(tp + fn, 1), 1.0)
+    f1 = np.where(tp + fp + fn > 0, 2 * tp / np.maximum(2 * tp + fp + fn, 1), 1.0)
+    return float(precision.mean()), float(recall.mean()), float(f1.mean())
+
+
+def compare(
+    reference: Piece,
+    played: Piece,
+    onset_tolerance: float = DEFAULT_ONSET_TOLERANCE,
+    control_hz: float = 20.0,
+) -> Report:
+    """Score ``played`` against ``reference``."""
+    ref_int, ref_hz, ref_vel = _arrays(reference)
+    out_int, out_hz, out_vel = _arrays(played)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # mir_eval warns about empty note lists; the figures say it
+        transcription = mir_eval.transcription
+        precision, recall, f1, _ = transcription.precision_recall_f1_overlap(
+            ref_int, ref_hz, out_int, out_hz, onset_tolerance=onset_tolerance, offset_ratio=None
+        )
+        _, _, f1_offsets, _ = transcription.precision_recall_f1_overlap(
+            ref_int, ref_hz, out_int, out_hz, onset_tolerance=onset_tolerance
+        )
+        _, _, velocity_f1, _ = mir_eval.transcription_velocity.precision_recall_f1_overlap(
+            ref_int, ref_hz, ref_vel, out_int, out_hz, out_vel, onset_tolerance=onset_tolerance, offset_ratio=None
+        )
+        pairs = transcription.match_notes(
+            ref_int, ref_hz, out_int, out_hz, onset_tolerance=onset_tolerance, offset_ratio=None
+        ) if len(reference) and len(played) else []
+
+    matched = {r: p for r, p in pairs}
+    rows = [NoteRow(n, played.notes[matched[i]] if i in matched else None) for i, n in enumerate(reference.notes)]
+    used = set(matched.values())
+    rows += [NoteRow(None, n) for j, n in enumerate(played.notes) if j not in used]
+    rows.sort(key=lambda r: ((r.reference or r.played).onset, (r.reference or r.played).pitch))
+
+    pairs_rows = [r for r in rows if r.reference is not None and r.played is not None]
+    velocity_errors = [abs(r.velocity_error) for r in pairs_rows]
+    onset_errors = [abs(r.onset_error) for r in pairs_rows]
+    fingered = [r for r in pairs_rows if r.reference.finger is not None and r.played.finger is not None]
+    both_fingered = reference.has_fingering and played.has_fingering
+    step_p, step_r, step_f1 = key_press_f1(reference, played, control_hz)
+    return Report(
+        reference_notes=len(reference),
+        played_notes=len(played),
+        matched_notes=len(pairs_rows),
+        precision=float(precision),
+        recall=float(recall),
+        f1=float(f1),
+        f1_with_offsets=float(f1_offsets),
+        velocity_f1=float(velocity_f1),
+        velocity_mae=float(np.mean(velocity_errors)) if velocity_errors else None,
+        velocity_max_error=int(max(velocity_errors)) if velocity_errors else None,
+        onset_error_mean=round(float(np.mean(onset_errors)), 6) if onset_errors else None,
+        onset_error_max=round(float(max(onset_errors)), 6) if onset_errors else None,
+        step_precision=step_p,
+        step_recall=step_r,
+        step_f1=step_f1,
+        fingering_accuracy=(
+            sum(r.reference.finger == r.played.finger for r in fingered) / len(fingered)
+            if both_fingered and fingered
+            else None
+        ),
+        onset_tolerance=onset_tolerance,
+        rows=tuple(rows),
+    )
+
+
+def plot_report(reference: Piece, played: Piece, report: Report, path) -> None:
+    """Both piano rolls, reference above and performance below, with misses, extras and velocity errors marked."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.patches import Patch, Rectangle
+
+    fig, axes = plt.subplots(2, 1, sharex=True, sharey=True, figsize=(10, 6))
+    pitches = [n.pitch for n in reference.notes + played.notes] or [60]
+    end = max(reference.duration, played.duration, 0.1)
+    colours = {"matched": "#4c72b0", "missed": "#d62728", "extra": "#d62728"}
+    for ax, title in zip(axes, ("reference", "performance")):
+        ax.set_title(title, loc="left")
+        ax.set_ylabel("MIDI pitch")
+        ax.set_xlim(0, end * 1.02)
+        ax.set_ylim(min(pitches) - 1.5, max(pitches) + 1.5)
+        ax.grid(alpha=0.3)
+    for row in report.rows:
+        status = "missed" if row.played is None else "extra" if row.reference is None else "matched"
+        for ax, note in zip(axes, (row.reference, row.played)):
+            if note is None:
+                continue
+            alpha = 0.3 + 0.7 * note.velocity / 127
+            ax.add_patch(
+                Rectangle((note.onset, note.pitch - 0.4), note.duration, 0.8, color=colours[status], alpha=alpha)
+            )
+        if status == "matched" and row.velocity_error:
+            axes[1].annotate(
+                f"{row.velocity_error:+d}", (row.played.onset, row.played.pitch + 0.5), fontsize=7, color="#d62728"
+            )
+    axes[1].set_xlabel("time (s)")
+    axes[0].legend(
+        handles=[Patch(color=colours["matched"], label="matched (shade = velocity)"),
+                 Patch(color=colours["missed"], label="missed / extra")],
+        loc="upper right", fontsize=8,
+    )
+    mae = "n/a" if report.velocity_mae is None else f"{report.velocity_mae:.1f}"
+    fig.suptitle(f"note F1 {report.f1:.3f}   velocity MAE {mae}")
+    fig.tight_layout()
+    buffer = io.BytesIO()
+    fig.savefig(buffer, format="png", dpi=100)
+    plt.close(fig)
+    atomic_write(path, buffer.getvalue())

@@ -1,0 +1,136 @@
+"""What the instrument and the hand can do, as plain data: the keyboard's range and the fingers.
+
+These specs are shared by every layer (score tensor, simulator, metrics), so they live here,
+below the simulator, with no physics in them.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from pianobot.errors import PianobotError
+from pianobot.music.piece import FINGER_NAMES, Piece, pitch_name
+
+_BLACK = {1, 3, 6, 8, 10}
+
+
+@dataclass(frozen=True)
+class KeyboardSpec:
+    """A contiguous range of piano keys."""
+
+    lowest: int = 60
+    """MIDI pitch of the lowest key (60 = C4, the paper's keyboard)."""
+    count: int = 24
+    """Number of keys (24 = two octaves: 14 white + 10 black)."""
+
+    def __post_init__(self) -> None:
+        if not 1 <= self.count <= 88:
+            raise PianobotError(f"--keys {self.count}: a keyboard has 1 to 88 keys")
+        if not 0 <= self.lowest or self.lowest + self.count - 1 > 127:
+            raise PianobotError(
+                f"a keyboard of {self.count} keys from {pitch_name(self.lowest)} goes past MIDI's "
+                "highest pitch G9: lower --lowest-note or use fewer --keys"
+            )
+
+    @property
+    def highest(self) -> int:
+        return self.lowest + self.count - 1
+
+    @property
+    def pitches(self) -> range:
+        return range(self.lowest, self.lowest + self.count)
+
+    def __contains__(self, pitch: int) -> bool:
+        return self.lowest <= pitch <= self.highest
+
+    def index(self, pitch: int) -> int:
+        """Key index 0..count-1 of a pitch on this keyboard."""
+        if pitch not in self:
+            raise PianobotError(f"{pitch_name(pitch)} is not on the keyboard {self.describe()}")
+        return pitch - self.lowest
+
+    @staticmethod
+    def is_black(pitch: int) -> bool:
+        return pitch % 12 in _BLACK
+
+    def describe(self) -> str:
+        return f"{pitch_name(self.lowest)}-{pitch_name(self.highest)} ({self.count} keys)"
+
+
+@dataclass(frozen=True)
+class HandSpec:
+    """Which fingers the robot hand plays with, in pianists' numbering (1 thumb ... 5 little)."""
+
+    fingers: tuple[int, ...] = (2, 3, 4)
+    """The Allegro hand's index, middle and ring fingers; add 1 for its thumb."""
+
+    def __post_init__(self) -> None:
+        if not self.fingers or len(set(self.fingers)) != len(self.fingers):
+            raise PianobotError(f"hand fingers {self.fingers} must be distinct and at least one")
+        if any(f not in FINGER_NAMES for f in self.fingers):
+            raise PianobotError(f"hand fingers {self.fingers} must be numbers 1-5")
+        object.__setattr__(self, "fingers", tuple(sorted(self.fingers)))
+
+    def slot(self, finger: int) -> int:
+        """Position of a finger in the one-hot fingering vector."""
+        return self.fingers.index(finger)
+
+    def describe(self) -> str:
+        return ", ".join(f"{f} ({FINGER_NAMES[f]})" for f in self.fingers)
+
+
+def suggest_transpose(piece: Piece, keyboard: KeyboardSpec) -> int | None:
+    """The smallest shift (octaves preferred) that brings every note onto the keyboard, if any."""
+    low = min(n.pitch for n in piece.notes)
+    high = max(n.pitch for n in piece.notes)
+    if high - low >= keyboard.count:
+        return None
+    fits = [s for s in range(keyboard.lowest - low, keyboard.highest - high + 1)]
+    octaves = [s for s in fits if s % 12 == 0]
+    return min(octaves or fits, key=abs)
+
+
+def check_playable(piece: Piece, keyboard: KeyboardSpec, hand: HandSpec) -> None:
+    """Raise a one-line :class:`PianobotError` if this hand cannot play ``piece`` on ``keyboard``.
+
+    Checks: at least one note; every note on the keyboard; no more notes sounding at once than
+    the hand has fingers; every finger number one the hand has; no finger holding two notes
+    at once.
+    """
+    if not piece.notes:
+        raise PianobotError("the piece has no notes: give a MIDI file with at least one note")
+    outside = [n for n in piece.notes if n.pitch not in keyboard]
+    if outside:
+        names = ", ".join(n.describe() for n in outside[:4]) + (" ..." if len(outside) > 4 else "")
+        shift = suggest_transpose(piece, keyboard)
+        fix = (
+            f"use --transpose {shift}" if shift is not None else "the piece spans more than the keyboard"
+        )
+        raise PianobotError(
+            f"{len(outside)} note(s) outside the keyboard {keyboard.describe()}: {names}; "
+            f"{fix}, or widen the keyboard with --lowest-note / --keys"
+        )
+    polyphony, when = piece.max_polyphony()
+    if polyphony > len(hand.fingers):
+        sounding = [n.name for n in piece.notes if n.onset <= when < n.offset]
+        raise PianobotError(
+            f"{polyphony} notes sound at once at {when:.3f} s ({', '.join(sounding)}) but the hand has "
+            f"{len(hand.fingers)} fingers: drop notes from that chord (e.g. with --track) or enable the thumb with --thumb"
+        )
+    for note in piece.notes:
+        if note.finger is not None and note.finger not in hand.fingers:
+            raise PianobotError(
+                f"{note.describe()} is fingered {note.finger} ({FINGER_NAMES[note.finger]}) but the hand "
+                f"plays with fingers {hand.describe()}: change that note's fingering"
+                + (" or enable the thumb with --thumb" if note.finger == 1 else "")
+            )
+    busy: dict[int, float] = {}
+    for note in piece.notes:
+        if note.finger is None:
+            continue
+        if busy.get(note.finger, -1.0) > note.onset:
+            raise PianobotError(
+                f"finger {note.finger} is asked to play {note.describe()} while it still holds an earlier "
+                "note: give one of the two notes another finger"
+            )
+        busy[note.finger] = note.offset

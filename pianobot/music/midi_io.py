@@ -1,0 +1,322 @@
+"""Standard MIDI files in and out, with fingering carried in lyric or text meta events.
+
+Fingering convention (see docs/fingering.md): at the tick where notes start, a lyric (or text)
+meta event in the same track holds one finger number per note starting there, lowest pitch
+first, separated by spaces or commas: ``"3"`` for a melody note, ``"2 4"`` for a two-note chord.
+A substitution written ``3_1`` counts as its first finger (the one that strikes); ``-`` marks
+a note without a finger. Texts that are not finger lists (ordinary lyrics) are ignored.
+
+Parsing uses mido; times come from the file's own tempo map unless ``bpm`` re-times the piece
+so that one beat lasts 60/bpm seconds.
+"""
+
+from __future__ import annotations
+
+import io
+import re
+import warnings
+from collections import defaultdict
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+import mido
+
+from pianobot.errors import PianobotError, PianobotWarning
+from pianobot.files import atomic_write
+from pianobot.music.piece import Note, Piece, pitch_name
+
+_FINGER_TOKEN = r"(?:[0-9](?:_[0-9])?|-)"
+_FINGER_TEXT = re.compile(rf"^\s*{_FINGER_TOKEN}(?:[\s,]+{_FINGER_TOKEN})*\s*$")
+MAX_FILE_BYTES = 50_000_000
+
+
+@dataclass(frozen=True)
+class TrackInfo:
+    """What one track of a MIDI file holds."""
+
+    index: int
+    name: str
+    notes: int
+    channels: tuple[int, ...]
+
+
+def parse_finger_text(text: str) -> list[int | None] | None:
+    """Finger numbers in a lyric/text event, or None when the text is not a finger list."""
+    if not _FINGER_TEXT.match(text):
+        return None
+    fingers: list[int | None] = []
+    for token in re.split(r"[\s,]+", text.strip()):
+        if token == "-":
+            fingers.append(None)
+            continue
+        finger = int(token.split("_")[0])
+        if not 1 <= finger <= 5:
+            raise PianobotError(
+                f"fingering text '{text}' holds finger {finger}: fingers are 1 (thumb) to 5 (little finger)"
+            )
+        fingers.append(finger)
+    return fingers
+
+
+def finger_text(fingers: list[int | None]) -> str:
+    """The inverse of :func:`parse_finger_text`."""
+    return " ".join("-" if f is None else str(f) for f in fingers)
+
+
+def _load(path: Path) -> mido.MidiFile:
+    if not path.exists():
+        raise PianobotError(f"no such file: {path}")
+    if path.is_dir():
+        raise PianobotError(f"{path} is a folder: give a .mid file")
+    if path.stat().st_size > MAX_FILE_BYTES:
+        raise PianobotError(f"{path} is larger than {MAX_FILE_BYTES // 1_000_000} MB: that is not a piano piece")
+    try:
+        data = path.read_bytes()
+    except OSError as e:
+        raise PianobotError(f"cannot read {path}: {e.strerror}") from None
+    if not data.startswith(b"MThd"):
+        raise PianobotError(f"{path} is not a MIDI file (it does not start with 'MThd'): give a standard .mid file")
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            midi = mido.MidiFile(file=io.BytesIO(data))
+    except Exception as e:  # mido raises many types on corrupt data
+        reason = str(e) or type(e).__name__
+        raise PianobotError(
+            f"{path} is not a readable MIDI file ({reason}): it may be truncated or corrupt; re-export it"
+        ) from None
+    if midi.type == 2:
+        raise PianobotError(f"{path} is a type 2 MIDI file (independent patterns): re-export it as type 0 or 1")
+    if midi.ticks_per_beat <= 0:
+        raise PianobotError(f"{path} uses SMPTE time division, which pianobot does not read: re-export it with beats")
+    return midi
+
+
+def _absolute(track: mido.MidiTrack) -> list[tuple[int, mido.Message]]:
+    """(absolute tick, message) pairs; at equal ticks note-offs come before note-ons."""
+    tick, out = 0, []
+    for msg in track:
+        tick += msg.time
+        out.append((tick, msg))
+
+    def order(item):
+        t, m = item
+        is_on = m.type == "note_on" and m.velocity > 0
+        return (t, 1 if is_on else 0)
+
+    return sorted(out, key=order)
+
+
+class _TempoMap:
+    """Ticks to seconds through a file's set_tempo events (default 120 bpm)."""
+
+    def __init__(self, midi: mido.MidiFile):
+        changes = sorted(
+            (t, m.tempo) for track in midi.tracks for t, m in _absolute(track) if m.type == "set_tempo"
+        )
+        self.tpb = midi.ticks_per_beat
+        self.points: list[tuple[int, float, int]] = []  # (tick, seconds at tick, tempo from there)
+        tick, seconds, tempo = 0, 0.0, 500_000
+        for change_tick, new_tempo in changes:
+            seconds += mido.tick2second(change_tick - tick, self.tpb, tempo)
+            tick, tempo = change_tick, new_tempo
+            self.points.append((tick, seconds, tempo))
+        self.first_tempo = changes[0][1] if changes and changes[0][0] == 0 else 500_000
+        self._base = (0, 0.0, 500_000)
+
+    def seconds(self, tick: int) -> float:
+        start = self._base
+        for point in self.points:
+            if point[0] > tick:
+                break
+            start = point
+        return start[1] + mido.tick2second(tick - start[0], self.tpb, start[2])
+
+
+def list_tracks(midi: mido.MidiFile) -> list[TrackInfo]:
+    infos = []
+    for i, track in enumerate(midi.tracks):
+        name = next((m.name for m in track if m.type == "track_name"), "")
+        ons = [m for m in track if m.type == "note_on" and m.velocity > 0]
+        infos.append(TrackInfo(i, name, len(ons), tuple(sorted({m.channel for m in ons}))))
+    return infos
+
+
+def _select_tracks(midi: mido.MidiFile, track: str | int | None, path: Path) -> list[int]:
+    infos = list_tracks(midi)
+    if track is None:
+        return [t.index for t in infos]
+    with_notes = ", ".join(f"{t.index} '{t.name}'" if t.name else str(t.index) for t in infos if t.notes)
+    key = str(track).strip()
+    if key.isdigit():
+        if int(key) < len(infos):
+            return [int(key)]
+    else:
+        hits = [t.index for t in infos if t.name.strip().lower() == key.lower()]
+        if hits:
+            return hits
+    raise PianobotError(f"{path} has no track '{track}': choose one of the tracks with notes: {with_notes or 'none'}")
+
+
+def _track_notes(
+    track: mido.MidiTrack, index: int, seconds, path: Path
+) -> tuple[list[tuple[int, int, int, int]], dict[int, list[int | None]]]:
+    """Notes as (on tick, off tick, pitch, velocity) and finger lists by tick, for one track."""
+    open_notes: dict[tuple[int, int], tuple[int, int]] = {}
+    notes: list[tuple[int, int, int, int]] = []
+    fingering: dict[int, list[int | None]] = defaultdict(list)
+    end = 0
+    for tick, msg in _absolute(track):
+        end = tick
+        if msg.type in ("lyrics", "text"):
+            fingers = parse_finger_text(msg.text)
+            if fingers is not None:
+                fingering[tick].extend(fingers)
+        elif msg.type == "note_on" and msg.velocity > 0:
+            key = (msg.channel, msg.note)
+            if key in open_notes:
+                on, vel = open_notes.pop(key)
+                warnings.warn(
+                    PianobotWarning(
+                        f"track {index}: {pitch_name(msg.note)} starts again at {seconds(tick):.3f} s while "
+                        "still sounding; the earlier note now ends there"
+                    )
+                )
+                if tick > on:
+                    notes.append((on, tick, msg.note, vel))
+            open_notes[key] = (tick, msg.velocity)
+        elif msg.type in ("note_off", "note_on"):
+            key = (msg.channel, msg.note)
+            if key in open_notes:
+                on, vel = open_notes.pop(key)
+                if tick > on:
+                    notes.append((on, tick, msg.note, vel))
+    for (_, pitch), (on, vel) in open_notes.items():
+        warnings.warn(PianobotWarning(f"track {index}: {pitch_name(pitch)} never ends; it ends with the track"))
+        if end > on:
+            notes.append((on, end, pitch, vel))
+    return notes, fingering
+
+
+def read_midi(path: str | Path, *, track: str | int | None = None, bpm: float | None = None) -> Piece:
+    """Read a .mid file into a :class:`Piece`, with fingering from lyric/text events.
+
+    ``track`` picks one track by index or name (default: all tracks merged). ``bpm`` re-times
+    the piece at a constant tempo, ignoring the file's tempo map.
+    """
+    path = Path(path)
+    midi = _load(path)
+    tempo_map = _TempoMap(midi)
+    if bpm is not None:
+        if not 10 <= bpm <= 1000:
+            raise PianobotError(f"--tempo {bpm}: choose a tempo between 10 and 1000 bpm")
+        tpb = midi.ticks_per_beat
+        seconds = lambda tick: tick / tpb * 60.0 / bpm  # noqa: E731
+        nominal = bpm
+    else:
+        seconds = tempo_map.seconds
+        nominal = max(10.0, min(1000.0, mido.tempo2bpm(tempo_map.first_tempo)))
+
+    notes: list[Note] = []
+    for index in _select_tracks(midi, track, path):
+        raw, fingering = _track_notes(midi.tracks[index], index, seconds, path)
+        by_tick: dict[int, list[tuple[int, int, int, int]]] = defaultdict(list)
+        for item in raw:
+            by_tick[item[0]].append(item)
+        for tick, fingers in fingering.items():
+            starting = sorted(by_tick.get(tick, []), key=lambda item: item[2])
+            if not starting:
+                warnings.warn(
+                    PianobotWarning(
+                        f"track {index}: fingering '{finger_text(fingers)}' at {seconds(tick):.3f} s has no "
+                        "note starting there; ignored"
+                    )
+                )
+                continue
+            if len(fingers) != len(starting):
+                raise PianobotError(
+                    f"{path} track {index} at {seconds(tick):.3f} s: fingering '{finger_text(fingers)}' gives "
+                    f"{len(fingers)} finger(s) for {len(starting)} note(s) starting there "
+                    f"({', '.join(pitch_name(s[2]) for s in starting)}): give one finger per note, lowest pitch first"
+                )
+        for on, off, pitch, vel in raw:
+            starting = sorted(by_tick[on], key=lambda item: item[2])
+            fingers = fingering.get(on)
+            finger = fingers[starting.index((on, off, pitch, vel))] if fingers else None
+            onset, offset = seconds(on), seconds(off)
+            if round(offset, 3) <= round(onset, 3):
+                warnings.warn(
+                    PianobotWarning(f"{pitch_name(pitch)} at {onset:.3f} s lasts under 1 ms; dropped")
+                )
+                continue
+            notes.append(Note(onset=onset, pitch=pitch, offset=offset, velocity=vel, finger=finger))
+    return Piece(tuple(_resolve_overlaps(notes)), bpm=nominal)
+
+
+def _resolve_overlaps(notes: list[Note]) -> list[Note]:
+    """One key cannot sound twice at once: cut an earlier note where the same pitch starts again."""
+    by_pitch: dict[int, list[Note]] = defaultdict(list)
+    for note in sorted(notes, key=lambda n: (n.onset, n.pitch, -n.velocity)):
+        previous = by_pitch[note.pitch][-1] if by_pitch[note.pitch] else None
+        if previous is not None and note.onset < previous.offset:
+            if note.onset == previous.onset:
+                warnings.warn(
+                    PianobotWarning(f"{note.describe()} appears twice at once; the louder one is kept")
+                )
+                if note.offset > previous.offset:
+                    by_pitch[note.pitch][-1] = replace(previous, offset=note.offset)
+                continue
+            warnings.warn(
+                PianobotWarning(
+                    f"{previous.describe()} still sounds when {note.name} starts again at {note.onset:.3f} s; "
+                    "the earlier note now ends there"
+                )
+            )
+            by_pitch[note.pitch][-1] = replace(previous, offset=note.onset)
+        by_pitch[note.pitch].append(note)
+    return [n for group in by_pitch.values() for n in group]
+
+
+def _write_resolution(bpm: float) -> tuple[int, int]:
+    """(tempo in microseconds per beat, ticks per beat) so that one tick is exactly 1 ms."""
+    tempo = max(1000, round(60e6 / bpm / 1000) * 1000)
+    return tempo, tempo // 1000
+
+
+def midi_bytes(piece: Piece, *, name: str = "pianobot") -> bytes:
+    """The piece as a type-0 MIDI file with 1 ms ticks and fingering lyrics."""
+    tempo, tpb = _write_resolution(piece.bpm)
+    events: list[tuple[int, int, mido.Message | mido.MetaMessage]] = []
+    for chord in piece.chords():
+        tick = round(chord[0].onset * 1000)
+        if any(n.finger is not None for n in chord):
+            text = finger_text([n.finger for n in sorted(chord, key=lambda n: n.pitch)])
+            events.append((tick, 1, mido.MetaMessage("lyrics", text=text)))
+        for note in chord:
+            events.append((tick, 2, mido.Message("note_on", note=note.pitch, velocity=note.velocity)))
+    for note in piece.notes:
+        events.append((round(note.offset * 1000), 0, mido.Message("note_off", note=note.pitch, velocity=0)))
+    events.sort(key=lambda e: (e[0], e[1]))
+    track = mido.MidiTrack()
+    track.append(mido.MetaMessage("track_name", name=name))
+    track.append(mido.MetaMessage("set_tempo", tempo=tempo))
+    last = 0
+    for tick, _, msg in events:
+        track.append(msg.copy(time=tick - last))
+        last = tick
+    track.append(mido.MetaMessage("end_of_track", time=0))
+    midi = mido.MidiFile(type=0, ticks_per_beat=tpb)
+    midi.tracks.append(track)
+    buffer = io.BytesIO()
+    midi.save(file=buffer)
+    return buffer.getvalue()
+
+
+def write_midi(piece: Piece, path: str | Path, *, name: str = "pianobot") -> Path:
+    """Write ``piece`` to ``path`` atomically (see :func:`midi_bytes`)."""
+    return atomic_write(path, midi_bytes(piece, name=name))
+
+
+def describe_tracks(path: str | Path) -> list[TrackInfo]:
+    """Tracks of a MIDI file, for `pianobot inspect`."""
+    return list_tracks(_load(Path(path)))

@@ -1,0 +1,212 @@
+"""Immutable notes and pieces.
+
+A :class:`Note` is a pitch sounding from ``onset`` to ``offset`` (seconds) at a MIDI velocity,
+optionally with the pianist's finger number (1 thumb ... 5 little finger). A :class:`Piece` is
+a sorted tuple of notes. Both are frozen and validated on construction; every transform returns
+a new object and never touches the one it was called on.
+
+Times are kept in whole milliseconds (rounded on construction). One millisecond is far below
+the 50 ms control step and the 50 ms onset tolerance of the metrics, and it makes
+``read(write(piece)) == piece`` exact: pianobot writes MIDI files with 1 ms ticks.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+from typing import Iterable, Sequence
+
+from pianobot.errors import PianobotError
+
+FINGER_NAMES = {1: "thumb", 2: "index", 3: "middle", 4: "ring", 5: "little"}
+_NAMES = ("C", "C#", "D", "D#", "E", "F", "F#", "G", "G#", "A", "A#", "B")
+_LETTER = {"C": 0, "D": 2, "E": 4, "F": 5, "G": 7, "A": 9, "B": 11}
+TIME_RESOLUTION = 1e-3
+"""Note times are rounded to this many seconds (1 ms)."""
+
+
+def pitch_name(pitch: int) -> str:
+    """MIDI pitch number to scientific pitch name with sharps: 60 -> 'C4', 61 -> 'C#4'."""
+    return f"{_NAMES[pitch % 12]}{pitch // 12 - 1}"
+
+
+def parse_pitch(name: str) -> int:
+    """Scientific pitch name to MIDI number: 'C4' -> 60, 'Eb4' / 'E-4' -> 63, 'C#4' -> 61.
+
+    Also accepts a plain MIDI number ('60').
+    """
+    text = name.strip()
+    if text.lstrip("-").isdigit():
+        value = int(text)
+    else:
+        if not text or text[0].upper() not in _LETTER:
+            raise PianobotError(f"'{name}' is not a pitch: write it like C4, F#3, Bb5 or a MIDI number 0-127")
+        value = _LETTER[text[0].upper()]
+        rest = text[1:]
+        while rest and rest[0] in "#b-":
+            value += 1 if rest[0] == "#" else -1
+            rest = rest[1:]
+        try:
+            octave = int(rest)
+        except ValueError:
+            raise PianobotError(
+                f"'{name}' is not a pitch: write it like C4, F#3, Bb5 or a MIDI number 0-127"
+            ) from None
+        value += (octave + 1) * 12
+    if not 0 <= value <= 127:
+        raise PianobotError(f"pitch '{name}' is outside MIDI's range 0-127 (C-1 to G9)")
+    return value
+
+
+def _ms(seconds: float) -> float:
+    return round(round(seconds / TIME_RESOLUTION) * TIME_RESOLUTION, 6)
+
+
+@dataclass(frozen=True)
+class Note:
+    """One note: MIDI pitch 0-127, onset < offset in seconds, velocity 1-127, finger 1-5 or None."""
+
+    onset: float
+    pitch: int
+    offset: float
+    velocity: int = 80
+    finger: int | None = None
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "onset", _ms(self.onset))
+        object.__setattr__(self, "offset", _ms(self.offset))
+        if not isinstance(self.pitch, int) or not 0 <= self.pitch <= 127:
+            raise PianobotError(f"pitch {self.pitch!r} is outside MIDI's range 0-127")
+        if self.onset < 0:
+            raise PianobotError(f"note {pitch_name(self.pitch)} starts at {self.onset} s: onsets must be >= 0")
+        if self.offset <= self.onset:
+            raise PianobotError(
+                f"note {pitch_name(self.pitch)} at {self.onset:.3f} s ends at {self.offset:.3f} s: "
+                "a note must end after it starts (it must last at least 1 ms)"
+            )
+        if not isinstance(self.velocity, int) or not 1 <= self.velocity <= 127:
+            raise PianobotError(
+                f"note {pitch_name(self.pitch)} at {self.onset:.3f} s has velocity {self.velocity!r}: "
+                "velocities are whole numbers 1-127"
+            )
+        if self.finger is not None and (not isinstance(self.finger, int) or not 1 <= self.finger <= 5):
+            raise PianobotError(
+                f"note {pitch_name(self.pitch)} at {self.onset:.3f} s has finger {self.finger!r}: "
+                "fingers are numbered 1 (thumb) to 5 (little finger)"
+            )
+
+    @property
+    def duration(self) -> float:
+        return round(self.offset - self.onset, 6)
+
+    @property
+    def name(self) -> str:
+        return pitch_name(self.pitch)
+
+    def describe(self) -> str:
+        """Short human description used in error messages: 'E4 at 1.500 s'."""
+        return f"{self.name} at {self.onset:.3f} s"
+
+
+def _sort_key(n: Note) -> tuple:
+    return (n.onset, n.pitch, n.offset, n.velocity, n.finger or 0)
+
+
+@dataclass(frozen=True)
+class Piece:
+    """A sorted, immutable sequence of notes.
+
+    ``bpm`` is the nominal tempo (beats per minute) used when the piece is written to MIDI; it
+    does not take part in equality, since the notes' times already say everything about timing.
+    """
+
+    notes: tuple[Note, ...]
+    bpm: float = field(default=120.0, compare=False)
+
+    def __post_init__(self) -> None:
+        for note in self.notes:
+            if not isinstance(note, Note):
+                raise TypeError(f"Piece takes Note objects, got {type(note).__name__}")
+        notes = tuple(sorted(self.notes, key=_sort_key))
+        object.__setattr__(self, "notes", notes)
+        if not 10 <= self.bpm <= 1000:
+            raise PianobotError(f"tempo {self.bpm} bpm is out of range: use 10-1000 bpm")
+
+    # -- views ---------------------------------------------------------------------------
+    def __len__(self) -> int:
+        return len(self.notes)
+
+    def __iter__(self):
+        return iter(self.notes)
+
+    @property
+    def duration(self) -> float:
+        """Time from 0 to the last offset, in seconds."""
+        return max((n.offset for n in self.notes), default=0.0)
+
+    @property
+    def has_fingering(self) -> bool:
+        """True when every note has a finger."""
+        return bool(self.notes) and all(n.finger is not None for n in self.notes)
+
+    def chords(self) -> list[tuple[Note, ...]]:
+        """Notes grouped by equal onset (a melody note is a chord of one), in time order."""
+        groups: list[list[Note]] = []
+        for note in self.notes:
+            if groups and groups[-1][0].onset == note.onset:
+                groups[-1].append(note)
+            else:
+                groups.append([note])
+        return [tuple(g) for g in groups]
+
+    def max_polyphony(self) -> tuple[int, float]:
+        """Largest number of notes sounding at once, and the first time it happens."""
+        events = sorted([(n.onset, 1) for n in self.notes] + [(n.offset, -1) for n in self.notes])
+        best, when, now = 0, 0.0, 0
+        for time, change in events:  # offsets (-1) sort before onsets (+1) at equal times
+            now += change
+            if now > best:
+                best, when = now, time
+        return best, when
+
+    # -- transforms (all return new pieces) ---------------------------------------------
+    def transpose(self, semitones: int) -> "Piece":
+        """The same piece shifted by ``semitones`` (positive is up)."""
+        if semitones == 0:
+            return self
+        out = []
+        for n in self.notes:
+            if not 0 <= n.pitch + semitones <= 127:
+                raise PianobotError(
+                    f"--transpose {semitones} moves {n.describe()} outside MIDI's range 0-127: use a smaller shift"
+                )
+            out.append(replace(n, pitch=n.pitch + semitones))
+        return Piece(tuple(out), bpm=self.bpm)
+
+    def retime(self, factor: float) -> "Piece":
+        """Every time multiplied by ``factor`` (2.0 plays twice as slowly)."""
+        if factor <= 0:
+            raise PianobotError(f"time factor {factor} must be positive")
+        return Piece(
+            tuple(replace(n, onset=n.onset * factor, offset=n.offset * factor) for n in self.notes),
+            bpm=self.bpm / factor,
+        )
+
+    def shift(self, seconds: float) -> "Piece":
+        """Every time moved by ``seconds`` (the result must not start before 0)."""
+        return Piece(
+            tuple(replace(n, onset=n.onset + seconds, offset=n.offset + seconds) for n in self.notes),
+            bpm=self.bpm,
+        )
+
+    def with_fingers(self, fingers: Sequence[int | None]) -> "Piece":
+        """The same notes (in this piece's order) with the given fingers."""
+        if len(fingers) != len(self.notes):
+            raise ValueError(f"{len(fingers)} fingers for {len(self.notes)} notes")
+        return Piece(tuple(replace(n, finger=f) for n, f in zip(self.notes, fingers)), bpm=self.bpm)
+
+    def without_fingering(self) -> "Piece":
+        return self.with_fingers([None] * len(self.notes))
+
+    @staticmethod
+    def of(notes: Iterable[Note], bpm: float = 120.0) -> "Piece":
+        return Piece(tuple(notes), bpm=bpm)

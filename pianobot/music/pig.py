@@ -1,0 +1,138 @@
+"""PIG v1.0 fingering files (the PIG piano-fingering dataset's format).
+
+One header line (``//Version: PianoFingering_v170101``), then one note per line with 8
+tab-separated columns: id, onset (s), offset (s), spelled pitch (``C#4``, ``Bb3``), onset
+velocity, offset velocity, channel (0 right hand, 1 left hand), finger (``+1``..``+5`` right,
+``-1``..``-5`` left; a substitution ``3_1`` counts as its first finger, the one that strikes).
+
+A PIG file can be read as a piece on its own, or applied as a fingering sidecar to the notes of
+a .mid file (:func:`apply_fingering`).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from pianobot.errors import PianobotError
+from pianobot.files import atomic_write
+from pianobot.music.piece import Note, Piece, parse_pitch, pitch_name
+
+HEADER = "//Version: PianoFingering_v170101"
+SIDECAR_SUFFIX = "_fingering.txt"
+"""A sidecar for ``song.mid`` is ``song_fingering.txt`` in the same folder (PIG's own naming)."""
+MATCH_TOLERANCE = 0.025
+"""A sidecar note matches a MIDI note of the same pitch whose onset is this close (seconds)."""
+
+
+def _parse_finger(text: str, where: str) -> tuple[int, int]:
+    """(finger 1-5, hand sign +1/-1) from '+3', '-2', '3', '3_1'."""
+    token = text.strip().split("_")[0]
+    try:
+        value = int(token)
+    except ValueError:
+        raise PianobotError(f"{where}: finger '{text}' is not a number like +3, -2 or 3_1") from None
+    if not 1 <= abs(value) <= 5:
+        raise PianobotError(f"{where}: finger '{text}' must be 1-5 (right hand) or -1..-5 (left hand)")
+    return abs(value), (-1 if token.startswith("-") else 1)
+
+
+def read_pig_rows(path: str | Path) -> list[tuple[Note, int]]:
+    """Every note of a PIG file with its channel (0 right hand, 1 left hand)."""
+    path = Path(path)
+    if not path.exists():
+        raise PianobotError(f"fingering file {path} does not exist: check the path given to --fingering")
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as e:
+        raise PianobotError(f"cannot read fingering file {path} ({e}): it must be a UTF-8 PIG text file") from None
+    rows: list[tuple[Note, int]] = []
+    for number, line in enumerate(text.splitlines(), start=1):
+        if not line.strip() or line.startswith("//"):
+            continue
+        where = f"{path.name} line {number}"
+        cols = line.split("\t") if "\t" in line else line.split()
+        if len(cols) < 8:
+            raise PianobotError(
+                f"{where} has {len(cols)} columns, a PIG file needs 8 "
+                "(id, onset, offset, pitch, onset velocity, offset velocity, channel, finger)"
+            )
+        try:
+            onset, offset = float(cols[1]), float(cols[2])
+            velocity = int(cols[4])
+            channel = int(cols[6])
+        except ValueError:
+            raise PianobotError(f"{where}: onset, offset, velocity and channel must be numbers") from None
+        if channel not in (0, 1):
+            raise PianobotError(f"{where}: channel {channel} must be 0 (right hand) or 1 (left hand)")
+        finger, _ = _parse_finger(cols[7], where)
+        pitch = parse_pitch(cols[3])
+        try:
+            note = Note(onset=onset, pitch=pitch, offset=offset, velocity=max(1, min(127, velocity)), finger=finger)
+        except PianobotError as e:
+            raise PianobotError(f"{where}: {e}") from None
+        rows.append((note, channel))
+    if not rows:
+        raise PianobotError(f"fingering file {path} holds no notes: is it a PIG v1.0 file?")
+    return rows
+
+
+def read_pig(path: str | Path, *, hand: str = "right") -> Piece:
+    """A PIG file's notes for one hand as a piece (fingers stored as 1-5)."""
+    channel = {"right": 0, "left": 1}[hand]
+    notes = [note for note, ch in read_pig_rows(path) if ch == channel]
+    if not notes:
+        raise PianobotError(f"{path} has no {hand}-hand notes (channel {channel}): choose the other hand")
+    return Piece(tuple(notes))
+
+
+def pig_text(piece: Piece) -> str:
+    """The piece as PIG text (right hand, channel 0). Every note needs a finger."""
+    lines = [HEADER]
+    for i, note in enumerate(piece.notes):
+        if note.finger is None:
+            raise PianobotError(f"{note.describe()} has no finger: a PIG file needs a finger for every note")
+        lines.append(
+            "\t".join(
+                [str(i), f"{note.onset:.6f}", f"{note.offset:.6f}", pitch_name(note.pitch),
+                 str(note.velocity), "80", "0", str(note.finger)]
+            )
+        )
+    return "\n".join(lines) + "\n"
+
+
+def write_pig(piece: Piece, path: str | Path) -> Path:
+    return atomic_write(path, pig_text(piece))
+
+
+def sidecar_for(midi_path: str | Path) -> Path:
+    """Where the fingering sidecar of a .mid file would be."""
+    midi_path = Path(midi_path)
+    return midi_path.with_name(midi_path.stem + SIDECAR_SUFFIX)
+
+
+def apply_fingering(piece: Piece, pig_path: str | Path) -> Piece:
+    """Take each note's finger from the PIG note of the same pitch starting at the same time.
+
+    Every note of ``piece`` must find its PIG note (within :data:`MATCH_TOLERANCE`); PIG notes
+    left over (e.g. the other hand's) are ignored.
+    """
+    rows = sorted(read_pig_rows(pig_path), key=lambda r: (r[0].onset, r[0].pitch))
+    used = [False] * len(rows)
+    fingers = []
+    for note in piece.notes:
+        best = None
+        for i, (candidate, _) in enumerate(rows):
+            if used[i] or candidate.pitch != note.pitch:
+                continue
+            gap = abs(candidate.onset - note.onset)
+            if gap <= MATCH_TOLERANCE and (best is None or gap < best[0]):
+                best = (gap, i)
+        if best is None:
+            raise PianobotError(
+                f"fingering file {Path(pig_path).name} has no note for {note.describe()}: "
+                "the sidecar must list the same notes as the .mid file (same pitches and onsets)"
+            )
+        used[best[1]] = True
+        fingers.append(rows[best[1]][0].finger)
+    return piece.with_fingers(fingers)
+
