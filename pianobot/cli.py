@@ -17,7 +17,7 @@ from rich.console import Console
 
 from pianobot import __version__, display
 from pianobot.errors import PianobotError, PianobotWarning
-from pianobot.files import atomic_write
+from pianobot.files import atomic_write, check_writable
 from pianobot.metrics import DEFAULT_ONSET_TOLERANCE, compare, plot_report
 from pianobot.music import midi_io
 from pianobot.music.instrument import HandSpec, KeyboardSpec, check_playable
@@ -134,6 +134,9 @@ def score(
         raise PianobotError(f"--onset-tolerance {onset_tolerance}: give seconds between 0 and 1, e.g. 0.05")
     if plot is not None and plot.suffix.lower() != ".png":
         raise PianobotError(f"--plot {plot}: the plot is a PNG image, name the file *.png")
+    for target in (json_path, plot):
+        if target is not None:
+            check_writable(target)
     reference_piece = load_piece(reference)
     played_piece = midi_io.read_midi(played)
     report = compare(reference_piece, played_piece, onset_tolerance=onset_tolerance)

@@ -9,16 +9,22 @@ from pathlib import Path
 from pianobot.errors import PianobotError
 
 
+def check_writable(path: str | os.PathLike) -> Path:
+    """Fail early, before any work is done, if ``path`` cannot be written."""
+    path = Path(path)
+    if path.is_dir():
+        raise PianobotError(f"{path} is a folder: give a file name to write to")
+    if not path.parent.is_dir():
+        raise PianobotError(f"folder {path.parent} does not exist: create it first or choose another path")
+    return path
+
+
 def atomic_write(path: str | os.PathLike, data: bytes | str) -> Path:
     """Write ``data`` to ``path`` via a temporary file in the same folder and an atomic rename.
 
     Either the whole new file is there afterwards, or the old one (if any) is untouched.
     """
-    path = Path(path)
-    if path.is_dir():
-        raise PianobotError(f"{path} is a folder: give a file name to write to")
-    if not path.parent.exists():
-        raise PianobotError(f"folder {path.parent} does not exist: create it first or choose another path")
+    path = check_writable(path)
     payload = data.encode() if isinstance(data, str) else data
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     try:

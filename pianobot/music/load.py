@@ -39,9 +39,10 @@ def load_piece(path: str | Path, options: LoadOptions = LoadOptions()) -> Piece:
         piece = midi_io.read_midi(path, track=options.track)
         sidecar = options.fingering or pig.sidecar_for(path)
         if options.fingering is not None or sidecar.exists():
-            if piece.has_fingering:
-                warnings.warn(PianobotWarning(f"fingering from {sidecar.name} replaces the fingering inside {path.name}"))
+            embedded = any(n.finger is not None for n in piece.notes)
             piece = pig.apply_fingering(piece, sidecar)
+            if embedded:
+                warnings.warn(PianobotWarning(f"fingering from {sidecar.name} replaces the fingering inside {path.name}"))
         if options.tempo is not None:
             # re-read with the new tempo, then carry the fingering over note by note
             fingers = [n.finger for n in piece.notes]

@@ -12,6 +12,7 @@ the 50 ms control step and the 50 ms onset tolerance of the metrics, and it make
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field, replace
 from typing import Iterable, Sequence
 
@@ -41,16 +42,12 @@ def parse_pitch(name: str) -> int:
         if not text or text[0].upper() not in _LETTER:
             raise PianobotError(f"'{name}' is not a pitch: write it like C4, F#3, Bb5 or a MIDI number 0-127")
         value = _LETTER[text[0].upper()]
-        rest = text[1:]
-        while rest and rest[0] in "#b-":
-            value += 1 if rest[0] == "#" else -1
-            rest = rest[1:]
-        try:
-            octave = int(rest)
-        except ValueError:
-            raise PianobotError(
-                f"'{name}' is not a pitch: write it like C4, F#3, Bb5 or a MIDI number 0-127"
-            ) from None
+        # the octave is the trailing number; "-1" at the end is octave -1 (C-1 = 0), not a flat
+        match = re.fullmatch(r"([#b-]*?)(-1|\d+)", text[1:])
+        if match is None:
+            raise PianobotError(f"'{name}' is not a pitch: write it like C4, F#3, Bb5 or a MIDI number 0-127")
+        accidentals, octave = match.group(1), int(match.group(2))
+        value += accidentals.count("#") - accidentals.count("b") - accidentals.count("-")
         value += (octave + 1) * 12
     if not 0 <= value <= 127:
         raise PianobotError(f"pitch '{name}' is outside MIDI's range 0-127 (C-1 to G9)")

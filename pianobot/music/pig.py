@@ -65,8 +65,8 @@ def read_pig_rows(path: str | Path) -> list[tuple[Note, int]]:
         if channel not in (0, 1):
             raise PianobotError(f"{where}: channel {channel} must be 0 (right hand) or 1 (left hand)")
         finger, _ = _parse_finger(cols[7], where)
-        pitch = parse_pitch(cols[3])
         try:
+            pitch = parse_pitch(cols[3])
             note = Note(onset=onset, pitch=pitch, offset=offset, velocity=max(1, min(127, velocity)), finger=finger)
         except PianobotError as e:
             raise PianobotError(f"{where}: {e}") from None

@@ -1,0 +1,61 @@
+"""Fixtures built in code: small pieces written to tmp_path, never files from the network."""
+
+from __future__ import annotations
+
+import mido
+import pytest
+
+from pianobot.music.midi_io import write_midi
+from pianobot.music.piece import Note, Piece
+
+
+@pytest.fixture
+def scale() -> Piece:
+    """Four quarter notes at 60 bpm, fingered 2 3 4 2, with different velocities."""
+    return Piece(
+        (
+            Note(0.0, 60, 1.0, 70, 2),
+            Note(1.0, 62, 2.0, 90, 3),
+            Note(2.0, 64, 3.0, 60, 4),
+            Note(3.0, 65, 4.0, 100, 2),
+        ),
+        bpm=60,
+    )
+
+
+@pytest.fixture
+def scale_file(tmp_path, scale):
+    return write_midi(scale, tmp_path / "scale.mid")
+
+
+def midi_file(path, tracks, ticks_per_beat=480, tempo_events=((0, 500_000),)):
+    """Write a type-1 MIDI file from per-track lists of (absolute tick, message)."""
+    midi = mido.MidiFile(type=1, ticks_per_beat=ticks_per_beat)
+    conductor = mido.MidiTrack()
+    last = 0
+    for tick, tempo in tempo_events:
+        conductor.append(mido.MetaMessage("set_tempo", tempo=tempo, time=tick - last))
+        last = tick
+    midi.tracks.append(conductor)
+    for name, events in tracks:
+        track = mido.MidiTrack()
+        track.append(mido.MetaMessage("track_name", name=name, time=0))
+        last = 0
+        for tick, msg in sorted(events, key=lambda e: e[0]):
+            track.append(msg.copy(time=tick - last))
+            last = tick
+        midi.tracks.append(track)
+    midi.save(path)
+    return path
+
+
+def on(note, velocity=80, channel=0):
+    return mido.Message("note_on", note=note, velocity=velocity, channel=channel)
+
+
+def off(note, channel=0):
+    return mido.Message("note_off", note=note, velocity=0, channel=channel)
+
+
+def lyric(text):
+    return mido.MetaMessage("lyrics", text=text)

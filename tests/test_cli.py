@@ -1,0 +1,155 @@
+import json
+from dataclasses import replace
+from pathlib import Path
+
+import mido
+import pytest
+from typer.testing import CliRunner
+
+from pianobot.cli import app
+from pianobot.music.midi_io import write_midi
+from pianobot.music.piece import Note, Piece
+from pianobot.music.pig import sidecar_for, write_pig
+
+runner = CliRunner()
+EXAMPLES = Path(__file__).parent.parent / "examples" / "midi"
+
+
+def run(*args):
+    return runner.invoke(app, [str(a) for a in args])
+
+
+def assert_one_line_error(result, *words):
+    """Exit code 2 and exactly one line on stderr (inspect may still have printed what it found)."""
+    assert result.exit_code == 2, result.output
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: "), result.output
+    assert "Traceback" not in result.output
+    for word in words:
+        assert word in lines[0], lines[0]
+
+
+def test_score_of_a_file_against_itself(scale_file):
+    result = run("score", scale_file, scale_file)
+    assert result.exit_code == 0, result.output
+    assert "note F1" in result.output and "1.000" in result.output
+
+
+def test_score_json_holds_the_expected_figures(tmp_path, scale):
+    notes = list(scale.notes)
+    notes[1] = replace(notes[1], velocity=notes[1].velocity - 10)
+    notes[2] = replace(notes[2], onset=notes[2].onset + 0.03)
+    del notes[3]
+    reference = write_midi(scale, tmp_path / "ref.mid")
+    played = write_midi(Piece(tuple(notes), bpm=60), tmp_path / "played.mid")
+    result = run("score", played, reference, "--json", tmp_path / "r.json", "--plot", tmp_path / "r.png")
+    assert result.exit_code == 0, result.output
+    figures = json.loads((tmp_path / "r.json").read_text())
+    assert figures["f1"] == pytest.approx(6 / 7)
+    assert figures["velocity_mae"] == pytest.approx(10 / 3)
+    assert figures["velocity_max_error"] == 10
+    assert figures["onset_error_max"] == pytest.approx(0.03)
+    assert [n["status"] for n in figures["notes"]] == ["matched", "matched", "matched", "missed"]
+    assert (tmp_path / "r.png").read_bytes()[:4] == b"\x89PNG"
+
+
+def test_onset_tolerance_option_changes_matching(tmp_path, scale):
+    late = scale.shift(0.04)
+    reference, played = write_midi(scale, tmp_path / "ref.mid"), write_midi(late, tmp_path / "late.mid")
+    run("score", played, reference, "--json", tmp_path / "a.json")
+    run("score", played, reference, "--json", tmp_path / "b.json", "--onset-tolerance", "0.03")
+    assert json.loads((tmp_path / "a.json").read_text())["f1"] == 1.0
+    assert json.loads((tmp_path / "b.json").read_text())["f1"] == 0.0
+
+
+def test_inspect_shows_notes_phrases_and_range():
+    result = run("inspect", EXAMPLES / "twinkle.mid")
+    assert result.exit_code == 0, result.output
+    assert "14 notes" in result.output and "3 phrases" in result.output
+    assert "playable on C4-B5" in result.output
+
+
+def test_inspect_with_transpose_tempo_and_keyboard_options(tmp_path):
+    low = write_midi(Piece((Note(0, 48, 1, 80, 2), Note(1, 50, 2, 80, 3)), bpm=60), tmp_path / "low.mid")
+    assert_one_line_error(run("inspect", low), "--transpose 12")
+    assert run("inspect", low, "--transpose", "12").exit_code == 0
+    assert run("inspect", low, "--lowest-note", "C3").exit_code == 0
+    slow = run("inspect", low, "--lowest-note", "C3", "--tempo", "30")
+    assert "duration 4.00 s at 30 bpm" in slow.output
+
+
+def test_thumb_option_enables_finger_one(tmp_path):
+    path = write_midi(Piece((Note(0, 60, 1, 80, 1),)), tmp_path / "thumb.mid")
+    assert_one_line_error(run("inspect", path), "--thumb")
+    assert run("inspect", path, "--thumb").exit_code == 0
+
+
+def test_track_option(tmp_path):
+    midi = mido.MidiFile(type=1)
+    for name, pitch in (("right", 72), ("left", 48)):
+        track = mido.MidiTrack([mido.MetaMessage("track_name", name=name), mido.Message("note_on", note=pitch, velocity=80),
+                                mido.Message("note_off", note=pitch, time=480)])
+        midi.tracks.append(track)
+    midi.save(tmp_path / "two.mid")
+    assert_one_line_error(run("inspect", tmp_path / "two.mid"), "outside the keyboard", "C3")
+    assert run("inspect", tmp_path / "two.mid", "--track", "right").exit_code == 0
+    assert_one_line_error(run("inspect", tmp_path / "two.mid", "--track", "9"), "no track '9'")
+
+
+def write_bytes(tmp_path, name, data):
+    path = tmp_path / name
+    path.write_bytes(data)
+    return path
+
+
+@pytest.mark.parametrize("command", ["inspect", "score"])
+def test_bad_files_answer_with_one_line(tmp_path, scale_file, command):
+    not_midi = write_bytes(tmp_path, "x.mid", b"RIFF....WAVEfmt ")
+    truncated = write_bytes(tmp_path, "t.mid", scale_file.read_bytes()[:30])
+    empty = tmp_path / "empty.mid"
+    mido.MidiFile(tracks=[mido.MidiTrack([mido.MetaMessage("track_name", name="x")])]).save(empty)
+    for bad, words in ((not_midi, "not a MIDI file"), (truncated, "truncated"), (empty, "no notes"),
+                       (tmp_path / "missing.mid", "no such file")):
+        args = ("inspect", bad) if command == "inspect" else ("score", scale_file, bad)
+        assert_one_line_error(run(*args), str(bad.name) if words != "no such file" else "missing.mid", words)
+
+
+def test_polyphony_and_missing_fingers(tmp_path):
+    chord = write_midi(Piece(tuple(Note(0, p, 1) for p in (60, 64, 67, 71))), tmp_path / "c.mid")
+    assert_one_line_error(run("inspect", chord), "4 notes sound at once")
+    little = write_midi(Piece((Note(0, 60, 1, 80, 5),)), tmp_path / "l.mid")
+    assert_one_line_error(run("inspect", little), "fingered 5 (little)")
+
+
+def test_sidecar_problems(tmp_path, scale):
+    song = write_midi(scale, tmp_path / "song.mid")
+    assert_one_line_error(run("inspect", song, "--fingering", tmp_path / "nope.txt"), "does not exist")
+    sidecar_for(song).write_text("//Version: PianoFingering_v170101\n0\t0\t1\tC4\n")
+    assert_one_line_error(run("inspect", song), "song_fingering.txt line 2", "needs 8")
+    write_pig(scale, sidecar_for(song))
+    result = run("inspect", song)
+    assert result.exit_code == 0 and "replaces the fingering" in result.output
+
+
+def test_overlaps_are_a_warning_not_an_error(tmp_path):
+    midi = mido.MidiFile(type=1)
+    for _ in range(2):
+        midi.tracks.append(mido.MidiTrack([mido.Message("note_on", note=60, velocity=80, time=0 if not midi.tracks else 240),
+                                           mido.Message("note_off", note=60, time=480)]))
+    midi.save(tmp_path / "overlap.mid")
+    result = run("inspect", tmp_path / "overlap.mid")
+    assert result.exit_code == 0, result.output
+    assert "warning:" in result.output and "Traceback" not in result.output
+
+
+def test_bad_option_values(scale_file, tmp_path):
+    assert_one_line_error(run("score", scale_file, scale_file, "--onset-tolerance", "0"), "--onset-tolerance")
+    assert_one_line_error(run("score", scale_file, scale_file, "--plot", tmp_path / "x.jpg"), "PNG")
+    assert_one_line_error(run("inspect", scale_file, "--lowest-note", "X9"), "not a pitch")
+    assert_one_line_error(run("inspect", scale_file, "--tempo", "0"), "--tempo")
+    assert_one_line_error(run("score", scale_file, scale_file, "--json", tmp_path / "no" / "r.json"), "does not exist")
+
+
+def test_version():
+    result = run("--version")
+    assert result.exit_code == 0 and result.output.startswith("pianobot ")

@@ -1,0 +1,62 @@
+import pytest
+
+from pianobot.errors import PianobotError
+from pianobot.music.instrument import HandSpec, KeyboardSpec, check_playable, suggest_transpose
+from pianobot.music.piece import Note, Piece
+
+KEYS = KeyboardSpec()
+HAND = HandSpec()
+
+
+def test_default_keyboard_is_the_papers_two_octaves():
+    assert (KEYS.lowest, KEYS.highest) == (60, 83)
+    white = [p for p in KEYS.pitches if not KEYS.is_black(p)]
+    assert len(white) == 14 and KEYS.count - len(white) == 10
+
+
+def test_notes_outside_the_keyboard_are_named_with_a_transpose_hint():
+    piece = Piece((Note(0, 48, 1, finger=2), Note(1, 50, 2, finger=3)))  # C3, D3
+    with pytest.raises(PianobotError) as e:
+        check_playable(piece, KEYS, HAND)
+    message = str(e.value)
+    assert "C3 at 0.000 s" in message and "D3 at 1.000 s" in message
+    assert "--transpose 12" in message and "--lowest-note" in message
+
+
+def test_transpose_suggestion_prefers_octaves_and_fails_for_wide_pieces():
+    assert suggest_transpose(Piece((Note(0, 86, 1),)), KEYS) == -12
+    assert suggest_transpose(Piece((Note(0, 59, 1), Note(1, 83, 2))), KEYS) is None
+
+
+def test_more_simultaneous_notes_than_fingers():
+    chord = Piece(tuple(Note(0, p, 1) for p in (60, 64, 67, 72)))
+    with pytest.raises(PianobotError, match="4 notes sound at once at 0.000 s .* 3 fingers"):
+        check_playable(chord, KEYS, HAND)
+    check_playable(chord, KEYS, HandSpec(fingers=(1, 2, 3, 4)))
+
+
+@pytest.mark.parametrize("finger", [1, 5])
+def test_fingers_the_hand_lacks(finger):
+    piece = Piece((Note(0, 60, 1, finger=finger),))
+    with pytest.raises(PianobotError, match=f"fingered {finger}"):
+        check_playable(piece, KEYS, HAND)
+
+
+def test_one_finger_cannot_hold_two_notes():
+    piece = Piece((Note(0, 60, 2, finger=2), Note(1, 64, 2, finger=2)))
+    with pytest.raises(PianobotError, match="finger 2 is asked to play E4"):
+        check_playable(piece, KEYS, HAND)
+    legato = Piece((Note(0, 60, 1, finger=2), Note(1, 64, 2, finger=2)))
+    check_playable(legato, KEYS, HAND)
+
+
+def test_empty_piece():
+    with pytest.raises(PianobotError, match="no notes"):
+        check_playable(Piece(()), KEYS, HAND)
+
+
+def test_bad_keyboard_specs():
+    with pytest.raises(PianobotError):
+        KeyboardSpec(lowest=120, count=24)
+    with pytest.raises(PianobotError):
+        KeyboardSpec(count=0)

@@ -1,0 +1,97 @@
+from dataclasses import replace
+
+import mir_eval
+import numpy as np
+import pytest
+
+from pianobot.metrics import compare, key_press_f1
+from pianobot.music.piece import Note, Piece
+
+
+@pytest.fixture
+def reference():
+    return Piece(tuple(Note(float(i), 60 + 2 * i, i + 1.0, 60 + 10 * i, 2 + i % 3) for i in range(6)), bpm=60)
+
+
+def flawed(reference):
+    """One note dropped, one velocity changed by +20, one onset shifted by 30 ms."""
+    notes = list(reference.notes)
+    notes[3] = replace(notes[3], velocity=notes[3].velocity + 20)
+    notes[4] = replace(notes[4], onset=notes[4].onset + 0.03)
+    del notes[1]
+    return Piece(tuple(notes))
+
+
+def test_a_piece_against_itself_is_perfect(reference):
+    report = compare(reference, reference)
+    assert report.f1 == report.precision == report.recall == 1.0
+    assert report.f1_with_offsets == report.velocity_f1 == report.step_f1 == 1.0
+    assert report.velocity_mae == 0 and report.velocity_max_error == 0
+    assert report.onset_error_mean == 0 and report.onset_error_max == 0
+    assert report.fingering_accuracy == 1.0
+
+
+def test_exact_figures_for_a_known_set_of_mistakes(reference):
+    report = compare(reference, flawed(reference))
+    assert report.matched_notes == 5
+    assert report.precision == 1.0
+    assert report.recall == pytest.approx(5 / 6)
+    assert report.f1 == pytest.approx(10 / 11)
+    assert report.f1_with_offsets == pytest.approx(10 / 11)
+    assert report.velocity_mae == pytest.approx(20 / 5)
+    assert report.velocity_max_error == 20
+    assert report.onset_error_mean == pytest.approx(0.03 / 5)
+    assert report.onset_error_max == pytest.approx(0.03)
+    # 120 steps; the dropped note empties 20 of them and the late onset one more
+    assert report.step_f1 == pytest.approx(99 / 120)
+    assert [r.played is None for r in report.rows].count(True) == 1
+
+
+def test_figures_agree_with_mir_eval_called_directly(reference):
+    played = flawed(reference)
+    played = Piece(played.notes + (Note(2.5, 71, 3.0, 50),))  # an extra note too
+    report = compare(reference, played, onset_tolerance=0.02)
+
+    def arrays(piece):
+        return (
+            np.array([[n.onset, n.offset] for n in piece]),
+            mir_eval.util.midi_to_hz(np.array([n.pitch for n in piece], dtype=float)),
+            np.array([n.velocity for n in piece], dtype=float),
+        )
+
+    (ri, rp, rv), (ei, ep, ev) = arrays(reference), arrays(played)
+    p, r, f, _ = mir_eval.transcription.precision_recall_f1_overlap(ri, rp, ei, ep, onset_tolerance=0.02, offset_ratio=None)
+    assert (report.precision, report.recall, report.f1) == pytest.approx((p, r, f))
+    _, _, f_off, _ = mir_eval.transcription.precision_recall_f1_overlap(ri, rp, ei, ep, onset_tolerance=0.02)
+    assert report.f1_with_offsets == pytest.approx(f_off)
+    _, _, f_vel, _ = mir_eval.transcription_velocity.precision_recall_f1_overlap(
+        ri, rp, rv, ei, ep, ev, onset_tolerance=0.02, offset_ratio=None
+    )
+    assert report.velocity_f1 == pytest.approx(f_vel)
+    # the 30 ms late note no longer matches at a 20 ms tolerance
+    assert report.matched_notes == 4 and report.recall == pytest.approx(4 / 6)
+
+
+def test_fingering_accuracy_counts_matched_notes_only(reference):
+    wrong = reference.with_fingers([2, 2, 2, 2, 3, 4])
+    expected = sum(a == b for a, b in zip([n.finger for n in reference], [2, 2, 2, 2, 3, 4])) / 6
+    assert compare(reference, wrong).fingering_accuracy == pytest.approx(expected)
+    assert compare(reference, reference.without_fingering()).fingering_accuracy is None
+
+
+def test_nothing_played():
+    reference = Piece((Note(0, 60, 1),))
+    report = compare(reference, Piece(()))
+    assert report.f1 == 0 and report.velocity_mae is None and report.step_f1 == 0
+    assert [r.played for r in report.rows] == [None]
+
+
+def test_key_press_f1_scores_empty_steps_as_one():
+    reference = Piece((Note(0.0, 60, 0.5), Note(1.0, 62, 1.5)))  # 30 steps, 10 of them silent
+    played = Piece((Note(0.0, 60, 0.5),))
+    precision, recall, f1 = key_press_f1(reference, played)
+    assert f1 == pytest.approx(20 / 30)
+    assert precision == 1.0
+    assert recall == pytest.approx(20 / 30)
+    extra = Piece(reference.notes + (Note(0.5, 64, 1.0),))
+    assert key_press_f1(reference, extra)[0] == pytest.approx(20 / 30)

@@ -1,0 +1,63 @@
+import pytest
+
+from pianobot.errors import PianobotError
+from pianobot.music.piece import Note, Piece, parse_pitch, pitch_name
+
+
+def test_pitch_names_round_trip():
+    for pitch in range(0, 128):
+        assert parse_pitch(pitch_name(pitch)) == pitch
+    assert parse_pitch("Bb3") == 58
+    assert parse_pitch("E-4") == 63
+    assert parse_pitch("72") == 72
+
+
+@pytest.mark.parametrize("text", ["H4", "C", "", "C#x", "G10"])
+def test_bad_pitch_names_are_clear_errors(text):
+    with pytest.raises(PianobotError):
+        parse_pitch(text)
+
+
+@pytest.mark.parametrize(
+    "kwargs, words",
+    [
+        (dict(onset=0, pitch=128, offset=1), "0-127"),
+        (dict(onset=1, pitch=60, offset=1), "end after"),
+        (dict(onset=-1, pitch=60, offset=1), ">= 0"),
+        (dict(onset=0, pitch=60, offset=1, velocity=0), "1-127"),
+        (dict(onset=0, pitch=60, offset=1, velocity=128), "1-127"),
+        (dict(onset=0, pitch=60, offset=1, finger=6), "1 (thumb) to 5"),
+    ],
+)
+def test_note_validation_names_the_allowed_range(kwargs, words):
+    with pytest.raises(PianobotError, match=words.replace("(", r"\(").replace(")", r"\)")):
+        Note(**kwargs)
+
+
+def test_times_are_kept_in_milliseconds():
+    note = Note(0.12345, 60, 0.98765)
+    assert (note.onset, note.offset) == (0.123, 0.988)
+
+
+def test_notes_are_sorted_and_transforms_return_new_pieces(scale):
+    shuffled = Piece(tuple(reversed(scale.notes)), bpm=60)
+    assert shuffled == scale
+    up = scale.transpose(2)
+    assert [n.pitch for n in up] == [62, 64, 66, 67]
+    assert [n.pitch for n in scale] == [60, 62, 64, 65]  # unchanged
+    slow = scale.retime(2.0)
+    assert slow.notes[1].onset == 2.0 and slow.notes[1].offset == 4.0 and slow.bpm == 30
+    assert scale.notes[1].onset == 1.0
+
+
+def test_transpose_out_of_midi_range_is_an_error(scale):
+    with pytest.raises(PianobotError, match="--transpose 70"):
+        scale.transpose(70)
+
+
+def test_chords_and_polyphony():
+    piece = Piece((Note(0, 60, 1), Note(0, 64, 1), Note(1, 62, 2), Note(1.5, 67, 3), Note(1.5, 71, 2.5)))
+    assert [len(c) for c in piece.chords()] == [2, 1, 2]
+    assert piece.max_polyphony() == (3, 1.5)
+    # notes that touch (one ends where the next starts) do not overlap
+    assert Piece((Note(0, 60, 1), Note(1, 62, 2))).max_polyphony()[0] == 1

@@ -1,0 +1,92 @@
+import pytest
+
+from pianobot.errors import PianobotError, PianobotWarning
+from pianobot.music.load import LoadOptions, load_piece
+from pianobot.music.midi_io import write_midi
+from pianobot.music.pig import apply_fingering, read_pig, sidecar_for, write_pig
+
+
+def test_pig_round_trip(tmp_path, scale):
+    path = write_pig(scale, tmp_path / "s_fingering.txt")
+    assert path.read_text().splitlines()[0].startswith("//Version")
+    assert path.read_text().splitlines()[1].split("\t") == ["0", "0.000000", "1.000000", "C4", "70", "80", "0", "2"]
+    assert read_pig(path) == scale.with_fingers([n.finger for n in scale])
+    # and read as a piece on its own through the loader
+    assert load_piece(path) == scale
+
+
+def test_pig_hands_substitutions_and_spelled_pitches(tmp_path):
+    path = tmp_path / "x.txt"
+    path.write_text(
+        "//Version: PianoFingering_v170101\n"
+        "0\t0.0\t0.5\tBb4\t64\t80\t0\t3_1\n"
+        "1\t0.0\t1.0\tC3\t64\t80\t1\t-5\n"
+        "2\t0.5\t1.0\tC#5\t64\t80\t0\t+4\n"
+    )
+    right = read_pig(path)
+    assert [(n.pitch, n.finger) for n in right] == [(70, 3), (73, 4)]
+    left = read_pig(path, hand="left")
+    assert [(n.pitch, n.finger) for n in left] == [(48, 5)]
+
+
+@pytest.mark.parametrize(
+    "line, words",
+    [
+        ("0\t0.0\t0.5\tC4\t64", "needs 8"),
+        ("0\tzero\t0.5\tC4\t64\t80\t0\t2", "must be numbers"),
+        ("0\t0.0\t0.5\tC4\t64\t80\t0\t9", "finger '9'"),
+        ("0\t0.0\t0.5\tH4\t64\t80\t0\t2", "not a pitch"),
+        ("0\t0.0\t0.5\tC4\t64\t80\t3\t2", "channel 3"),
+    ],
+)
+def test_bad_pig_lines_name_the_line(tmp_path, line, words):
+    path = tmp_path / "bad.txt"
+    path.write_text("//Version: PianoFingering_v170101\n" + line + "\n")
+    with pytest.raises(PianobotError, match=words) as e:
+        read_pig(path)
+    assert "line 2" in str(e.value)
+
+
+def test_sidecar_is_found_next_to_the_midi_and_applied(tmp_path, scale):
+    midi = write_midi(scale.without_fingering(), tmp_path / "song.mid")
+    assert load_piece(midi).has_fingering is False
+    write_pig(scale, sidecar_for(midi))
+    assert sidecar_for(midi).name == "song_fingering.txt"
+    assert load_piece(midi) == scale
+
+
+def test_sidecar_replaces_embedded_fingering_with_a_warning(tmp_path, scale):
+    midi = write_midi(scale, tmp_path / "song.mid")
+    other = scale.with_fingers([4, 3, 2, 4])
+    write_pig(other, sidecar_for(midi))
+    with pytest.warns(PianobotWarning, match="replaces"):
+        assert load_piece(midi) == other
+
+
+def test_sidecar_that_does_not_fit_the_notes(tmp_path, scale):
+    midi = write_midi(scale, tmp_path / "song.mid")
+    write_pig(scale.transpose(1), tmp_path / "wrong.txt")
+    with pytest.raises(PianobotError, match="has no note for C4 at 0.000 s"):
+        apply_fingering(scale, tmp_path / "wrong.txt")
+    with pytest.raises(PianobotError, match="does not exist"):
+        load_piece(midi, LoadOptions(fingering=tmp_path / "missing.txt"))
+
+
+def test_unreadable_sidecar(tmp_path, scale):
+    midi = write_midi(scale, tmp_path / "song.mid")
+    sidecar_for(midi).write_bytes(b"\xff\xfe\x00binary")
+    with pytest.raises(PianobotError, match="cannot read fingering file"):
+        load_piece(midi)
+
+
+def test_sidecar_fingering_survives_retiming(tmp_path, scale):
+    midi = write_midi(scale.without_fingering(), tmp_path / "song.mid")
+    write_pig(scale, sidecar_for(midi))
+    slow = load_piece(midi, LoadOptions(tempo=30))
+    assert [n.finger for n in slow] == [2, 3, 4, 2]
+    assert slow.notes[1].onset == 2.0
+
+
+def test_pig_needs_every_finger(tmp_path, scale):
+    with pytest.raises(PianobotError, match="needs a finger"):
+        write_pig(scale.without_fingering(), tmp_path / "x.txt")
