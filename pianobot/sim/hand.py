@@ -1,0 +1,181 @@
+"""An Allegro-like right hand on a wrist that slides along the keyboard, built from code.
+
+Each finger has the Allegro's four joints: abduction (about the vertical axis), then three
+flexion joints (MCP, PIP, DIP) with the Allegro's link lengths. The fingers point away from the
+player (-y) and curl down onto the keys; positive flexion curls. The palm sits at a fixed height
+on a prismatic wrist joint along x, as in the paper.
+
+Fingers use the pianists' numbers: 2 index, 3 middle, 4 ring (the default hand); 1 thumb is
+optional. The thumb is modelled as a fourth finger beside the index with the same joint layout
+(an approximation: the Allegro thumb's base is rotated, which matters little for pressing keys
+from above).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from pianobot.music.instrument import HandSpec
+
+
+@dataclass(frozen=True)
+class FingerGeometry:
+    """Allegro finger dimensions (m) and joint limits (rad)."""
+
+    base_to_mcp: float = 0.0164
+    proximal: float = 0.0540
+    middle: float = 0.0384
+    distal: float = 0.0267
+    """From the DIP joint to the fingertip's end, the tip sphere included."""
+    tip_radius: float = 0.009
+    """Narrower than the Allegro's 14 mm tip, so that one fingertip fits on one 22.5 mm key, as a human fingertip does."""
+    link_radius: float = 0.008
+    abduction_limit: float = 0.47
+    flexion_limits: tuple[tuple[float, float], ...] = ((-0.196, 1.61), (-0.174, 1.709), (-0.227, 1.618))
+
+
+FINGER_BASE_X = {1: -0.0870, 2: -0.0435, 3: 0.0, 4: 0.0435}
+"""Finger base positions across the palm (m); the thumb sits beside the index."""
+FINGER_BASE_Y = {1: 0.012, 2: 0.0, 3: 0.0, 4: 0.0}
+
+
+@dataclass(frozen=True)
+class HandConfig:
+    """The hand's fingers, pose above the keyboard and actuator limits."""
+
+    spec: HandSpec = field(default_factory=HandSpec)
+    """Which fingers are built and actuated (default index, middle, ring)."""
+    geometry: FingerGeometry = field(default_factory=FingerGeometry)
+    palm_height: float = 0.080
+    """Height of the finger bases above the white keys' top (m)."""
+    palm_y: float = 0.215
+    """y of the finger bases (the keys run from y = 0 at the hinge to 0.15 at the front)."""
+    max_joint_speed: float = 8.0
+    """Joint speed (rad/s) at action +-1 in velocity control."""
+    joint_force: float = 0.7
+    """Most torque (N m) a joint motor may use to reach its commanded speed (about the Allegro's)."""
+    max_joint_torque: float = 0.7
+    """Torque (N m) at action +-1 in torque control."""
+    max_wrist_speed: float = 0.5
+    """Wrist speed along the rail (m/s) at action +-1."""
+    wrist_force: float = 60.0
+    """Most force (N) the wrist motor may use."""
+    finger_mass: float = 0.03
+    """Mass of each finger link (kg)."""
+
+
+def joint_names(spec: HandSpec) -> list[str]:
+    """Actuated finger joints in action order: for each finger, abduction, MCP, PIP, DIP."""
+    return [f"f{f}_{j}" for f in spec.fingers for j in ("abd", "mcp", "pip", "dip")]
+
+
+def _box_inertia(mass: float, size: tuple[float, float, float]) -> str:
+    x, y, z = size
+    return (
+        f'<inertia ixx="{mass * (y * y + z * z) / 12:.3e}" iyy="{mass * (x * x + z * z) / 12:.3e}" '
+        f'izz="{mass * (x * x + y * y) / 12:.3e}" ixy="0" ixz="0" iyz="0"/>'
+    )
+
+
+def _link(name: str, mass: float, length: float, radius: float, colour: str, tip: float = 0.0) -> str:
+    """A finger link along -y: a capsule-like box, plus the fingertip sphere if ``tip`` > 0."""
+    size = (2 * radius, length, 2 * radius)
+    visual_tip = collision_tip = ""
+    if tip:
+        center = f"0 {-(length - tip):.5f} 0"
+        visual_tip = (
+            f'<visual><origin xyz="{center}"/><geometry><sphere radius="{tip}"/></geometry>'
+            f'<material name="tip"><color rgba="0.9 0.75 0.2 1"/></material></visual>'
+        )
+        collision_tip = f'<collision><origin xyz="{center}"/><geometry><sphere radius="{tip}"/></geometry></collision>'
+        length = length - tip  # the box ends at the sphere's centre
+        size = (2 * radius, length, 2 * radius)
+    origin = f'<origin xyz="0 {-length / 2:.5f} 0"/>'
+    return "\n".join(
+        [
+            f'<link name="{name}">',
+            f'<inertial>{origin}<mass value="{mass}"/>{_box_inertia(mass, size)}</inertial>',
+            f'<visual>{origin}<geometry><box size="{size[0]:.4f} {size[1]:.4f} {size[2]:.4f}"/></geometry>'
+            f'<material name="{colour}"><color rgba="0.2 0.2 0.25 1"/></material></visual>',
+            visual_tip,
+            f'<collision>{origin}<geometry><box size="{size[0]:.4f} {size[1]:.4f} {size[2]:.4f}"/></geometry></collision>',
+            collision_tip,
+            "</link>",
+        ]
+    )
+
+
+def _joint(name: str, kind: str, parent: str, child: str, xyz: tuple, axis: str, limits: tuple) -> str:
+    return "\n".join(
+        [
+            f'<joint name="{name}" type="{kind}">',
+            f'<parent link="{parent}"/><child link="{child}"/>',
+            f'<origin xyz="{xyz[0]:.5f} {xyz[1]:.5f} {xyz[2]:.5f}"/><axis xyz="{axis}"/>',
+            f'<limit lower="{limits[0]}" upper="{limits[1]}" effort="100" velocity="100"/>',
+            '<dynamics damping="0.01" friction="0"/>',
+            "</joint>",
+        ]
+    )
+
+
+def hand_urdf(config: HandConfig, rail: tuple[float, float]) -> str:
+    """URDF text of the rail, the sliding palm and the fingers (one element per line: PyBullet
+    rejects a URDF written as one long line)."""
+    g = config.geometry
+    parts = ['<?xml version="1.0"?>', '<robot name="allegro_like_right_hand">']
+    parts.append('<link name="rail"><inertial><mass value="0"/><inertia ixx="0" iyy="0" izz="0" ixy="0" ixz="0" iyz="0"/></inertial></link>')
+    palm_size = (0.16, 0.09, 0.02)
+    parts.append(
+        "\n".join(
+            [
+                '<link name="palm">',
+                f'<inertial><origin xyz="0 0.045 0.01"/><mass value="0.4"/>{_box_inertia(0.4, palm_size)}</inertial>',
+                f'<visual><origin xyz="-0.02 0.045 0.012"/><geometry><box size="{palm_size[0]} {palm_size[1]} {palm_size[2]}"/></geometry>'
+                '<material name="palm"><color rgba="0.3 0.3 0.35 1"/></material></visual>',
+                "</link>",
+            ]
+        )
+    )
+    parts.append(_joint("wrist", "prismatic", "rail", "palm", (0, 0, 0), "1 0 0", rail))
+    for f in config.spec.fingers:
+        prefix = f"f{f}"
+        parts.append(_link(f"{prefix}_base", config.finger_mass, g.base_to_mcp, g.link_radius, "finger"))
+        parts.append(
+            _joint(f"{prefix}_abd", "revolute", "palm", f"{prefix}_base",
+                   (FINGER_BASE_X[f], FINGER_BASE_Y[f], 0.0), "0 0 1", (-g.abduction_limit, g.abduction_limit))
+        )
+        chain = [("mcp", "proximal", g.proximal), ("pip", "middle", g.middle), ("dip", "distal", g.distal)]
+        parent, offset = f"{prefix}_base", g.base_to_mcp
+        for (joint, link, length), limits in zip(chain, g.flexion_limits):
+            tip = g.tip_radius if link == "distal" else 0.0
+            parts.append(_link(f"{prefix}_{link}", config.finger_mass, length, g.link_radius, "finger", tip))
+            parts.append(_joint(f"{prefix}_{joint}", "revolute", parent, f"{prefix}_{link}", (0, -offset, 0), "1 0 0", limits))
+            parent, offset = f"{prefix}_{link}", length
+    parts.append("</robot>")
+    return "\n".join(parts) + "\n"
+
+
+# -- kinematics in the finger's plane, for controllers -----------------------------------------
+def tip_in_finger_plane(geometry: FingerGeometry, flexion: np.ndarray) -> tuple[float, float]:
+    """(forward reach, drop) of the fingertip's end from the abduction joint for MCP/PIP/DIP angles.
+
+    Reach is measured along the finger's pointing direction, drop downwards.
+    """
+    a1, a2, a3 = np.cumsum(flexion)
+    reach = geometry.base_to_mcp + geometry.proximal * math.cos(a1) + geometry.middle * math.cos(a2)
+    drop = geometry.proximal * math.sin(a1) + geometry.middle * math.sin(a2)
+    reach += geometry.distal * math.cos(a3)
+    drop += geometry.distal * math.sin(a3)
+    return reach, drop
+
+
+def lowest_point_in_finger_plane(geometry: FingerGeometry, flexion: np.ndarray) -> tuple[float, float]:
+    """(reach, drop) of the lowest point of the fingertip sphere: where it meets a key from above."""
+    a1, a2, a3 = np.cumsum(flexion)
+    reach = geometry.base_to_mcp + geometry.proximal * math.cos(a1) + geometry.middle * math.cos(a2)
+    drop = geometry.proximal * math.sin(a1) + geometry.middle * math.sin(a2)
+    centre = geometry.distal - geometry.tip_radius
+    return reach + centre * math.cos(a3), drop + centre * math.sin(a3) + geometry.tip_radius

@@ -1,0 +1,268 @@
+"""The PyBullet world: keyboard and hand in one physics client, stepped at the control rate.
+
+:class:`PianoWorld` knows physics only, no score: it takes a normalised action, runs the
+physics steps of one control step, and reports what the keyboard sounded (note-on/off events
+with velocities and the finger that touched each key) and the state the observations are
+built from.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from dataclasses import dataclass, field
+
+import numpy as np
+import pybullet as p
+
+from pianobot.sim.hand import HandConfig, hand_urdf, joint_names
+from pianobot.sim.keyboard import KeyboardConfig, KeyEvent, KeySensor, key_boxes, keyboard_urdf, keyboard_width
+
+CONTROL_MODES = ("velocity", "torque")
+
+
+@dataclass(frozen=True)
+class WorldConfig:
+    """Physics settings and the two bodies."""
+
+    keyboard: KeyboardConfig = field(default_factory=KeyboardConfig)
+    hand: HandConfig = field(default_factory=HandConfig)
+    physics_hz: float = 240.0
+    """Physics steps per second (500 Hz cost twice as much and showed no benefit)."""
+    control_hz: float = 20.0
+    """Control steps per second; each runs physics_hz / control_hz physics steps."""
+    solver_iterations: int = 15
+    """Constraint solver iterations per physics step (50 is PyBullet's default; 15 is twice as fast and keys stay stable)."""
+    control: str = "velocity"
+    """Finger joint control: 'velocity' (action = joint speed) or 'torque' (action = joint torque)."""
+    discrete_wrist: bool = False
+    """If True the wrist action picks one of the white keys' positions and the wrist servoes there."""
+    gui: bool = False
+    """Open PyBullet's window instead of running headless."""
+
+    @property
+    def substeps(self) -> int:
+        return max(1, int(round(self.physics_hz / self.control_hz)))
+
+
+@dataclass
+class StepResult:
+    """What one control step did."""
+
+    events: list[KeyEvent]
+    """Note-on/off events, in time order."""
+    fingers: dict[int, int]
+    """For every note-on in ``events``: pitch -> the finger that touched the key (if one did)."""
+    pressed: np.ndarray
+    """Keys that sounded at any time during the step (bool, one per key)."""
+    pressed_velocity: np.ndarray
+    """Their note-on velocity (int, 0 where not pressed)."""
+
+
+class PianoWorld:
+    """One PyBullet client holding the keyboard and the hand."""
+
+    def __init__(self, config: WorldConfig = WorldConfig()):
+        if config.control not in CONTROL_MODES:
+            raise ValueError(f"control must be one of {CONTROL_MODES}, got {config.control!r}")
+        self.config = config
+        self.client = p.connect(p.GUI if config.gui else p.DIRECT)
+        self.dt = 1.0 / config.physics_hz
+        p.setTimeStep(self.dt, physicsClientId=self.client)
+        # No gravity: the hand is gravity-compensated, as the Allegro's own controller makes it, and a
+        # key's weight is part of its return spring. (With gravity, 15 solver iterations let light
+        # finger links sag under their motors.)
+        p.setGravity(0, 0, 0, physicsClientId=self.client)
+        p.setPhysicsEngineParameter(numSolverIterations=config.solver_iterations, physicsClientId=self.client)
+        self.boxes = key_boxes(config.keyboard)
+        self.width = keyboard_width(config.keyboard)
+        self.keyboard = self._build_keyboard()
+        self.key_joints = list(range(len(self.boxes)))
+        self.hand, self.wrist_joint, self.finger_joints, self.tip_links = self._build_hand()
+        self.sensor = KeySensor(config.keyboard)
+        self.time = 0.0
+        self._apply_spring(np.zeros(len(self.boxes)))
+        if config.gui:
+            p.resetDebugVisualizerCamera(0.45, 0, -45, [self.width / 2, 0.1, 0], physicsClientId=self.client)
+
+    # -- construction ------------------------------------------------------------------------
+    def _load_urdf(self, text: str, position: list[float]) -> int:
+        fd, path = tempfile.mkstemp(prefix="pianobot_", suffix=".urdf")
+        try:
+            with os.fdopen(fd, "w") as f:
+                f.write(text)
+            return p.loadURDF(path, basePosition=position, useFixedBase=True, physicsClientId=self.client)
+        finally:
+            os.unlink(path)
+
+    def _build_keyboard(self) -> int:
+        body = self._load_urdf(keyboard_urdf(self.config.keyboard), [0, 0, 0])
+        for j in range(len(self.boxes)):
+            p.changeDynamics(body, j, linearDamping=0, angularDamping=0, physicsClientId=self.client)
+        return body
+
+    def _build_hand(self) -> tuple[int, int, list[int], dict[int, int]]:
+        c, hand = self.client, self.config.hand
+        body = self._load_urdf(hand_urdf(hand, rail=(0.0, self.width)), [0, hand.palm_y, hand.palm_height])
+        index = {p.getJointInfo(body, j, physicsClientId=c)[1].decode(): j for j in range(p.getNumJoints(body, physicsClientId=c))}
+        fingers = [index[name] for name in joint_names(hand.spec)]
+        tips = {f: index[f"f{f}_dip"] for f in hand.spec.fingers}  # the DIP joint's child is the distal link
+        for j in [index["wrist"], *fingers]:
+            p.changeDynamics(body, j, linearDamping=0, angularDamping=0, physicsClientId=c)
+        for link in tips.values():
+            p.changeDynamics(body, link, lateralFriction=0.8, physicsClientId=c)
+        return body, index["wrist"], fingers, tips
+
+    # -- state -------------------------------------------------------------------------------
+    def reset(self, wrist: float, finger_angles: np.ndarray) -> None:
+        """Put the hand at ``wrist`` (m along the keyboard) with the given joint angles, keys at rest."""
+        c = self.client
+        for j in self.key_joints:
+            p.resetJointState(self.keyboard, j, 0.0, 0.0, physicsClientId=c)
+        p.resetJointState(self.hand, self.wrist_joint, wrist, 0.0, physicsClientId=c)
+        for j, angle in zip(self.finger_joints, finger_angles):
+            p.resetJointState(self.hand, j, float(angle), 0.0, physicsClientId=c)
+        self.sensor.reset()
+        self.time = 0.0
+        self._hold(finger_angles, wrist)
+
+    def _hold(self, finger_angles: np.ndarray, wrist: float) -> None:
+        """Motors hold the current pose until the first action arrives."""
+        c, hand = self.client, self.config.hand
+        p.setJointMotorControl2(self.hand, self.wrist_joint, p.POSITION_CONTROL, targetPosition=wrist, force=hand.wrist_force, physicsClientId=c)
+        p.setJointMotorControlArray(
+            self.hand, self.finger_joints, p.VELOCITY_CONTROL, targetVelocities=[0.0] * len(self.finger_joints),
+            forces=[hand.joint_force] * len(self.finger_joints), physicsClientId=c,
+        )
+
+    def key_state(self) -> tuple[np.ndarray, np.ndarray]:
+        """Key angles (rad) and angular speeds (rad/s)."""
+        states = p.getJointStates(self.keyboard, self.key_joints, physicsClientId=self.client)
+        return np.array([s[0] for s in states]), np.array([s[1] for s in states])
+
+    def hand_state(self) -> tuple[float, float, np.ndarray, np.ndarray]:
+        """Wrist position (m) and speed (m/s), finger joint angles and speeds."""
+        c = self.client
+        wrist = p.getJointState(self.hand, self.wrist_joint, physicsClientId=c)
+        states = p.getJointStates(self.hand, self.finger_joints, physicsClientId=c)
+        return wrist[0], wrist[1], np.array([s[0] for s in states]), np.array([s[1] for s in states])
+
+    def touching(self) -> dict[int, tuple[int, float]]:
+        """Key index -> (finger, normal force) for every key a fingertip presses on now."""
+        out: dict[int, tuple[int, float]] = {}
+        finger_of = {link: f for f, link in self.tip_links.items()}
+        for contact in p.getContactPoints(self.hand, self.keyboard, physicsClientId=self.client):
+            finger = finger_of.get(contact[3])
+            key, force = contact[4], contact[9]
+            if finger is not None and key >= 0 and force > out.get(key, (0, 0.0))[1]:
+                out[key] = (finger, force)
+        return out
+
+    def tip_forces(self) -> dict[int, float]:
+        """Total normal force (N) on each fingertip from the keys."""
+        forces = {f: 0.0 for f in self.tip_links}
+        finger_of = {link: f for f, link in self.tip_links.items()}
+        for contact in p.getContactPoints(self.hand, self.keyboard, physicsClientId=self.client):
+            finger = finger_of.get(contact[3])
+            if finger is not None:
+                forces[finger] += contact[9]
+        return forces
+
+    def link_pose(self, link: int) -> tuple[np.ndarray, np.ndarray]:
+        """World position and rotation matrix of a hand link's frame."""
+        state = p.getLinkState(self.hand, link, computeForwardKinematics=True, physicsClientId=self.client)
+        rotation = np.array(p.getMatrixFromQuaternion(state[5], physicsClientId=self.client)).reshape(3, 3)
+        return np.array(state[4]), rotation
+
+    # -- stepping ----------------------------------------------------------------------------
+    def _apply_spring(self, angles: np.ndarray) -> None:
+        """The keys' return spring: a motor driving back to rest whose torque limit grows with depth."""
+        kb = self.config.keyboard
+        depth = np.clip(angles / kb.geometry.max_angle, 0.0, 1.0)
+        torque = kb.spring_torque + (kb.spring_torque_pressed - kb.spring_torque) * depth**2
+        p.setJointMotorControlArray(
+            self.keyboard, self.key_joints, p.POSITION_CONTROL, targetPositions=[0.0] * len(self.key_joints),
+            positionGains=[kb.spring_gain] * len(self.key_joints), forces=torque.tolist(), physicsClientId=self.client,
+        )
+
+    def _apply_action(self, action: np.ndarray) -> None:
+        cfg, hand, c = self.config, self.config.hand, self.client
+        n = len(self.finger_joints)
+        action = np.asarray(action, dtype=float)
+        if action.shape != (n + 1,):
+            raise ValueError(f"action must have shape ({n + 1},): {n} finger joints then the wrist; got {action.shape}")
+        action = np.clip(action, -1.0, 1.0)
+        fingers, wrist = action[:n], float(action[n])
+        if cfg.control == "velocity":
+            p.setJointMotorControlArray(
+                self.hand, self.finger_joints, p.VELOCITY_CONTROL, targetVelocities=(fingers * hand.max_joint_speed).tolist(),
+                forces=[hand.joint_force] * n, physicsClientId=c,
+            )
+        else:
+            p.setJointMotorControlArray(self.hand, self.finger_joints, p.VELOCITY_CONTROL, forces=[0.0] * n, physicsClientId=c)
+            p.setJointMotorControlArray(
+                self.hand, self.finger_joints, p.TORQUE_CONTROL, forces=(fingers * hand.max_joint_torque).tolist(), physicsClientId=c
+            )
+        if cfg.discrete_wrist:
+            target = self.discrete_wrist_position(wrist)
+            p.setJointMotorControl2(self.hand, self.wrist_joint, p.POSITION_CONTROL, targetPosition=target,
+                                    maxVelocity=hand.max_wrist_speed, force=hand.wrist_force, physicsClientId=c)
+        else:
+            p.setJointMotorControl2(self.hand, self.wrist_joint, p.VELOCITY_CONTROL, targetVelocity=wrist * hand.max_wrist_speed,
+                                    force=hand.wrist_force, physicsClientId=c)
+
+    def discrete_wrist_position(self, action: float) -> float:
+        """The white-key position that a wrist action in [-1, 1] selects."""
+        centres = [b.center[0] for b in self.boxes if not b.black]
+        index = int(round((np.clip(action, -1, 1) + 1) / 2 * (len(centres) - 1)))
+        return centres[index]
+
+    def step(self, action: np.ndarray) -> StepResult:
+        """One control step: apply ``action`` (finger joints then wrist, each in [-1, 1]) and run the physics."""
+        self._apply_action(action)
+        events: list[KeyEvent] = []
+        fingers: dict[int, int] = {}
+        pressed = self.sensor.sounding.copy()
+        pressed_velocity = self.sensor.velocity.copy()
+        torque = self.config.control == "torque"
+        for _ in range(self.config.substeps):
+            if torque:
+                self._apply_action(action)
+            p.stepSimulation(physicsClientId=self.client)
+            self.time += self.dt
+            angles, speeds = self.key_state()
+            new = self.sensor.update(self.time, angles, speeds)
+            if new:
+                touch = None
+                for event in new:
+                    if event.on:
+                        touch = touch if touch is not None else self.touching()
+                        key = event.pitch - self.config.keyboard.spec.lowest
+                        if key in touch:
+                            fingers[event.pitch] = touch[key][0]
+                events += new
+            pressed |= self.sensor.sounding
+            pressed_velocity = np.maximum(pressed_velocity, self.sensor.velocity)
+            self._apply_spring(angles)
+        return StepResult(events, fingers, pressed, pressed_velocity)
+
+    # -- images ------------------------------------------------------------------------------
+    def render(self, width: int = 480, height: int = 320) -> np.ndarray:
+        """An RGB frame (height, width, 3) from a camera above and in front of the keyboard."""
+        c = self.client
+        target = [self.width / 2, 0.09, 0.0]
+        view = p.computeViewMatrixFromYawPitchRoll(target, 0.42, 180, -40, 0, 2, physicsClientId=c)
+        projection = p.computeProjectionMatrixFOV(50, width / height, 0.01, 2.0, physicsClientId=c)
+        _, _, rgba, _, _ = p.getCameraImage(width, height, view, projection, renderer=p.ER_TINY_RENDERER, physicsClientId=c)
+        return np.asarray(rgba, dtype=np.uint8).reshape(height, width, 4)[:, :, :3]
+
+    def close(self) -> None:
+        if self.client is not None and p.isConnected(self.client):
+            p.disconnect(self.client)
+        self.client = None
+
+    def __del__(self):
+        try:
+            self.close()
+        except Exception:
+            pass
