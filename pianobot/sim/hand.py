@@ -49,17 +49,17 @@ class HandConfig:
     spec: HandSpec = field(default_factory=HandSpec)
     """Which fingers are built and actuated (default index, middle, ring)."""
     geometry: FingerGeometry = field(default_factory=FingerGeometry)
-    palm_height: float = 0.080
+    palm_height: float = 0.070
     """Height of the finger bases above the white keys' top (m)."""
-    palm_y: float = 0.215
+    palm_y: float = 0.190
     """y of the finger bases (the keys run from y = 0 at the hinge to 0.15 at the front)."""
-    max_joint_speed: float = 8.0
+    max_joint_speed: float = 12.0
     """Joint speed (rad/s) at action +-1 in velocity control."""
     joint_force: float = 0.7
     """Most torque (N m) a joint motor may use to reach its commanded speed (about the Allegro's)."""
     max_joint_torque: float = 0.7
     """Torque (N m) at action +-1 in torque control."""
-    max_wrist_speed: float = 0.5
+    max_wrist_speed: float = 1.0
     """Wrist speed along the rail (m/s) at action +-1."""
     wrist_force: float = 60.0
     """Most force (N) the wrist motor may use."""
@@ -179,3 +179,31 @@ def lowest_point_in_finger_plane(geometry: FingerGeometry, flexion: np.ndarray) 
     drop = geometry.proximal * math.sin(a1) + geometry.middle * math.sin(a2)
     centre = geometry.distal - geometry.tip_radius
     return reach + centre * math.cos(a3), drop + centre * math.sin(a3) + geometry.tip_radius
+
+
+def finger_ik(geometry: FingerGeometry, reach: float, drop: float, tilt: float = 1.1) -> np.ndarray | None:
+    """MCP, PIP and DIP angles that put the fingertip's lowest point at (reach, drop).
+
+    Three joints for two coordinates leave one freedom: the distal link's angle below the
+    horizontal (``tilt``, rad). The tilt closest to the preferred one within [0.6, 1.57] that the
+    joint limits allow is used; between those bounds the fingertip, not a knuckle, is the
+    finger's lowest point. Returns None when the point is out of reach.
+    """
+    limits = geometry.flexion_limits
+    for offset in np.concatenate([[0.0], np.repeat(np.arange(1, 50) * 0.02, 2) * np.tile([1, -1], 49)]):
+        phi = tilt + offset
+        if not 0.6 <= phi <= 1.57:
+            continue
+        centre_x, centre_z = reach, drop - geometry.tip_radius
+        l3 = geometry.distal - geometry.tip_radius
+        x = centre_x - l3 * math.cos(phi) - geometry.base_to_mcp
+        z = centre_z - l3 * math.sin(phi)
+        cosine = (x * x + z * z - geometry.proximal**2 - geometry.middle**2) / (2 * geometry.proximal * geometry.middle)
+        if abs(cosine) > 1:
+            continue
+        pip = math.acos(cosine)
+        mcp = math.atan2(z, x) - math.atan2(geometry.middle * math.sin(pip), geometry.proximal + geometry.middle * math.cos(pip))
+        q = np.array([mcp, pip, phi - mcp - pip])
+        if all(lo <= a <= hi for a, (lo, hi) in zip(q, limits)):
+            return q
+    return None

@@ -53,7 +53,7 @@ class VelocityCurve:
 
     slow: float = 0.02
     """Key speed (m/s) that gives velocity 1; anything slower also gives 1."""
-    fast: float = 0.8
+    fast: float = 0.6
     """Key speed (m/s) that gives velocity 127; anything faster also gives 127."""
 
     def velocity(self, speed: float | np.ndarray) -> np.ndarray:

@@ -1,0 +1,231 @@
+"""A gymnasium environment: the hand plays one phrase (or one random task instance) on the keyboard.
+
+``step()`` acts on the physics, then observes, then computes the reward. The episode lasts a
+lead-in (the hand gets ready), the phrase, and a short tail; its end is ``truncated``, never
+``terminated``: nothing about the state makes the future worthless.
+
+Observations (a dict, see docs/environment.md): the score's L x (2+F) matrix for the current
+step and ``lookahead`` following steps; the fingertips' tactile images of the last two steps
+(uint8, pooled by default); wrist position and speed; finger joint angles and speeds; and, only
+when asked for (the paper's ablation), key angles and speeds. Actions: finger joints (4 per
+finger) then the wrist, each in [-1, 1].
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import gymnasium as gym
+import numpy as np
+from gymnasium import spaces
+
+from pianobot.music.instrument import check_playable
+from pianobot.music.piece import Piece
+from pianobot.music.tasks import TASKS, make_task
+from pianobot.music.tensor import FINGER, NOTE, VELOCITY, ScoreSpec, score_tensor, steps_for
+from pianobot.rewards import RewardConfig, reward_terms
+from pianobot.sim.hand import finger_ik, joint_names
+from pianobot.sim.tactile import TactileConfig, TactileRenderer, pool, to_uint8
+from pianobot.sim.world import PianoWorld, WorldConfig
+
+IDLE_HEIGHT = 0.010
+"""At the start the fingertips hover this high (m) over the white keys, 40 mm in from their front."""
+
+
+def idle_pose(config: WorldConfig) -> np.ndarray:
+    """Joint angles (abduction, MCP, PIP, DIP) of one finger at the start of an episode."""
+    hand = config.hand
+    reach = hand.palm_y - (config.keyboard.geometry.white_length - 0.040)
+    flexion = finger_ik(hand.geometry, reach, hand.palm_height - IDLE_HEIGHT)
+    if flexion is None:
+        raise ValueError("the hand's palm_y / palm_height leave the keys out of the fingers' reach")
+    return np.concatenate([[0.0], flexion])
+
+
+@dataclass(frozen=True)
+class EnvConfig:
+    """Everything that shapes an episode, its observations and its reward."""
+
+    world: WorldConfig = field(default_factory=WorldConfig)
+    """Keyboard, hand, physics rates and control mode."""
+    reward: RewardConfig = field(default_factory=RewardConfig)
+    lookahead: int = 10
+    """Score steps observed after the current one (10 = 0.5 s at 20 Hz)."""
+    tactile: bool = True
+    """Observe the fingertips' tactile images."""
+    tactile_sensor: TactileConfig = field(default_factory=TactileConfig)
+    tactile_pool: tuple[int, int] | None = (15, 20)
+    """Average-pool the 60 x 80 images to this size (None keeps full resolution)."""
+    key_observations: bool = False
+    """Also observe key angles and speeds (privileged; the paper's ablation)."""
+    lead_in: float = 1.0
+    """Seconds before the first note, for the hand to get ready (the wrist may have to cross the keyboard)."""
+    tail: float = 0.25
+    """Seconds after the last note ends."""
+    random_start: bool = True
+    """Start the wrist at a random position along the keyboard (else at its centre)."""
+
+    @property
+    def score_spec(self) -> ScoreSpec:
+        return ScoreSpec(self.world.keyboard.spec, self.world.hand.spec, self.world.control_hz)
+
+
+class PianoEnv(gym.Env):
+    """The hand plays ``piece`` (a phrase), or a fresh random instance of ``task`` at each reset."""
+
+    metadata = {"render_modes": ["rgb_array"], "render_fps": 20}
+
+    def __init__(
+        self,
+        piece: Piece | None = None,
+        task: str | None = None,
+        config: EnvConfig = EnvConfig(),
+        render_mode: str | None = None,
+    ):
+        if (piece is None) == (task is None):
+            raise ValueError("give exactly one of piece= or task=")
+        if task is not None and task not in TASKS:
+            raise ValueError(f"unknown task {task!r}: choose one of {', '.join(TASKS)}")
+        self.config = config
+        self.spec_score = config.score_spec
+        self.task = task
+        self.render_mode = render_mode
+        if piece is not None:
+            check_playable(piece, self.spec_score.keyboard, self.spec_score.hand)
+        self.piece = piece
+        self.world = PianoWorld(config.world)
+        self.n_fingers = len(config.world.hand.spec.fingers)
+        self.n_joints = len(joint_names(config.world.hand.spec))
+        keys = self.spec_score.keyboard.count
+        self.lead_steps = steps_for(config.lead_in, self.spec_score)
+        self.tactile = (
+            TactileRenderer(config.tactile_sensor, config.world.hand.geometry, self.world.boxes) if config.tactile else None
+        )
+
+        obs = {
+            "score": spaces.Box(0.0, 1.0, (config.lookahead + 1, keys, self.spec_score.channels), np.float32),
+            "wrist": spaces.Box(-np.inf, np.inf, (2,), np.float32),
+            "joints": spaces.Box(-np.inf, np.inf, (self.n_joints,), np.float32),
+            "joint_velocities": spaces.Box(-np.inf, np.inf, (self.n_joints,), np.float32),
+        }
+        if config.tactile:
+            rows, cols = config.tactile_pool or (config.tactile_sensor.rows, config.tactile_sensor.cols)
+            obs["tactile"] = spaces.Box(0, 255, (2, self.n_fingers, rows, cols), np.uint8)
+        if config.key_observations:
+            obs["keys"] = spaces.Box(-np.inf, np.inf, (keys,), np.float32)
+            obs["key_velocities"] = spaces.Box(-np.inf, np.inf, (keys,), np.float32)
+        self.observation_space = spaces.Dict(obs)
+        self.action_space = spaces.Box(-1.0, 1.0, (self.n_joints + 1,), np.float32)
+        if piece is not None:
+            self._set_piece(piece)
+
+    # -- episode bookkeeping -------------------------------------------------------------------
+    def _set_piece(self, piece: Piece) -> None:
+        self.piece = piece
+        spec = self.spec_score
+        body = steps_for(piece.duration + self.config.tail, spec)
+        self.horizon = self.lead_steps + body
+        padded = self.horizon + self.config.lookahead + 1
+        tensor = score_tensor(piece, spec, steps=body)
+        self.score = np.zeros((padded, spec.keyboard.count, spec.channels), dtype=np.float32)
+        self.score[self.lead_steps : self.lead_steps + body] = tensor
+        finger_numbers = np.array(spec.hand.fingers)
+        has_finger = self.score[:, :, FINGER:].max(axis=2) > 0.5
+        self.target_finger = np.where(has_finger, finger_numbers[self.score[:, :, FINGER:].argmax(axis=2)], 0)
+
+    @property
+    def score_start(self) -> float:
+        """World time (s) at which the piece's time 0 falls."""
+        return self.lead_steps / self.spec_score.control_hz
+
+    def reset(self, *, seed: int | None = None, options: dict | None = None):
+        super().reset(seed=seed)
+        if self.task is not None:
+            self._set_piece(make_task(self.task, self.np_random, self.spec_score.keyboard))
+        world = self.world
+        wrist = float(self.np_random.uniform(0.0, world.width)) if self.config.random_start else world.width / 2
+        world.reset(wrist, np.tile(idle_pose(self.config.world), self.n_fingers))
+        self.t = 0
+        self.key_finger = np.zeros(self.spec_score.keyboard.count, dtype=int)
+        if self.tactile is not None:
+            shape = self.observation_space["tactile"].shape[1:]
+            self.tactile_history = [np.zeros(shape, np.uint8), np.zeros(shape, np.uint8)]
+            self.tactile_history[1] = self._tactile_image()
+        return self._observe(), {"piece": self.piece}
+
+    # -- the step: act, observe, reward ------------------------------------------------------
+    def step(self, action):
+        result = self.world.step(np.asarray(action, dtype=np.float64))
+        lowest = self.spec_score.keyboard.lowest
+        for event in result.events:
+            key = event.pitch - lowest
+            self.key_finger[key] = result.fingers.get(event.pitch, 0) if event.on else 0
+
+        if self.tactile is not None:
+            self.tactile_history = [self.tactile_history[1], self._tactile_image()]
+        target_row = self.score[self.t]
+        played = result.pressed_velocity / 127.0
+        terms = reward_terms(
+            self.config.reward, played, self.key_finger, target_row[:, VELOCITY] * target_row[:, NOTE], self.target_finger[self.t]
+        )
+        reward = float(sum(terms.values()))
+        self.t += 1
+        truncated = self.t >= self.horizon
+        info = {
+            "reward_terms": terms,
+            "events": result.events,
+            "fingers": result.fingers,
+            "pressed": result.pressed,
+            "target": target_row[:, NOTE] > 0.5,
+        }
+        return self._observe(), reward, False, truncated, info
+
+    def _tactile_image(self) -> np.ndarray:
+        angles, _ = self.world.key_state()
+        forces = self.world.tip_forces()
+        images = []
+        for finger, link in self.world.tip_links.items():
+            position, rotation = self.world.link_pose(link)
+            images.append(self.tactile.image(position, rotation, angles, forces[finger]))
+        images = np.stack(images)
+        if self.config.tactile_pool is not None:
+            images = pool(images, *self.config.tactile_pool)
+        return to_uint8(images)
+
+    def _observe(self) -> dict:
+        cfg, world = self.config, self.world
+        wrist, wrist_speed, angles, speeds = world.hand_state()
+        hand = cfg.world.hand
+        obs = {
+            "score": self.score[self.t : self.t + cfg.lookahead + 1].copy(),
+            "wrist": np.array([2 * wrist / world.width - 1, wrist_speed / hand.max_wrist_speed], np.float32),
+            "joints": angles.astype(np.float32),
+            "joint_velocities": (speeds / hand.max_joint_speed).astype(np.float32),
+        }
+        if self.tactile is not None:
+            obs["tactile"] = np.stack(self.tactile_history)
+        if cfg.key_observations:
+            key_angles, key_speeds = world.key_state()
+            max_angle = cfg.world.keyboard.geometry.max_angle
+            obs["keys"] = (key_angles / max_angle).astype(np.float32)
+            obs["key_velocities"] = (key_speeds / (max_angle * cfg.world.control_hz)).astype(np.float32)
+        return obs
+
+    def render(self):
+        return self.world.render()
+
+    def close(self):
+        self.world.close()
+
+
+def register_envs() -> None:
+    """Register ``pianobot/Piano-v0`` (give piece=) and one id per task family, e.g. ``pianobot/OneNote-v0``."""
+    if "pianobot/Piano-v0" in gym.registry:
+        return
+    gym.register(id="pianobot/Piano-v0", entry_point="pianobot.env:PianoEnv")
+    for task in TASKS:
+        name = "".join(part.capitalize() for part in task.split("-"))
+        gym.register(id=f"pianobot/{name}-v0", entry_point="pianobot.env:PianoEnv", kwargs={"task": task})
+
+
+register_envs()
