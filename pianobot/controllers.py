@@ -47,6 +47,8 @@ class ScriptedPianist:
     """Fingertip height over its key's top (or the white keys' top) when it has nothing to do (m)."""
     min_ready_height = 0.003
     """Lowest hover height before a strike (m)."""
+    path_tolerance = 0.002
+    """A fingertip that must rise more than this (m) rises first; one that must move across more than this moves across before it goes down."""
     band_clearance = 0.004
     """Crossing into or out of the black keys' band, the fingertip stays this far (m) above their tops."""
     aim_tolerance = 0.004
@@ -230,13 +232,15 @@ class ScriptedPianist:
             wrist_target = wrist
         action = np.zeros(len(self.fingers) * 4 + 1)
         step_limit = hand.max_joint_speed * self.dt
+        wrist_step = float(np.clip(wrist_target - wrist, -hand.max_wrist_speed * self.dt, hand.max_wrist_speed * self.dt))
+        wrist_next = wrist + wrist_step  # fingers aim from where the wrist will be, so held keys stay held
         for slot, finger in enumerate(self.fingers):
             q = joints[slot]
             key, phase, height, speed = plans.get(finger, (None, "idle", 0.0, 0.0))
             contact_y = self._contact_y(key) if key is not None else self.white_contact_y
             top = self.key_top[key] if key is not None else 0.0
             forward = hand.palm_y - contact_y
-            offset = self.key_x[key] - (wrist + FINGER_BASE_X[finger]) if key is not None else 0.0
+            offset = self.key_x[key] - (wrist_next + FINGER_BASE_X[finger]) if key is not None else 0.0
             abduction = float(np.clip(math.atan2(offset, forward), -geometry.abduction_limit, geometry.abduction_limit))
             reach = forward / math.cos(abduction)  # keeps the tip at contact_y even when the key is out of reach
             if phase in ("ready", "strike") and abs(offset - forward * math.tan(abduction)) > self.aim_tolerance:
@@ -248,13 +252,21 @@ class ScriptedPianist:
             else:  # hold: aim a little below the key's surface
                 drop = hand.palm_height - (top - 0.004)
             reach, drop = self._safe_path(q, reach, drop)
+            now_reach, now_drop = lowest_point_in_finger_plane(geometry, q[1:])
+            rising = drop < now_drop - self.path_tolerance
+            if not rising and abs(reach - now_reach) > self.path_tolerance:
+                drop = min(drop, now_drop)  # across at this height first, then down
             desired = np.concatenate([[abduction], self._ik(reach, drop, q[1:])])
             command = np.clip((desired - q) / step_limit, -1.0, 1.0)
+            if rising and phase != "strike":  # up first, by the knuckle alone, so the tip never dips
+                height = hand.palm_height - drop
+                command[1] = np.clip((self._mcp_for_height(q, height, 0.0) - q[1]) / step_limit, -1.0, 1.0)
+                command[2:] = 0.0
             if phase == "strike":  # ``speed`` holds the height (over the key) to reach by the end of this step
                 command[1] = np.clip((self._mcp_for_height(q, speed, top) - q[1]) / step_limit, 0.0, 1.0)
                 command[2:] = 0.0  # PIP and DIP keep their shape: the finger pivots at the knuckle
             elif phase == "hold":
                 command[1] = max(command[1], self.hold_speed)
             action[slot * 4 : slot * 4 + 4] = command
-        action[-1] = np.clip((wrist_target - wrist) / (hand.max_wrist_speed * self.dt), -1.0, 1.0)
+        action[-1] = wrist_step / (hand.max_wrist_speed * self.dt)
         return action.astype(np.float32)
