@@ -13,6 +13,7 @@ hand's and keyboard's geometry; it is the proof that the simulator is playable.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -36,6 +37,27 @@ class RandomController:
         return self.rng.uniform(-1.0, 1.0, self.action_size).astype(np.float32)
 
 
+@dataclass
+class Plan:
+    """What one finger does in this control step."""
+
+    key: int
+    phase: str
+    """'ready' (hover at ``height``), 'strike' (down to ``goal``) or 'hold' (keep the key down, going to ``goal``)."""
+    height: float = 0.0
+    """Ready height over the key's top (m)."""
+    goal: float = 0.0
+    """Fingertip height over the key's top to reach by the end of this step (m)."""
+    start: int = 0
+    """Control steps until the note's onset."""
+    lead: int = 0
+    """Control steps the strike takes from the ready height."""
+    next: tuple | None = None
+    """While holding: this finger's next note in the window."""
+    next_start: int = 0
+    next_lead: int = 0
+
+
 class ScriptedPianist:
     """A hand-written pianist for velocity control. See the module docstring."""
 
@@ -49,6 +71,8 @@ class ScriptedPianist:
     """Lowest hover height before a strike (m)."""
     path_tolerance = 0.002
     """A fingertip that must rise more than this (m) rises first; one that must move across more than this moves across before it goes down."""
+    clearance = 0.003
+    """The hand does not slide while a finger that has let go is lower than this over the white keys (m)."""
     band_clearance = 0.004
     """Crossing into or out of the black keys' band, the fingertip stays this far (m) above their tops."""
     aim_tolerance = 0.004
@@ -57,6 +81,10 @@ class ScriptedPianist:
     """The fingertip is planned to pass the strike depth by up to this much (m) at the onset."""
     hold_depth_margin = 0.0025
     """A held key is pressed this far (m) past its strike depth before the finger just holds it."""
+    prepare_steps = 3
+    """Control steps a finger needs to lift, move over and settle before a strike from the ready height."""
+    reach_fraction = 0.8
+    """Share of the abduction range a holding finger may use while the wrist moves."""
     hold_speed = 0.08
     """MCP action while holding a key down."""
     white_gain = 1.0
@@ -128,145 +156,162 @@ class ScriptedPianist:
         score = observation["score"]
         joints = np.asarray(observation["joints"], dtype=float).reshape(len(self.fingers), 4)
         wrist = (float(observation["wrist"][0]) + 1) / 2 * self.width
-        plans: dict[int, tuple] = {}
+        plans: dict[int, Plan] = {}
         for slot, finger in enumerate(self.fingers):
             plan = self._plan_finger(score, slot, joints[slot])
             if plan is not None:
                 plans[finger] = plan
+        self._let_go(plans, joints, wrist)
         self.previous_row = score[0].copy()
         return self._command(plans, joints, wrist)
 
-    def _plan_finger(self, score: np.ndarray, slot: int, q: np.ndarray) -> tuple | None:
-        """(key, phase, ready height, tip speed) for one finger, or None when it has nothing to do.
+    def _wrist_for(self, finger: int, key: int) -> float:
+        """Wrist position that puts ``finger`` straight over ``key``."""
+        return float(self.key_x[key] - FINGER_BASE_X[finger])
+
+    def _hold_span(self) -> float:
+        """How far (m) the wrist may move away from a held key's position while that key stays held."""
+        return self.reach_fraction * (self.hand.palm_y - self.white_contact_y) * math.tan(self.geometry.abduction_limit)
+
+    def _let_go(self, plans: dict[int, "Plan"], joints: np.ndarray, wrist: float) -> None:
+        """Release held keys early when the hand must get ready for what comes next.
+
+        A finger lets go when its own next strike is near; every holding finger lets go when
+        another finger's strike needs the wrist where the held key is out of reach.
+        """
+        span = self._hold_span()
+        for finger, plan in list(plans.items()):
+            if plan.phase == "hold" and plan.next is not None:
+                if plan.next_start - plan.next_lead - self.prepare_steps <= 0:
+                    plans[finger] = self._approach(plan.next, joints[self.fingers.index(finger)])
+        holds = {f: p for f, p in plans.items() if p.phase == "hold"}
+        if not holds:
+            return
+        low = max(self._wrist_for(f, p.key) - span for f, p in holds.items())
+        high = min(self._wrist_for(f, p.key) + span for f, p in holds.items())
+        for finger, plan in plans.items():
+            if plan.phase == "hold":
+                continue
+            wanted = self._wrist_for(finger, plan.key)
+            travel = max(0.0, low - wanted, wanted - high)
+            shift_steps = math.ceil(travel / (self.hand.max_wrist_speed * self.dt))
+            if travel > 0 and plan.start - plan.lead - self.prepare_steps - shift_steps <= 0:
+                for held in holds:
+                    nxt = plans[held].next
+                    if nxt is None:
+                        del plans[held]
+                    else:
+                        plans[held] = self._approach(nxt, joints[self.fingers.index(held)])
+                return
+
+    def _plan_finger(self, score: np.ndarray, slot: int, q: np.ndarray) -> "Plan | None":
+        """What one finger should do now, or None when it has nothing to do.
 
         Phases: 'ready' hovers over the key; 'strike' moves down so as to reach the strike depth
-        exactly at the onset, at the speed the target velocity needs; 'hold' keeps the key down.
+        exactly at the onset, at the speed the target velocity needs; 'hold' keeps a sounding
+        key down (first going on down at the strike speed, so that a strike that lands a little
+        late still sounds at the right velocity).
         """
         runs = self._runs(score, slot)
         current = next((r for r in runs if r[1] == 0), None)
         upcoming = next((r for r in runs if r[1] > 0), None)
-        if current is not None:
-            key = current[0]
-            began_earlier = self.previous_row is not None and (
-                self.previous_row[key, NOTE] > 0.5 and self.previous_row[key, FINGER + slot] > 0.5
-            )
-            if upcoming is not None:
-                speed = self._tip_speed(upcoming[0], upcoming[3])
-                depth = self._strike_depth(upcoming[0])
-                if upcoming[1] - self._ready_steps(speed, depth) <= 1:  # the next strike is due: let go now
-                    return self._approach(upcoming, q)
-            if not began_earlier:
-                return self._approach(current, q)  # the onset step itself: strike now
-            # holding: keep going down at the strike speed until safely past the strike depth
-            # (a strike that lands a little late still sounds at the right velocity), then press
-            tip_height = self._tip_height(q, key)
-            floor = -self._strike_depth(key) - self.hold_depth_margin
-            if tip_height > floor:
-                speed = self._tip_speed(key, current[3])
-                return (key, "strike", 0.0, max(tip_height - speed * self.dt, floor))
-            return (key, "hold", 0.0, 0.0)
+        if current is None:
+            return self._approach(upcoming, q) if upcoming is not None else None
+        key = current[0]
+        began_earlier = self.previous_row is not None and (
+            self.previous_row[key, NOTE] > 0.5 and self.previous_row[key, FINGER + slot] > 0.5
+        )
+        if not began_earlier:
+            return self._approach(current, q)  # the onset step itself: strike now
+        tip_height = self._tip_height(q, key)
+        floor = -self._strike_depth(key) - self.hold_depth_margin
+        goal = max(tip_height - self._tip_speed(key, current[3]) * self.dt, floor)
+        plan = Plan(key, "hold", goal=goal)
         if upcoming is not None:
-            return self._approach(upcoming, q)
-        return None
+            plan.next = upcoming
+            plan.next_start = upcoming[1]
+            plan.next_lead = self._ready_steps(self._tip_speed(upcoming[0], upcoming[3]), self._strike_depth(upcoming[0]))
+        return plan
 
-    def _approach(self, run: tuple, q: np.ndarray) -> tuple:
+    def _approach(self, run: tuple, q: np.ndarray) -> "Plan":
         key, start, _, velocity = run
         speed = self._tip_speed(key, velocity)
         depth = self._strike_depth(key)
         steps = self._ready_steps(speed, depth)
         height = steps * speed * self.dt - depth
         if start > steps:
-            return (key, "ready", height, speed)
+            return Plan(key, "ready", height=height, start=start, lead=steps)
         # closed loop: after this step the fingertip should be where constant-speed travel for the
-        # remaining (start - 1) steps ends exactly at the strike depth on the onset
+        # remaining (start - 1) steps passes the strike depth just before the onset
         tip_height = self._tip_height(q, key)
-        # aim a little past the strike depth so the key sounds while the finger still moves at speed
         past = min(self.strike_margin, speed * self.dt / 4)
         goal = tip_height - speed * self.dt if start == 0 else -depth - past + speed * self.dt * (start - 1)
         floor = -depth - self.hold_depth_margin
-        return (key, "strike", height, float(np.clip(goal, floor, tip_height)))
+        return Plan(key, "strike", height=height, goal=float(np.clip(goal, floor, tip_height)), start=start, lead=steps)
 
-    def _safe_path(self, q: np.ndarray, reach: float, drop: float) -> tuple[float, float]:
-        """Move between the white keys' band and the black keys' band high, never low across a black key's front.
+    # -- turning plans into joint speeds ------------------------------------------------------
+    def _command(self, plans: dict, joints: np.ndarray, wrist: float) -> np.ndarray:
+        hand, geometry = self.hand, self.geometry
+        wrist_target = wrist
+        if plans:
+            wanted = [self._wrist_for(f, plan.key) for f, plan in plans.items()]
+            wrist_target = float(np.clip(np.mean(wanted), 0.0, self.width))
+            holds = [self._wrist_for(f, plan.key) for f, plan in plans.items() if plan.phase == "hold"]
+            if holds:  # never drag a held key's finger out of its reach
+                span = self._hold_span()
+                wrist_target = float(np.clip(wrist_target, max(holds) - span, min(holds) + span))
+        if any(self._low(joints[slot]) for slot, f in enumerate(self.fingers) if f not in plans or plans[f].phase == "ready"):
+            wrist_target = wrist  # a finger that lets go of a key rises before the hand moves
+        step = hand.max_wrist_speed * self.dt
+        wrist_step = float(np.clip(wrist_target - wrist, -step, step))
+        wrist_next = wrist + wrist_step  # fingers aim from where the wrist will be, so held keys stay held
+        action = np.zeros(len(self.fingers) * 4 + 1)
+        for slot, finger in enumerate(self.fingers):
+            action[slot * 4 : slot * 4 + 4] = self._finger_command(finger, plans.get(finger), joints[slot], wrist_next)
+        action[-1] = wrist_step / step
+        return action.astype(np.float32)
 
-        Going towards a black key, rise first; coming back from one to a low target, move back first.
-        """
-        now_reach, now_drop = lowest_point_in_finger_plane(self.geometry, q[1:])
-        band_reach = self.hand.palm_y - self.black_band_y  # a tip reaching further lies over the black keys
-        in_band_now = now_reach > band_reach
-        in_band_target = reach > band_reach
-        safe_drop = self.hand.palm_height - (self.black_rise + self.band_clearance)
-        if in_band_target and not in_band_now and now_drop > safe_drop:
-            return now_reach, safe_drop  # rise first
-        if in_band_now and not in_band_target and drop > safe_drop and now_drop > safe_drop:
-            return reach, now_drop  # back out first, at the present height
-        return reach, drop
+    def _finger_command(self, finger: int, plan: "Plan | None", q: np.ndarray, wrist_next: float) -> np.ndarray:
+        """Joint speeds (actions) that bring the fingertip to this step's waypoint by the end of the step."""
+        hand, geometry = self.hand, self.geometry
+        phase = plan.phase if plan is not None else "idle"
+        key = plan.key if plan is not None else None
+        contact_y = self._contact_y(key) if key is not None else self.white_contact_y
+        top = float(self.key_top[key]) if key is not None else 0.0
+        forward = hand.palm_y - contact_y
+        offset = self.key_x[key] - (wrist_next + FINGER_BASE_X[finger]) if key is not None else 0.0
+        abduction = float(np.clip(math.atan2(offset, forward), -geometry.abduction_limit, geometry.abduction_limit))
+        reach = forward / math.cos(abduction)  # keeps the tip at contact_y even when the key is out of reach
+        if phase in ("ready", "strike") and abs(offset - forward * math.tan(abduction)) > self.aim_tolerance:
+            phase = "idle"  # not over the key yet: wait high
+        height = {"idle": top + self.idle_height, "ready": top + (plan.height if plan else 0.0)}.get(phase)
+        if height is None:  # strike or hold: the planned height for the end of this step
+            height = top + plan.goal
+        now_reach, now_drop = lowest_point_in_finger_plane(geometry, q[1:])
+        now_height = hand.palm_height - now_drop
+        # waypoints: up first; across before down; into or out of the black keys' band only high up
+        if height > now_height + self.path_tolerance:
+            reach = now_reach if abs(reach - now_reach) > self.path_tolerance else reach
+        elif abs(reach - now_reach) > self.path_tolerance:
+            height = max(height, now_height)
+        band_reach = hand.palm_y - self.black_band_y  # a tip reaching further lies over the black keys
+        crossing = (reach > band_reach) != (now_reach > band_reach)
+        safe = self.black_rise + self.band_clearance
+        if crossing and now_height < safe:
+            reach, height = now_reach, safe
+        flexion = self._ik(reach, hand.palm_height - height, q[1:])
+        desired = np.concatenate([[abduction], flexion])
+        command = np.clip((desired - q) / (hand.max_joint_speed * self.dt), -1.0, 1.0)
+        if phase == "hold":
+            command[1] = max(command[1], self.hold_speed)  # keep pressing the key
+        return command
+
+    def _low(self, q: np.ndarray) -> bool:
+        """True when the fingertip is lower than the white keys' top plus the clearance (it may touch a key)."""
+        _, drop = lowest_point_in_finger_plane(self.geometry, q[1:])
+        return self.hand.palm_height - drop < self.clearance
 
     def _tip_height(self, q: np.ndarray, key: int) -> float:
         """Height of the fingertip's lowest point over the key's top surface (m), from the joint angles."""
         _, drop = lowest_point_in_finger_plane(self.geometry, q[1:])
         return self.hand.palm_height - drop - self.key_top[key]
-
-    def _mcp_for_height(self, q: np.ndarray, height_over_top: float, top: float) -> float:
-        """The MCP angle that puts the fingertip at this height, PIP and DIP unchanged (Newton in 1D)."""
-        target_drop = self.hand.palm_height - top - height_over_top
-        angle = float(q[1])
-        for _ in range(6):
-            flexion = np.array([angle, q[2], q[3]])
-            _, drop = lowest_point_in_finger_plane(self.geometry, flexion)
-            flexion[0] += 1e-4
-            _, drop2 = lowest_point_in_finger_plane(self.geometry, flexion)
-            slope = (drop2 - drop) / 1e-4
-            if abs(slope) < 1e-6:
-                break
-            angle += (target_drop - drop) / slope
-        return angle
-
-    # -- turning plans into joint speeds ------------------------------------------------------
-    def _command(self, plans: dict, joints: np.ndarray, wrist: float) -> np.ndarray:
-        hand, geometry = self.hand, self.geometry
-        if plans:
-            wanted = [self.key_x[plan[0]] - FINGER_BASE_X[f] for f, plan in plans.items()]
-            wrist_target = float(np.clip(np.mean(wanted), 0.0, self.width))
-        else:
-            wrist_target = wrist
-        action = np.zeros(len(self.fingers) * 4 + 1)
-        step_limit = hand.max_joint_speed * self.dt
-        wrist_step = float(np.clip(wrist_target - wrist, -hand.max_wrist_speed * self.dt, hand.max_wrist_speed * self.dt))
-        wrist_next = wrist + wrist_step  # fingers aim from where the wrist will be, so held keys stay held
-        for slot, finger in enumerate(self.fingers):
-            q = joints[slot]
-            key, phase, height, speed = plans.get(finger, (None, "idle", 0.0, 0.0))
-            contact_y = self._contact_y(key) if key is not None else self.white_contact_y
-            top = self.key_top[key] if key is not None else 0.0
-            forward = hand.palm_y - contact_y
-            offset = self.key_x[key] - (wrist_next + FINGER_BASE_X[finger]) if key is not None else 0.0
-            abduction = float(np.clip(math.atan2(offset, forward), -geometry.abduction_limit, geometry.abduction_limit))
-            reach = forward / math.cos(abduction)  # keeps the tip at contact_y even when the key is out of reach
-            if phase in ("ready", "strike") and abs(offset - forward * math.tan(abduction)) > self.aim_tolerance:
-                phase = "idle"  # not over the key yet: travel high
-            if phase == "idle":
-                drop = hand.palm_height - max(self.idle_height, top + self.idle_height)
-            elif phase in ("ready", "strike"):
-                drop = hand.palm_height - (top + height)
-            else:  # hold: aim a little below the key's surface
-                drop = hand.palm_height - (top - 0.004)
-            reach, drop = self._safe_path(q, reach, drop)
-            now_reach, now_drop = lowest_point_in_finger_plane(geometry, q[1:])
-            rising = drop < now_drop - self.path_tolerance
-            if not rising and abs(reach - now_reach) > self.path_tolerance:
-                drop = min(drop, now_drop)  # across at this height first, then down
-            desired = np.concatenate([[abduction], self._ik(reach, drop, q[1:])])
-            command = np.clip((desired - q) / step_limit, -1.0, 1.0)
-            if rising and phase != "strike":  # up first, by the knuckle alone, so the tip never dips
-                height = hand.palm_height - drop
-                command[1] = np.clip((self._mcp_for_height(q, height, 0.0) - q[1]) / step_limit, -1.0, 1.0)
-                command[2:] = 0.0
-            if phase == "strike":  # ``speed`` holds the height (over the key) to reach by the end of this step
-                command[1] = np.clip((self._mcp_for_height(q, speed, top) - q[1]) / step_limit, 0.0, 1.0)
-                command[2:] = 0.0  # PIP and DIP keep their shape: the finger pivots at the knuckle
-            elif phase == "hold":
-                command[1] = max(command[1], self.hold_speed)
-            action[slot * 4 : slot * 4 + 4] = command
-        action[-1] = wrist_step / (hand.max_wrist_speed * self.dt)
-        return action.astype(np.float32)

@@ -127,13 +127,13 @@ def hand_urdf(config: HandConfig, rail: tuple[float, float]) -> str:
     g = config.geometry
     parts = ['<?xml version="1.0"?>', '<robot name="allegro_like_right_hand">']
     parts.append('<link name="rail"><inertial><mass value="0"/><inertia ixx="0" iyy="0" izz="0" ixy="0" ixz="0" iyz="0"/></inertial></link>')
-    palm_size = (0.16, 0.09, 0.02)
+    palm_size = (0.13, 0.05, 0.012)
     parts.append(
         "\n".join(
             [
                 '<link name="palm">',
                 f'<inertial><origin xyz="0 0.045 0.01"/><mass value="0.4"/>{_box_inertia(0.4, palm_size)}</inertial>',
-                f'<visual><origin xyz="-0.02 0.045 0.012"/><geometry><box size="{palm_size[0]} {palm_size[1]} {palm_size[2]}"/></geometry>'
+                f'<visual><origin xyz="-0.015 0.03 0.015"/><geometry><box size="{palm_size[0]} {palm_size[1]} {palm_size[2]}"/></geometry>'
                 '<material name="palm"><color rgba="0.3 0.3 0.35 1"/></material></visual>',
                 "</link>",
             ]

@@ -248,13 +248,19 @@ class PianoWorld:
 
     # -- images ------------------------------------------------------------------------------
     def render(self, width: int = 480, height: int = 320) -> np.ndarray:
-        """An RGB frame (height, width, 3) from a camera above and in front of the keyboard."""
+        """An RGB frame (height, width, 3) from a camera above the pianist's side of the keyboard.
+
+        The world is built with the pianist on the +y side, which makes it the mirror image of a
+        real piano (low notes on the pianist's right); the frame is mirrored back, so it shows
+        the keyboard and the right hand as a pianist sees them.
+        """
         c = self.client
-        target = [self.width / 2, 0.09, 0.0]
-        view = p.computeViewMatrixFromYawPitchRoll(target, 0.42, 180, -40, 0, 2, physicsClientId=c)
-        projection = p.computeProjectionMatrixFOV(50, width / height, 0.01, 2.0, physicsClientId=c)
+        target = [self.width / 2, 0.11, 0.0]
+        view = p.computeViewMatrixFromYawPitchRoll(target, 0.42, 180, -68, 0, 2, physicsClientId=c)
+        projection = p.computeProjectionMatrixFOV(45, width / height, 0.01, 2.0, physicsClientId=c)
         _, _, rgba, _, _ = p.getCameraImage(width, height, view, projection, renderer=p.ER_TINY_RENDERER, physicsClientId=c)
-        return np.asarray(rgba, dtype=np.uint8).reshape(height, width, 4)[:, :, :3]
+        frame = np.asarray(rgba, dtype=np.uint8).reshape(height, width, 4)[:, :, :3]
+        return np.ascontiguousarray(frame[:, ::-1])
 
     def close(self) -> None:
         if self.client is not None and p.isConnected(self.client):
