@@ -83,8 +83,8 @@ class ScriptedPianist:
     """A held key is pressed this far (m) past its strike depth before the finger just holds it."""
     prepare_steps = 3
     """Control steps a finger needs to lift, move over and settle before a strike from the ready height."""
-    reach_fraction = 0.8
-    """Share of the abduction range a holding finger may use while the wrist moves."""
+    hold_slide = 0.008
+    """How far (m) the wrist may move away from a held key's position while that key stays held."""
     hold_speed = 0.08
     """MCP action while holding a key down."""
     white_gain = 1.0
@@ -169,17 +169,13 @@ class ScriptedPianist:
         """Wrist position that puts ``finger`` straight over ``key``."""
         return float(self.key_x[key] - FINGER_BASE_X[finger])
 
-    def _hold_span(self) -> float:
-        """How far (m) the wrist may move away from a held key's position while that key stays held."""
-        return self.reach_fraction * (self.hand.palm_y - self.white_contact_y) * math.tan(self.geometry.abduction_limit)
-
     def _let_go(self, plans: dict[int, "Plan"], joints: np.ndarray, wrist: float) -> None:
         """Release held keys early when the hand must get ready for what comes next.
 
         A finger lets go when its own next strike is near; every holding finger lets go when
         another finger's strike needs the wrist where the held key is out of reach.
         """
-        span = self._hold_span()
+        span = self.hold_slide
         for finger, plan in list(plans.items()):
             if plan.phase == "hold" and plan.next is not None:
                 if plan.next_start - plan.next_lead - self.prepare_steps <= 0:
@@ -257,9 +253,8 @@ class ScriptedPianist:
             wanted = [self._wrist_for(f, plan.key) for f, plan in plans.items()]
             wrist_target = float(np.clip(np.mean(wanted), 0.0, self.width))
             holds = [self._wrist_for(f, plan.key) for f, plan in plans.items() if plan.phase == "hold"]
-            if holds:  # never drag a held key's finger out of its reach
-                span = self._hold_span()
-                wrist_target = float(np.clip(wrist_target, max(holds) - span, min(holds) + span))
+            if holds:  # a held key's finger may follow a small move only
+                wrist_target = float(np.clip(wrist_target, max(holds) - self.hold_slide, min(holds) + self.hold_slide))
         if any(self._low(joints[slot]) for slot, f in enumerate(self.fingers) if f not in plans or plans[f].phase == "ready"):
             wrist_target = wrist  # a finger that lets go of a key rises before the hand moves
         step = hand.max_wrist_speed * self.dt
