@@ -84,9 +84,9 @@ class ScriptedPianist:
     prepare_steps = 3
     """Control steps a finger needs to lift, move over and settle before a strike from the ready height."""
     hold_slide = 0.008
-    """How far (m) the wrist may move away from a held key's position while that key stays held."""
-    hold_speed = 0.08
-    """MCP action while holding a key down."""
+    """How far (m) the wrist may move in one step while a finger holds a key."""
+    hold_reach = 0.030
+    """How far (m) the wrist may be from straight over a held key (the abduction makes up for it)."""
     white_gain = 1.0
     """Correction on the strike speed for white keys, measured (see docs/simulator.md)."""
     black_gain = 1.0
@@ -122,8 +122,11 @@ class ScriptedPianist:
 
     def _ik(self, reach: float, drop: float, current: np.ndarray) -> np.ndarray:
         """Flexion angles for a fingertip target; out of reach, the finger keeps its shape."""
-        q = finger_ik(self.geometry, reach, drop)
-        return current if q is None else q
+        for change in (0.0, 0.002, -0.002, 0.004, -0.004, 0.008, 0.012, 0.016, 0.02):
+            q = finger_ik(self.geometry, reach, drop + change)  # the nearest height this finger can reach there
+            if q is not None:
+                return q
+        return current
 
     # -- planning --------------------------------------------------------------------------------
     def _runs(self, score: np.ndarray, slot: int) -> list[tuple[int, int, int, float]]:
@@ -175,7 +178,7 @@ class ScriptedPianist:
         A finger lets go when its own next strike is near; every holding finger lets go when
         another finger's strike needs the wrist where the held key is out of reach.
         """
-        span = self.hold_slide
+        span = self.hold_reach
         for finger, plan in list(plans.items()):
             if plan.phase == "hold" and plan.next is not None:
                 if plan.next_start - plan.next_lead - self.prepare_steps <= 0:
@@ -253,8 +256,10 @@ class ScriptedPianist:
             wanted = [self._wrist_for(f, plan.key) for f, plan in plans.items()]
             wrist_target = float(np.clip(np.mean(wanted), 0.0, self.width))
             holds = [self._wrist_for(f, plan.key) for f, plan in plans.items() if plan.phase == "hold"]
-            if holds:  # a held key's finger may follow a small move only
-                wrist_target = float(np.clip(wrist_target, max(holds) - self.hold_slide, min(holds) + self.hold_slide))
+            if holds:  # a held key's finger may follow a small move only, and only while all held keys allow it
+                low = max(max(holds) - self.hold_reach, wrist - self.hold_slide)
+                high = min(min(holds) + self.hold_reach, wrist + self.hold_slide)
+                wrist_target = float(np.clip(wrist_target, low, high)) if low <= high else wrist
         if any(self._low(joints[slot]) for slot, f in enumerate(self.fingers) if f not in plans or plans[f].phase == "ready"):
             wrist_target = wrist  # a finger that lets go of a key rises before the hand moves
         step = hand.max_wrist_speed * self.dt
@@ -297,8 +302,6 @@ class ScriptedPianist:
         flexion = self._ik(reach, hand.palm_height - height, q[1:])
         desired = np.concatenate([[abduction], flexion])
         command = np.clip((desired - q) / (hand.max_joint_speed * self.dt), -1.0, 1.0)
-        if phase == "hold":
-            command[1] = max(command[1], self.hold_speed)  # keep pressing the key
         return command
 
     def _low(self, q: np.ndarray) -> bool:
