@@ -62,7 +62,12 @@ class TactileRenderer:
         inside = 1.0 - (self.grid_u / (config.gel_width / 2)) ** 2 - (self.grid_v / (config.gel_length / 2)) ** 2
         self.gel = finger.tip_radius * np.sqrt(np.clip(inside, 0.0, None))  # dome height over the plane
         self.on_gel = inside > 0
-        self.reach = math.hypot(config.gel_width, config.gel_length) / 2 + finger.tip_radius
+        self.gel_index = np.flatnonzero(self.on_gel.ravel())
+        self.gel_uv = np.stack([self.grid_u.ravel()[self.gel_index], self.grid_v.ravel()[self.gel_index]], axis=1)
+        self.plane_radius = math.hypot(config.gel_width, config.gel_length) / 2
+        """Every ray starts within this distance of the tip sphere's centre."""
+        self.gel_radius = max(config.gel_width / 2, config.gel_length / 2, finger.tip_radius)
+        """Every point of the gel lies within this distance of the tip sphere's centre."""
         self.centers = np.array([b.center for b in boxes])
         self.halves = np.array([b.half for b in boxes])
 
@@ -73,50 +78,55 @@ class TactileRenderer:
         points = origin + self.grid_u.reshape(-1, 1) * u + self.grid_v.reshape(-1, 1) * v
         return points, rotation @ self.normal_local
 
-    def _to_key_frames(self, points: np.ndarray, angles: np.ndarray) -> np.ndarray:
-        """Points (..., 3) in world -> (K, ..., 3) in the rest frames of K keys with these angles.
+    @staticmethod
+    def _turn(y: np.ndarray, z: np.ndarray, angles: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(y, z) in the rest frames of keys turned by ``angles``: shapes (N,) -> (K, N).
 
         A key's joint turns it by -angle about x through its hinge (x_k, 0, 0); turning the
-        points by +angle undoes that. x stays as it is (the boxes keep world x)."""
-        c, s = np.cos(angles), np.sin(angles)
-        shape = (len(angles),) + (1,) * (points.ndim - 1)
-        y, z = points[..., 1], points[..., 2]
-        out = np.empty((len(angles),) + points.shape)
-        out[..., 0] = points[..., 0]
-        out[..., 1] = c.reshape(shape) * y - s.reshape(shape) * z
-        out[..., 2] = s.reshape(shape) * y + c.reshape(shape) * z
-        return out
+        points by +angle undoes that. x is the same in every key's frame."""
+        c, s = np.cos(angles)[:, None], np.sin(angles)[:, None]
+        return c * y - s * z, s * y + c * z
+
+    def gaps(self, point: np.ndarray, key_angles: np.ndarray) -> np.ndarray:
+        """Distance (m) from a world point to each key's box."""
+        y, z = self._turn(np.array([point[1]]), np.array([point[2]]), key_angles)
+        local = np.stack([np.full(len(key_angles), point[0]), y[:, 0], z[:, 0]], axis=1)
+        return np.linalg.norm(np.maximum(np.abs(local - self.centers) - self.halves, 0.0), axis=1)
 
     def distances(self, position: np.ndarray, rotation: np.ndarray, key_angles: np.ndarray, max_range: float) -> np.ndarray:
-        """Distance along the gel normal from each pixel to the nearest key (inf where none within range)."""
+        """Distance along the gel normal from each gel pixel to the nearest key (inf where none within range)."""
         rows, cols = self.config.rows, self.config.cols
+        out = np.full(rows * cols, np.inf, dtype=np.float32)
         centre = position + rotation @ self.origin_local
-        # keys whose box lies within reach of the gel at all
-        local_centre = self._to_key_frames(centre[None, :], key_angles)[:, 0, :]
-        gap = np.linalg.norm(np.maximum(np.abs(local_centre - self.centers) - self.halves, 0.0), axis=1)
-        near = np.flatnonzero(gap < self.reach + max_range)
+        near = np.flatnonzero(self.gaps(centre, key_angles) < self.plane_radius + max_range)
         if near.size == 0:
-            return np.full((rows, cols), np.inf)
-        points, direction = self.rays(position, rotation)
+            return out.reshape(rows, cols)
+        u, v, normal = rotation @ self.u_local, rotation @ self.v_local, rotation @ self.normal_local
+        points = (centre + self.gel_uv @ np.stack([u, v])).astype(np.float32)  # (N, 3), gel pixels only
         angles = key_angles[near]
-        local = self._to_key_frames(points, angles)  # (K, N, 3)
-        d = self._to_key_frames(direction[None, :], angles)[:, 0, :]  # (K, 3)
-        lo = (self.centers[near] - self.halves[near])[:, None, :]
-        hi = (self.centers[near] + self.halves[near])[:, None, :]
-        with np.errstate(divide="ignore", invalid="ignore"):
-            inv = (1.0 / d)[:, None, :]
-            t1 = (lo - local) * inv
-            t2 = (hi - local) * inv
-        t_near = np.nanmax(np.minimum(t1, t2), axis=2)  # (K, N)
-        t_far = np.nanmin(np.maximum(t1, t2), axis=2)
-        hit = (t_far >= np.maximum(t_near, 0.0)) & (t_near <= max_range)
-        t = np.where(hit, np.maximum(t_near, 0.0), np.inf)  # a ray starting inside a box hits at once
-        return t.min(axis=0).reshape(rows, cols)
+        y, z = self._turn(points[:, 1], points[:, 2], angles)  # (K, N)
+        dy, dz = self._turn(np.array([normal[1]]), np.array([normal[2]]), angles)  # (K, 1)
+        lo, hi = self.centers[near] - self.halves[near], self.centers[near] + self.halves[near]
+        t_near = np.zeros((len(near), len(points)), dtype=np.float32)
+        t_far = np.full_like(t_near, np.inf)
+        for axis, coordinate, direction in ((0, points[None, :, 0], np.full((len(near), 1), normal[0])), (1, y, dy), (2, z, dz)):
+            direction = np.where(np.abs(direction) < 1e-12, 1e-12, direction)  # parallel to a face: no NaNs
+            inverse = (1.0 / direction).astype(np.float32)
+            t1 = (lo[:, axis : axis + 1] - coordinate) * inverse
+            t2 = (hi[:, axis : axis + 1] - coordinate) * inverse
+            np.maximum(t_near, np.minimum(t1, t2), out=t_near)  # t_near starts at 0: a ray starting inside hits at once
+            np.minimum(t_far, np.maximum(t1, t2), out=t_far)
+        hit = (t_far >= t_near) & (t_near <= max_range)
+        out[self.gel_index] = np.where(hit, t_near, np.inf).min(axis=0)
+        return out.reshape(rows, cols)
 
     def image(self, position: np.ndarray, rotation: np.ndarray, key_angles: np.ndarray, force: float) -> np.ndarray:
         """Depth image in [0, 1], float32, shape (rows, cols)."""
         cfg = self.config
         squeeze = min(force / cfg.stiffness, cfg.max_depth)
+        centre = position + rotation @ self.origin_local
+        if self.gaps(centre, key_angles).min() > self.gel_radius + squeeze:
+            return np.zeros((cfg.rows, cfg.cols), np.float32)  # no key near the gel: nothing to see
         distance = self.distances(position, rotation, key_angles, max_range=float(self.gel.max()) + squeeze + 1e-4)
         depth = np.where(self.on_gel, self.gel + squeeze - distance, 0.0)
         return (np.clip(depth, 0.0, cfg.max_depth) / cfg.max_depth).astype(np.float32)
