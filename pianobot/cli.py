@@ -8,12 +8,14 @@ from __future__ import annotations
 
 import functools
 import json
+import os
 import warnings
 from pathlib import Path
 from typing import Optional
 
 import typer
 from rich.console import Console
+from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 
 from pianobot import __version__, display
 from pianobot.errors import PianobotError, PianobotWarning
@@ -21,7 +23,13 @@ from pianobot.files import atomic_write, check_writable
 from pianobot.metrics import DEFAULT_ONSET_TOLERANCE, compare, plot_report
 from pianobot.music import midi_io
 from pianobot.music.instrument import HandSpec, KeyboardSpec, check_playable
-from pianobot.music.load import LoadOptions, load_piece
+from pianobot.env import EnvConfig
+from pianobot.music.load import LoadOptions, load_piece, load_playable
+from pianobot.music.midi_io import write_midi
+from pianobot.perform import CONTROLLERS, perform, write_video
+from pianobot.sim.hand import HandConfig
+from pianobot.sim.keyboard import KeyboardConfig
+from pianobot.sim.world import WorldConfig
 from pianobot.music.phrases import DEFAULT_MAX_NOTES, split_phrases
 from pianobot.music.piece import parse_pitch, pitch_name
 
@@ -148,6 +156,58 @@ def score(
     if plot is not None:
         plot_report(reference_piece, played_piece, report, plot)
         out.print(f"piano rolls drawn to {plot}")
+
+
+@app.command()
+@friendly
+def play(
+    song: Path = typer.Argument(..., help="The piece to play, a .mid file with fingering."),
+    output: Path = typer.Option(..., "--output", "-o", help="Write what the simulated piano sounded to this .mid file."),
+    controller: str = typer.Option("scripted", "--controller", help="Who plays: 'scripted' (the hand-written pianist) or 'random'."),
+    seed: int = typer.Option(0, "--seed", help="Seed of the simulation (the hand's start position) and of the random controller."),
+    video: Optional[Path] = typer.Option(None, "--video", help="Also record the performance to this .mp4 file."),
+    gui: bool = typer.Option(False, "--gui", help="Show the simulation in a PyBullet window (needs a display)."),
+    track: Optional[str] = Track,
+    tempo: Optional[float] = Tempo,
+    transpose: int = Transpose,
+    fingering: Optional[Path] = Fingering,
+    lowest_note: str = LowestNote,
+    keys: int = Keys,
+    thumb: bool = Thumb,
+):
+    """Perform a piece in the simulator; write the played notes (velocities, fingers) and a velocity-error report."""
+    if output.suffix.lower() not in (".mid", ".midi"):
+        raise PianobotError(f"-o {output}: the performance is a MIDI file, name it *.mid")
+    if output.resolve() == song.resolve():
+        raise PianobotError(f"-o {output} would overwrite the piece being played: choose another file name")
+    report_path = output.with_suffix(".report.json")
+    for target in (output, report_path, video):
+        if target is not None:
+            check_writable(target)
+    if video is not None and video.suffix.lower() != ".mp4":
+        raise PianobotError(f"--video {video}: the video is an MP4 file, name it *.mp4")
+    if gui and not os.environ.get("DISPLAY"):
+        raise PianobotError("--gui needs a display (DISPLAY is not set): drop --gui, or use --video to watch it later")
+    if controller not in CONTROLLERS:
+        raise PianobotError(f"--controller {controller}: choose one of {', '.join(CONTROLLERS)}")
+    keyboard, hand = make_instrument(lowest_note, keys, thumb)
+    piece = load_playable(song, make_options(track, tempo, transpose, fingering), keyboard, hand)
+    if not piece.has_fingering and controller == "scripted":
+        raise PianobotError(f"{song} has notes without fingering: the scripted pianist needs a finger for every note (see docs/fingering.md)")
+    world = WorldConfig(keyboard=KeyboardConfig(spec=keyboard), hand=HandConfig(spec=hand), gui=gui)
+    config = EnvConfig(world=world, tactile=False)
+    with Progress(TextColumn("{task.description}"), BarColumn(), TimeRemainingColumn(), console=err, transient=True) as bar:
+        task = bar.add_task(f"playing {song.name}", total=None)
+        result = perform(piece, controller, config, seed=seed, video=video is not None,
+                         on_step=lambda done, total: bar.update(task, completed=done, total=total))
+    report = compare(piece, result.played)
+    write_midi(result.played, output, name=f"pianobot {controller}: {song.stem}")
+    atomic_write(report_path, json.dumps({"controller": controller, "seed": seed, **report.to_dict()}, indent=2) + "\n")
+    display.print_all(out, display.report_tables(report))
+    out.print(f"performance written to {output}, report to {report_path}")
+    if video is not None:
+        write_video(result.frames, video, fps=config.world.control_hz)
+        out.print(f"video written to {video}")
 
 
 def _version(value: bool):

@@ -76,7 +76,7 @@ def report_tables(report: Report) -> list[Table]:
         summary.add_row(name, value)
 
     notes = Table(title="per note")
-    for column in ("pitch", "target onset", "played onset", "target vel", "played vel", "vel error", "finger target/played", "status"):
+    for column in ("pitch", "target onset", "played onset", "target vel", "played vel", "vel error", "finger", "status"):
         notes.add_column(column)
     for row in report.rows:
         ref, out = row.reference, row.played
@@ -89,7 +89,7 @@ def report_tables(report: Report) -> list[Table]:
             _opt(ref and ref.velocity, "d"),
             _opt(out and out.velocity, "d"),
             _opt(row.velocity_error, "+d"),
-            f"{_finger(ref and ref.finger)} / {_finger(out and out.finger)}",
+            f"{_opt(ref and ref.finger, 'd')} / {_opt(out and out.finger, 'd')}".replace("n/a", "-"),
             status,
             style=style,
         )

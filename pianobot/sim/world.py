@@ -13,7 +13,7 @@ import tempfile
 from dataclasses import dataclass, field
 
 import numpy as np
-import pybullet as p
+from pianobot.sim.bullet import p
 
 from pianobot.sim.hand import HandConfig, hand_urdf, joint_names
 from pianobot.sim.keyboard import KeyboardConfig, KeyEvent, KeySensor, key_boxes, keyboard_urdf, keyboard_width
@@ -68,24 +68,30 @@ class PianoWorld:
         self.config = config
         self.client = p.connect(p.GUI if config.gui else p.DIRECT)
         self.dt = 1.0 / config.physics_hz
-        p.setTimeStep(self.dt, physicsClientId=self.client)
+        self.boxes = key_boxes(config.keyboard)
+        self.width = keyboard_width(config.keyboard)
+        self.key_joints = list(range(len(self.boxes)))
+        self.sensor = KeySensor(config.keyboard)
+        self.time = 0.0
+        self._build()
+        if config.gui:
+            p.resetDebugVisualizerCamera(0.45, 180, -60, [self.width / 2, 0.11, 0], physicsClientId=self.client)
+
+    # -- construction ------------------------------------------------------------------------
+    def _build(self) -> None:
+        """(Re)create the physics world: settings, keyboard and hand."""
+        c = self.client
+        p.resetSimulation(physicsClientId=c)
+        p.setTimeStep(self.dt, physicsClientId=c)
         # No gravity: the hand is gravity-compensated, as the Allegro's own controller makes it, and a
         # key's weight is part of its return spring. (With gravity, 15 solver iterations let light
         # finger links sag under their motors.)
-        p.setGravity(0, 0, 0, physicsClientId=self.client)
-        p.setPhysicsEngineParameter(numSolverIterations=config.solver_iterations, physicsClientId=self.client)
-        self.boxes = key_boxes(config.keyboard)
-        self.width = keyboard_width(config.keyboard)
+        p.setGravity(0, 0, 0, physicsClientId=c)
+        p.setPhysicsEngineParameter(numSolverIterations=self.config.solver_iterations, physicsClientId=c)
         self.keyboard = self._build_keyboard()
-        self.key_joints = list(range(len(self.boxes)))
         self.hand, self.wrist_joint, self.finger_joints, self.tip_links = self._build_hand()
-        self.sensor = KeySensor(config.keyboard)
-        self.time = 0.0
         self._apply_spring(np.zeros(len(self.boxes)))
-        if config.gui:
-            p.resetDebugVisualizerCamera(0.45, 0, -45, [self.width / 2, 0.1, 0], physicsClientId=self.client)
 
-    # -- construction ------------------------------------------------------------------------
     def _load_urdf(self, text: str, position: list[float]) -> int:
         fd, path = tempfile.mkstemp(prefix="pianobot_", suffix=".urdf")
         try:
@@ -117,8 +123,9 @@ class PianoWorld:
     def reset(self, wrist: float, finger_angles: np.ndarray) -> None:
         """Put the hand at ``wrist`` (m along the keyboard) with the given joint angles, keys at rest."""
         c = self.client
-        for j in self.key_joints:
-            p.resetJointState(self.keyboard, j, 0.0, 0.0, physicsClientId=c)
+        # a fresh world (6 ms): no contact cache or solver warm start carries over, so an
+        # episode does not depend on the ones before it
+        self._build()
         p.resetJointState(self.hand, self.wrist_joint, wrist, 0.0, physicsClientId=c)
         for j, angle in zip(self.finger_joints, finger_angles):
             p.resetJointState(self.hand, j, float(angle), 0.0, physicsClientId=c)
@@ -241,12 +248,24 @@ class PianoWorld:
                         if key in touch:
                             fingers[event.pitch] = touch[key][0]
                 events += new
+                self._colour_keys(new)
             pressed |= self.sensor.sounding
             pressed_velocity = np.maximum(pressed_velocity, self.sensor.velocity)
             self._apply_spring(angles)
         return StepResult(events, fingers, pressed, pressed_velocity)
 
     # -- images ------------------------------------------------------------------------------
+    def _colour_keys(self, events: list[KeyEvent]) -> None:
+        """Sounding keys turn blue, so pressed keys show in frames and videos."""
+        lowest = self.config.keyboard.spec.lowest
+        for event in events:
+            box = self.boxes[event.pitch - lowest]
+            if event.on:
+                colour = [0.1, 0.3, 0.8, 1] if box.black else [0.45, 0.65, 1.0, 1]
+            else:
+                colour = [0.08, 0.08, 0.08, 1] if box.black else [0.95, 0.95, 0.92, 1]
+            p.changeVisualShape(self.keyboard, event.pitch - lowest, rgbaColor=colour, physicsClientId=self.client)
+
     def render(self, width: int = 480, height: int = 320) -> np.ndarray:
         """An RGB frame (height, width, 3) from a camera above the pianist's side of the keyboard.
 
