@@ -175,32 +175,34 @@ class ScriptedPianist:
     def _let_go(self, plans: dict[int, "Plan"], joints: np.ndarray, wrist: float) -> None:
         """Release held keys early when the hand must get ready for what comes next.
 
-        A finger lets go when its own next strike is near; every holding finger lets go when
-        another finger's strike needs the wrist where the held key is out of reach.
+        A holding finger lets go in time for its own next strike; every holding finger lets go
+        in time for a strike (its own or another finger's) that needs the wrist where a held
+        key is out of reach, counting the steps the wrist needs to get there.
         """
-        span = self.hold_reach
+        def release(finger: int) -> None:
+            nxt = plans[finger].next
+            if nxt is None:
+                del plans[finger]
+            else:
+                plans[finger] = self._approach(nxt, joints[self.fingers.index(finger)])
+
         for finger, plan in list(plans.items()):
-            if plan.phase == "hold" and plan.next is not None:
-                if plan.next_start - plan.next_lead - self.prepare_steps <= 0:
-                    plans[finger] = self._approach(plan.next, joints[self.fingers.index(finger)])
+            if plan.phase == "hold" and plan.next is not None and plan.next_start - plan.next_lead - self.prepare_steps <= 0:
+                release(finger)
         holds = {f: p for f, p in plans.items() if p.phase == "hold"}
         if not holds:
             return
-        low = max(self._wrist_for(f, p.key) - span for f, p in holds.items())
-        high = min(self._wrist_for(f, p.key) + span for f, p in holds.items())
-        for finger, plan in plans.items():
-            if plan.phase == "hold":
-                continue
-            wanted = self._wrist_for(finger, plan.key)
+        low = max(self._wrist_for(f, p.key) for f, p in holds.items()) - self.hold_reach
+        high = min(self._wrist_for(f, p.key) for f, p in holds.items()) + self.hold_reach
+        strikes = [(f, p.key, p.start, p.lead) for f, p in plans.items() if p.phase != "hold"]
+        strikes += [(f, p.next[0], p.next_start, p.next_lead) for f, p in holds.items() if p.next is not None]
+        for finger, key, start, lead in strikes:
+            wanted = self._wrist_for(finger, key)
             travel = max(0.0, low - wanted, wanted - high)
             shift_steps = math.ceil(travel / (self.hand.max_wrist_speed * self.dt))
-            if travel > 0 and plan.start - plan.lead - self.prepare_steps - shift_steps <= 0:
+            if travel > 0 and start - lead - self.prepare_steps - shift_steps <= 0:
                 for held in holds:
-                    nxt = plans[held].next
-                    if nxt is None:
-                        del plans[held]
-                    else:
-                        plans[held] = self._approach(nxt, joints[self.fingers.index(held)])
+                    release(held)
                 return
 
     def _plan_finger(self, score: np.ndarray, slot: int, q: np.ndarray) -> "Plan | None":
@@ -292,6 +294,9 @@ class ScriptedPianist:
         # waypoints: up first; across before down; into or out of the black keys' band only high up
         if height > now_height + self.path_tolerance:
             reach = now_reach if abs(reach - now_reach) > self.path_tolerance else reach
+            over = self.black_rise if now_reach > hand.palm_y - self.black_band_y else 0.0
+            if now_height < over + self.clearance:
+                abduction = float(q[0])  # straight up out of the key before swinging sideways
         elif abs(reach - now_reach) > self.path_tolerance:
             height = max(height, now_height)
         band_reach = hand.palm_y - self.black_band_y  # a tip reaching further lies over the black keys

@@ -160,7 +160,6 @@ def compare(
     velocity_errors = [abs(r.velocity_error) for r in pairs_rows]
     onset_errors = [abs(r.onset_error) for r in pairs_rows]
     fingered = [r for r in pairs_rows if r.reference.finger is not None and r.played.finger is not None]
-    both_fingered = reference.has_fingering and played.has_fingering
     step_p, step_r, step_f1 = key_press_f1(reference, played, control_hz)
     return Report(
         reference_notes=len(reference),
@@ -180,7 +179,7 @@ def compare(
         step_f1=step_f1,
         fingering_accuracy=(
             sum(r.reference.finger == r.played.finger for r in fingered) / len(fingered)
-            if both_fingered and fingered
+            if fingered
             else None
         ),
         onset_tolerance=onset_tolerance,

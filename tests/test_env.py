@@ -1,0 +1,136 @@
+"""The gymnasium environment: spaces, determinism, truncation, reward terms, registration."""
+
+import gymnasium as gym
+import numpy as np
+import pytest
+from gymnasium.utils.env_checker import check_env
+
+from pianobot.env import EnvConfig, PianoEnv
+from pianobot.music.load import load_piece
+from pianobot.music.piece import Note, Piece
+from pianobot.rewards import RewardConfig
+
+PHRASE = Piece((Note(0.0, 60, 0.5, 70, 2), Note(0.5, 62, 1.0, 90, 3)), bpm=60)
+
+
+def rollout(env, seed, steps=30):
+    observation, _ = env.reset(seed=seed)
+    rng = np.random.default_rng(1)
+    trace = []
+    for _ in range(steps):
+        observation, reward, terminated, truncated, info = env.step(rng.uniform(-1, 1, env.action_space.shape))
+        trace.append((reward, observation))
+        if truncated:
+            break
+    return trace
+
+
+def same(a, b):
+    return all(ra == rb and all(np.array_equal(oa[k], ob[k]) for k in oa) for (ra, oa), (rb, ob) in zip(a, b))
+
+
+def test_gymnasium_check_env_passes():
+    check_env(PianoEnv(piece=PHRASE), skip_render_check=True)
+    check_env(PianoEnv(task="chord", config=EnvConfig(tactile=False)), skip_render_check=True)
+
+
+def test_observation_layout_matches_the_paper():
+    env = PianoEnv(piece=PHRASE)
+    observation, _ = env.reset(seed=0)
+    assert observation["score"].shape == (11, 24, 5)  # current step + 10 lookahead, L x 5
+    assert observation["tactile"].shape == (2, 3, 15, 20) and observation["tactile"].dtype == np.uint8
+    assert observation["joints"].shape == (12,) and observation["joint_velocities"].shape == (12,)
+    assert observation["wrist"].shape == (2,)
+    assert "keys" not in observation
+    assert env.action_space.shape == (13,)
+    full = PianoEnv(piece=PHRASE, config=EnvConfig(tactile_pool=None, key_observations=True, lookahead=0))
+    observation, _ = full.reset(seed=0)
+    assert observation["tactile"].shape == (2, 3, 60, 80)
+    assert observation["score"].shape == (1, 24, 5)
+    assert observation["keys"].shape == (24,) and observation["key_velocities"].shape == (24,)
+    assert "tactile" not in PianoEnv(piece=PHRASE, config=EnvConfig(tactile=False)).reset(seed=0)[0]
+
+
+def test_the_score_window_slides_one_step_per_step():
+    env = PianoEnv(piece=PHRASE, config=EnvConfig(tactile=False))
+    observation, _ = env.reset(seed=0)
+    lead = env.lead_steps
+    assert lead == 20  # 1 s lead-in at 20 Hz
+    assert observation["score"][lead - 10:, 0, 0].sum() == 0  # C4 lies beyond the 10-step lookahead
+    for _ in range(lead - 10):
+        observation, *_ = env.step(np.zeros(13))
+    assert observation["score"][10, 0, 0] == 1  # C4's onset has just come into view
+    assert observation["score"][10, 0, 1] == pytest.approx(70 / 127)
+    assert observation["score"][10, 0, 2:].tolist() == [1, 0, 0]  # index finger
+
+
+def test_deterministic_for_a_seed_and_independent_of_earlier_episodes():
+    env = PianoEnv(piece=PHRASE)
+    first = rollout(env, seed=7)
+    rollout(env, seed=8)
+    assert same(first, rollout(env, seed=7))
+    assert same(first, rollout(PianoEnv(piece=PHRASE), seed=7))
+    start = [PianoEnv(piece=PHRASE).reset(seed=s)[0]["wrist"][0] for s in (1, 2)]
+    assert start[0] != start[1]  # the hand starts at a random place
+
+
+def test_the_phrase_end_is_truncated_not_terminated():
+    env = PianoEnv(piece=PHRASE, config=EnvConfig(tactile=False))
+    env.reset(seed=0)
+    flags = []
+    for _ in range(env.horizon):
+        _, _, terminated, truncated, _ = env.step(np.zeros(13))
+        flags.append((terminated, truncated))
+    assert flags[-1] == (False, True)
+    assert not any(t for t, _ in flags) and not any(tr for _, tr in flags[:-1])
+    assert env.horizon == 20 + 25  # lead-in + 1.0 s of music + 0.25 s tail
+
+
+@pytest.mark.parametrize("kind", ["linear", "squared", "wasserstein"])
+def test_reward_terms_in_info_sum_to_the_reward(kind):
+    env = PianoEnv(piece=PHRASE, config=EnvConfig(tactile=False, reward=RewardConfig(kind=kind)))
+    env.reset(seed=0)
+    rng = np.random.default_rng(0)
+    for _ in range(40):
+        _, reward, _, _, info = env.step(rng.uniform(-1, 1, 13))
+        assert sum(info["reward_terms"].values()) == pytest.approx(reward)
+
+
+def test_idle_hand_touches_nothing():
+    env = PianoEnv(piece=PHRASE, config=EnvConfig(tactile=True))
+    observation, _ = env.reset(seed=3)
+    for _ in range(10):
+        observation, reward, _, _, info = env.step(np.zeros(13))
+        assert info["events"] == [] and observation["tactile"].max() == 0
+        assert reward == pytest.approx(1.0)  # nothing asked for yet, nothing played
+
+
+def test_torque_control_and_discrete_wrist_run():
+    from pianobot.sim.world import WorldConfig
+
+    for world in (WorldConfig(control="torque"), WorldConfig(discrete_wrist=True)):
+        env = PianoEnv(piece=PHRASE, config=EnvConfig(world=world, tactile=False))
+        trace = rollout(env, seed=0, steps=10)
+        assert len(trace) == 10 and all(np.isfinite(r) for r, _ in trace)
+    env = PianoEnv(piece=PHRASE, config=EnvConfig(world=WorldConfig(discrete_wrist=True), tactile=False))
+    env.reset(seed=0)
+    action = np.zeros(13)
+    action[-1] = -1.0
+    for _ in range(15):
+        observation, *_ = env.step(action)
+    assert observation["wrist"][0] == pytest.approx(2 * env.world.boxes[0].center[0] / env.world.width - 1, abs=0.01)
+
+
+def test_registered_ids():
+    env = gym.make("pianobot/OneNote-v0", config=EnvConfig(tactile=False))
+    observation, _ = env.reset(seed=0)
+    assert observation["score"].shape == (11, 24, 5)
+    assert gym.make("pianobot/Piano-v0", piece=PHRASE).unwrapped.piece == PHRASE
+    assert {"pianobot/ThreeNote-v0", "pianobot/SixNote-v0", "pianobot/Rhythmic-v0", "pianobot/Chord-v0"} <= set(gym.registry)
+
+
+def test_unplayable_phrase_is_refused():
+    from pianobot.errors import PianobotError
+
+    with pytest.raises(PianobotError, match="outside the keyboard"):
+        PianoEnv(piece=Piece((Note(0, 40, 1, 80, 2),)))

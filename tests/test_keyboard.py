@@ -1,0 +1,72 @@
+"""The keyboard: velocity calibration, the MIDI-like key sensor, and a physical key press."""
+
+import numpy as np
+import pytest
+
+from pianobot.music.instrument import KeyboardSpec
+from pianobot.sim.keyboard import KeyboardConfig, KeySensor, VelocityCurve, key_boxes, keyboard_width
+
+
+def test_velocity_curve_is_monotone_and_its_inverse_round_trips():
+    curve = VelocityCurve()
+    speeds = np.geomspace(0.005, 2.0, 200)
+    velocities = curve.velocity(speeds)
+    assert np.all(np.diff(velocities) >= 0)
+    assert velocities[0] == 1 and velocities[-1] == 127
+    for v in range(1, 128):
+        assert curve.velocity(curve.speed(v)) == v
+
+
+def test_key_layout_is_two_octaves_of_real_sized_keys():
+    config = KeyboardConfig()
+    boxes = key_boxes(config)
+    assert len(boxes) == 24 and sum(b.black for b in boxes) == 10
+    assert keyboard_width(config) == pytest.approx(14 * 0.0235)
+    white = [b for b in boxes if not b.black]
+    assert np.allclose(np.diff([b.center[0] for b in white]), 0.0235)
+    black = [b for b in boxes if b.black]
+    assert all(b.half[0] * 2 == pytest.approx(0.0137) and b.center[2] + b.half[2] == pytest.approx(0.0127) for b in black)
+    # C#4 lies between C4 and D4
+    assert white[0].center[0] < boxes[1].center[0] < white[1].center[0]
+    assert not any(b.black for b in key_boxes(KeyboardConfig(spec=KeyboardSpec(62, 1))))
+
+
+def test_key_sensor_sends_note_on_with_velocity_and_note_off_with_hysteresis():
+    config = KeyboardConfig(spec=KeyboardSpec(60, 2))
+    sensor = KeySensor(config)
+    full = config.geometry.max_angle
+    speed = np.array([0.0, 0.0])
+    assert sensor.update(0.0, np.array([0.5 * full, 0.0]), speed) == []  # not yet at the strike depth
+    fast = VelocityCurve().speed(100) / config.geometry.white_length
+    events = sensor.update(0.1, np.array([0.7 * full, 0.0]), np.array([fast, 0.0]))
+    assert [(e.pitch, e.on, e.velocity) for e in events] == [(60, True, 100)]
+    assert sensor.update(0.2, np.array([0.9 * full, 0.0]), speed) == []  # held: no second note-on
+    assert sensor.update(0.3, np.array([0.5 * full, 0.0]), speed) == []  # between release and strike: still on
+    events = sensor.update(0.4, np.array([0.2 * full, 0.0]), speed)
+    assert [(e.pitch, e.on) for e in events] == [(60, False)]
+    assert not sensor.sounding.any()
+
+
+def test_slow_press_is_soft_and_fast_press_is_loud():
+    """A finger pressing a key through the physics: the key's speed sets the velocity."""
+    from pianobot.sim.world import PianoWorld, WorldConfig
+    from pianobot.env import idle_pose
+
+    world = PianoWorld(WorldConfig())
+    velocities = []
+    for speed in (0.15, 0.6):
+        world.reset(world.boxes[4].center[0], np.tile(idle_pose(world.config), 3))  # middle finger over E4
+        action = np.zeros(13)
+        action[5] = speed  # the middle finger's knuckle (MCP) flexes
+        notes = []
+        for _ in range(20):
+            result = world.step(action)
+            notes += [e.velocity for e in result.events if e.on]
+            if notes:
+                break
+        assert len(notes) == 1
+        velocities.append(notes[0])
+        angles, _ = world.key_state()
+        assert angles.max() <= 1.3 * world.config.keyboard.geometry.max_angle  # the key stops at the keybed
+    world.close()
+    assert velocities[0] + 20 < velocities[1]
