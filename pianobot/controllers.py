@@ -247,6 +247,8 @@ class ScriptedPianist:
         tip_height = self._tip_height(q, key)
         past = min(self.strike_margin, speed * self.dt / 4)
         goal = tip_height - speed * self.dt if start == 0 else -depth - past + speed * self.dt * (start - 1)
+        if start <= 1:  # the last step never runs slower than the strike speed (too low a start: strike early)
+            goal = min(goal, tip_height - speed * self.dt)
         floor = -depth - self.hold_depth_margin
         return Plan(key, "strike", height=height, goal=float(np.clip(goal, floor, tip_height)), start=start, lead=steps)
 
@@ -292,7 +294,8 @@ class ScriptedPianist:
         now_reach, now_drop = lowest_point_in_finger_plane(geometry, q[1:])
         now_height = hand.palm_height - now_drop
         # waypoints: up first; across before down; into or out of the black keys' band only high up
-        if height > now_height + self.path_tolerance:
+        rise_here = finger_ik(geometry, now_reach, hand.palm_height - height) is not None
+        if height > now_height + self.path_tolerance and rise_here:
             reach = now_reach if abs(reach - now_reach) > self.path_tolerance else reach
             over = self.black_rise if now_reach > hand.palm_y - self.black_band_y else 0.0
             if now_height < over + self.clearance:

@@ -42,6 +42,14 @@ def idle_pose(config: WorldConfig) -> np.ndarray:
     return np.concatenate([[0.0], flexion])
 
 
+SPEED_BOUND = 5.0
+"""Speeds are observed as fractions of their maximum, clipped to +-SPEED_BOUND (a collision can spike them)."""
+
+
+def _bounded(values) -> np.ndarray:
+    return np.clip(np.asarray(values, dtype=np.float32), -SPEED_BOUND, SPEED_BOUND)
+
+
 @dataclass(frozen=True)
 class EnvConfig:
     """Everything that shapes an episode, its observations and its reward."""
@@ -104,16 +112,16 @@ class PianoEnv(gym.Env):
 
         obs = {
             "score": spaces.Box(0.0, 1.0, (config.lookahead + 1, keys, self.spec_score.channels), np.float32),
-            "wrist": spaces.Box(-np.inf, np.inf, (2,), np.float32),
-            "joints": spaces.Box(-np.inf, np.inf, (self.n_joints,), np.float32),
-            "joint_velocities": spaces.Box(-np.inf, np.inf, (self.n_joints,), np.float32),
+            "wrist": spaces.Box(-SPEED_BOUND, SPEED_BOUND, (2,), np.float32),
+            "joints": spaces.Box(-np.pi, np.pi, (self.n_joints,), np.float32),
+            "joint_velocities": spaces.Box(-SPEED_BOUND, SPEED_BOUND, (self.n_joints,), np.float32),
         }
         if config.tactile:
             rows, cols = config.tactile_pool or (config.tactile_sensor.rows, config.tactile_sensor.cols)
             obs["tactile"] = spaces.Box(0, 255, (2, self.n_fingers, rows, cols), np.uint8)
         if config.key_observations:
-            obs["keys"] = spaces.Box(-np.inf, np.inf, (keys,), np.float32)
-            obs["key_velocities"] = spaces.Box(-np.inf, np.inf, (keys,), np.float32)
+            obs["keys"] = spaces.Box(-SPEED_BOUND, SPEED_BOUND, (keys,), np.float32)
+            obs["key_velocities"] = spaces.Box(-SPEED_BOUND, SPEED_BOUND, (keys,), np.float32)
         self.observation_space = spaces.Dict(obs)
         self.action_space = spaces.Box(-1.0, 1.0, (self.n_joints + 1,), np.float32)
         if piece is not None:
@@ -198,17 +206,17 @@ class PianoEnv(gym.Env):
         hand = cfg.world.hand
         obs = {
             "score": self.score[self.t : self.t + cfg.lookahead + 1].copy(),
-            "wrist": np.array([2 * wrist / world.width - 1, wrist_speed / hand.max_wrist_speed], np.float32),
+            "wrist": _bounded([2 * wrist / world.width - 1, wrist_speed / hand.max_wrist_speed]),
             "joints": angles.astype(np.float32),
-            "joint_velocities": (speeds / hand.max_joint_speed).astype(np.float32),
+            "joint_velocities": _bounded(speeds / hand.max_joint_speed),
         }
         if self.tactile is not None:
             obs["tactile"] = np.stack(self.tactile_history)
         if cfg.key_observations:
             key_angles, key_speeds = world.key_state()
             max_angle = cfg.world.keyboard.geometry.max_angle
-            obs["keys"] = (key_angles / max_angle).astype(np.float32)
-            obs["key_velocities"] = (key_speeds / (max_angle * cfg.world.control_hz)).astype(np.float32)
+            obs["keys"] = _bounded(key_angles / max_angle)
+            obs["key_velocities"] = _bounded(key_speeds / (max_angle * cfg.world.control_hz))
         return obs
 
     def render(self):

@@ -153,3 +153,45 @@ def test_bad_option_values(scale_file, tmp_path):
 def test_version():
     result = run("--version")
     assert result.exit_code == 0 and result.output.startswith("pianobot ")
+
+
+def test_play_scripted_writes_a_performance_that_scores_well(tmp_path):
+    out = tmp_path / "out.mid"
+    result = run("play", EXAMPLES / "three-note.mid", "-o", out, "--video", tmp_path / "out.mp4")
+    assert result.exit_code == 0, result.output
+    report = json.loads((tmp_path / "out.report.json").read_text())
+    assert report["f1"] >= 0.95 and report["velocity_mae"] <= 10 and report["controller"] == "scripted"
+    from pianobot.music.midi_io import read_midi, write_midi
+
+    played = read_midi(out)
+    assert [n.pitch for n in played] == [60, 62, 64] and played.has_fingering
+    assert read_midi(write_midi(played, tmp_path / "again.mid")) == played
+    scored = run("score", out, EXAMPLES / "three-note.mid", "--json", tmp_path / "s.json")
+    assert json.loads((tmp_path / "s.json").read_text())["f1"] == report["f1"]
+    import imageio.v2 as imageio
+
+    frames = imageio.get_reader(tmp_path / "out.mp4").count_frames()
+    assert frames > 50  # one frame per control step
+    assert scored.exit_code == 0
+
+
+def test_play_bad_requests_answer_with_one_line(tmp_path, scale):
+    song = EXAMPLES / "one-note.mid"
+    assert_one_line_error(run("play", song, "-o", tmp_path / "out.wav"), "*.mid")
+    assert_one_line_error(run("play", song, "-o", song), "overwrite")
+    assert_one_line_error(run("play", song, "-o", tmp_path / "x.mid", "--controller", "robot"), "--controller robot")
+    assert_one_line_error(run("play", song, "-o", tmp_path / "x.mid", "--video", tmp_path / "v.gif"), "*.mp4")
+    unfingered = write_midi(scale.without_fingering(), tmp_path / "plain.mid")
+    assert_one_line_error(run("play", unfingered, "-o", tmp_path / "x.mid"), "without fingering")
+    assert not (tmp_path / "x.mid").exists()
+
+
+def test_play_gui_without_a_display_is_refused(tmp_path, monkeypatch):
+    monkeypatch.delenv("DISPLAY", raising=False)
+    assert_one_line_error(run("play", EXAMPLES / "one-note.mid", "-o", tmp_path / "x.mid", "--gui"), "display")
+
+
+def test_play_random_controller(tmp_path):
+    result = run("play", EXAMPLES / "one-note.mid", "-o", tmp_path / "r.mid", "--controller", "random", "--seed", "3")
+    assert result.exit_code == 0, result.output
+    assert json.loads((tmp_path / "r.report.json").read_text())["controller"] == "random"

@@ -1,4 +1,4 @@
-"""PyBullet, imported once without the banner its C module prints on standard output."""
+"""PyBullet, imported once without the build banner its C module prints."""
 
 from __future__ import annotations
 
@@ -8,14 +8,17 @@ import sys
 
 def _import_quietly():
     sys.stdout.flush()
-    saved = os.dup(1)
+    sys.stderr.flush()
+    saved = [os.dup(1), os.dup(2)]
     try:
         with open(os.devnull, "w") as null:
             os.dup2(null.fileno(), 1)
+            os.dup2(null.fileno(), 2)
             import pybullet
     finally:
-        os.dup2(saved, 1)
-        os.close(saved)
+        for fd, copy in zip((1, 2), saved):
+            os.dup2(copy, fd)
+            os.close(copy)
     return pybullet
 
 
