@@ -81,7 +81,9 @@ class ScriptedPianist:
     """The fingertip is planned to pass the strike depth by up to this much (m) at the onset."""
     hold_depth_margin = 0.0025
     """A held key is pressed this far (m) past its strike depth before the finger just holds it."""
-    prepare_steps = 3
+    max_move = 0.008
+    """Longest fingertip move (m) in one control step when positioning (strikes are not limited)."""
+    prepare_steps = 4
     """Control steps a finger needs to lift, move over and settle before a strike from the ready height."""
     hold_slide = 0.008
     """How far (m) the wrist may move in one step while a finger holds a key."""
@@ -288,11 +290,13 @@ class ScriptedPianist:
         reach = forward / math.cos(abduction)  # keeps the tip at contact_y even when the key is out of reach
         if phase in ("ready", "strike") and abs(offset - forward * math.tan(abduction)) > self.aim_tolerance:
             phase = "idle"  # not over the key yet: wait high
+        now_reach, now_drop = lowest_point_in_finger_plane(geometry, q[1:])
+        now_height = hand.palm_height - now_drop
+        if phase == "strike" and abs(reach - now_reach) > self.aim_tolerance:
+            phase = "ready"  # not in front of the key yet: a strike now would hit its edge
         height = {"idle": top + self.idle_height, "ready": top + (plan.height if plan else 0.0)}.get(phase)
         if height is None:  # strike or hold: the planned height for the end of this step
             height = top + plan.goal
-        now_reach, now_drop = lowest_point_in_finger_plane(geometry, q[1:])
-        now_height = hand.palm_height - now_drop
         # waypoints: up first; across before down; into or out of the black keys' band only high up
         rise_here = finger_ik(geometry, now_reach, hand.palm_height - height) is not None
         if height > now_height + self.path_tolerance and rise_here:
@@ -307,6 +311,11 @@ class ScriptedPianist:
         safe = self.black_rise + self.band_clearance
         if crossing and now_height < safe:
             reach, height = now_reach, safe
+        if phase not in ("strike", "hold"):  # positioning moves go in short straight steps, so the tip never dips
+            move = np.array([reach - now_reach, height - now_height])
+            length = float(np.hypot(*move))
+            if length > self.max_move:
+                reach, height = now_reach + move[0] * self.max_move / length, now_height + move[1] * self.max_move / length
         flexion = self._ik(reach, hand.palm_height - height, q[1:])
         desired = np.concatenate([[abduction], flexion])
         command = np.clip((desired - q) / (hand.max_joint_speed * self.dt), -1.0, 1.0)
