@@ -7,8 +7,10 @@
 - chord: three two-note chords.
 
 Notes lie on white keys of the default keyboard, fingered for the three-finger hand: in one
-hand position the index, middle and ring fingers lie over three neighbouring white keys. A
-task instance is drawn from a NumPy generator, so a seed fixes it.
+hand position the index, middle and ring fingers lie over three neighbouring white keys, and
+the hand moves at most :data:`MAX_SHIFT` white keys from one position to the next (a jump
+across the whole keyboard between two legato notes is beyond what a 0.5 s score lookahead
+lets a hand prepare). A task instance is drawn from a NumPy generator, so a seed fixes it.
 """
 
 from __future__ import annotations
@@ -21,6 +23,8 @@ from pianobot.music.piece import Note, Piece
 TASKS = ("one-note", "three-note", "six-note", "rhythmic", "chord")
 BPM = 60.0
 FINGERS = (2, 3, 4)
+MAX_SHIFT = 4
+"""Most white keys the hand position moves between consecutive positions."""
 
 
 def _white_keys(keyboard: KeyboardSpec) -> list[int]:
@@ -31,12 +35,19 @@ def _velocity(rng: np.random.Generator) -> int:
     return int(rng.integers(40, 111))
 
 
+def _position(rng: np.random.Generator, count: int, previous: int | None) -> int:
+    """Index of the white key under the index finger: anywhere at first, then near the previous one."""
+    if previous is None:
+        return int(rng.integers(0, count - 2))
+    return int(rng.integers(max(0, previous - MAX_SHIFT), min(count - 3, previous + MAX_SHIFT) + 1))
+
+
 def _melody(rng: np.random.Generator, keyboard: KeyboardSpec, beats: list[float]) -> Piece:
     whites = _white_keys(keyboard)
-    notes, time = [], 0.0
+    notes, time, base = [], 0.0, None
     for i, length in enumerate(beats):
         if i % 3 == 0:  # a new hand position every three notes
-            base = int(rng.integers(0, len(whites) - 2))
+            base = _position(rng, len(whites), base)
         slot = int(rng.integers(0, 3))
         duration = length * 60.0 / BPM
         notes.append(Note(time, whites[base + slot], time + duration, _velocity(rng), FINGERS[slot]))
@@ -56,9 +67,9 @@ def make_task(name: str, rng: np.random.Generator, keyboard: KeyboardSpec = Keyb
         return _melody(rng, keyboard, [float(rng.choice([1.0, 0.5, 1.0 / 3.0])) for _ in range(3)])
     if name == "chord":
         whites = _white_keys(keyboard)
-        notes = []
+        notes, base = [], None
         for i in range(3):
-            base = int(rng.integers(0, len(whites) - 2))
+            base = _position(rng, len(whites), base)
             velocity = _velocity(rng)
             notes += [Note(float(i), whites[base], i + 1.0, velocity, 2), Note(float(i), whites[base + 2], i + 1.0, velocity, 4)]
         return Piece(tuple(notes), bpm=BPM)
