@@ -14,8 +14,9 @@ $(BIN)/pianobot: pyproject.toml
 install: $(BIN)/pianobot
 
 demo: install
-	$(BIN)/pianobot inspect examples/midi/twinkle.mid
-	$(BIN)/pianobot score examples/midi/twinkle.mid examples/midi/twinkle.mid --no-notes
+	mkdir -p out
+	$(BIN)/pianobot play examples/midi/twinkle.mid -o out/twinkle.mid --video out/twinkle.mp4
+	$(BIN)/pianobot score out/twinkle.mid examples/midi/twinkle.mid --no-notes --plot out/twinkle.png
 
 test: install
 	$(BIN)/python -m pytest
