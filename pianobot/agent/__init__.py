@@ -1,0 +1,1 @@
+"""The learning agent: Soft Actor-Critic and its replay buffer."""

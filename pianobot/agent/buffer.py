@@ -1,0 +1,67 @@
+"""A replay buffer of preallocated NumPy arrays; tactile images stay uint8 until a batch is drawn."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import torch
+
+from pianobot.errors import PianobotError
+
+
+class ReplayBuffer:
+    """Transitions (o, a, r, terminated, o') in ring-buffer arrays."""
+
+    def __init__(self, capacity: int, vector_dim: int, tactile_shape: tuple[int, ...] | None, action_dim: int):
+        self.capacity = capacity
+        self.arrays = {
+            "vector": np.zeros((capacity, vector_dim), np.float32),
+            "next_vector": np.zeros((capacity, vector_dim), np.float32),
+            "action": np.zeros((capacity, action_dim), np.float32),
+            "reward": np.zeros(capacity, np.float32),
+            "terminated": np.zeros(capacity, np.float32),
+        }
+        if tactile_shape is not None:
+            self.arrays["tactile"] = np.zeros((capacity, *tactile_shape), np.uint8)
+            self.arrays["next_tactile"] = np.zeros((capacity, *tactile_shape), np.uint8)
+        self.size = 0
+        self.cursor = 0
+
+    def add(self, vector, tactile, action, reward, terminated, next_vector, next_tactile) -> None:
+        i = self.cursor
+        a = self.arrays
+        a["vector"][i], a["next_vector"][i], a["action"][i] = vector, next_vector, action
+        a["reward"][i], a["terminated"][i] = reward, float(terminated)
+        if "tactile" in a:
+            a["tactile"][i], a["next_tactile"][i] = tactile, next_tactile
+        self.cursor = (i + 1) % self.capacity
+        self.size = min(self.size + 1, self.capacity)
+
+    def sample(self, batch_size: int, rng: np.random.Generator) -> dict[str, torch.Tensor | None]:
+        index = rng.integers(0, self.size, batch_size)
+        batch = {k: torch.from_numpy(v[index]) for k, v in self.arrays.items()}
+        batch.setdefault("tactile", None)
+        batch.setdefault("next_tactile", None)
+        return batch
+
+    @property
+    def nbytes(self) -> int:
+        return sum(v.nbytes for v in self.arrays.values())
+
+    # -- checkpoints: plain .npy files, read without pickle -----------------------------------
+    def save(self, folder: Path) -> None:
+        folder.mkdir(parents=True, exist_ok=True)
+        for name, array in self.arrays.items():
+            np.save(folder / f"{name}.npy", array[: self.size])
+
+    def load(self, folder: Path, size: int, cursor: int) -> None:
+        for name, array in self.arrays.items():
+            try:
+                data = np.load(folder / f"{name}.npy", allow_pickle=False)
+            except (OSError, ValueError) as e:
+                raise PianobotError(f"checkpoint buffer {folder / (name + '.npy')} is unreadable ({e}): delete the checkpoint folder to start afresh") from None
+            if data.shape[1:] != array.shape[1:] or len(data) != size:
+                raise PianobotError(f"checkpoint buffer {folder} does not fit this configuration: delete it to start afresh")
+            array[:size] = data
+        self.size, self.cursor = size, cursor

@@ -1,0 +1,288 @@
+"""Soft Actor-Critic (paper, section "Soft Actor-Critic"), written for a CPU.
+
+Networks (paper, "Architecture"): a tactile encoder of three convolution layers shared across
+fingers, a three-layer MLP for the vector inputs (score window, wrist, joints), their features
+concatenated and fed to two-layer heads; ReLU throughout. The critic's two Q heads are one
+batched network (weights stacked on a leading axis, one ``baddbmm`` per layer), so both critics
+cost one forward and one optimiser step. The encoder belongs to the critic and the actor reads
+its features detached (as in DrQ): one encoder pass per update serves both.
+
+Everything tunable is in :class:`SACConfig`; docs/training.md says where our defaults differ
+from the paper's and why.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import torch
+from torch import nn
+from torch.nn import functional as F
+
+
+@dataclass(frozen=True)
+class SACConfig:
+    """Every hyperparameter of the agent, with its default. The single source of defaults."""
+
+    discount: float = 0.9
+    """RoboPianist found 0.8-0.9 better than 0.99 for piano playing (the paper does not say)."""
+    batch_size: int = 256
+    learning_rate: float = 1e-3
+    """Adam, for actor, critic and temperature (paper)."""
+    initial_alpha: float = 0.02
+    """Initial entropy temperature (paper)."""
+    target_entropy_scale: float = 1.0
+    """Target entropy = -scale * action dimensions."""
+    tau: float = 0.005
+    """Polyak factor of the target critic."""
+    hidden: int = 256
+    """Width of the MLP layers."""
+    score_features: int = 64
+    """Width of the first layer over the (large, sparse) score window."""
+    tactile_channels: int = 8
+    """Channels of the tactile convolutions."""
+    tactile_features: int = 32
+    """Features per finger from the tactile encoder."""
+    tactile_resolution: tuple[int, int] | None = (15, 20)
+    """Tactile images are average-pooled to this size before buffer and network (None: full 60 x 80)."""
+    buffer_size: int = 100_000
+    """Replay buffer capacity (transitions)."""
+    update_ratio: float = 1.0
+    """Gradient updates per environment step once learning starts."""
+    exploration_steps: int = 15_000
+    """Environment steps of exploration before learning starts (paper: 15000)."""
+    log_std_bounds: tuple[float, float] = (-5.0, 2.0)
+
+
+# -- observation layout -----------------------------------------------------------------------
+VECTOR_KEYS = ("score", "wrist", "joints", "joint_velocities", "keys", "key_velocities")
+
+
+def vector_size(observation_space) -> int:
+    return sum(int(np.prod(observation_space[k].shape)) for k in VECTOR_KEYS if k in observation_space.spaces)
+
+
+def score_size(observation_space) -> int:
+    """Length of the score window at the start of the flat vector."""
+    return int(np.prod(observation_space["score"].shape))
+
+
+def split_observation(observation: dict) -> tuple[np.ndarray, np.ndarray | None]:
+    """A dict observation as (flat float32 vector, uint8 tactile images or None)."""
+    vector = np.concatenate([np.asarray(observation[k], np.float32).ravel() for k in VECTOR_KEYS if k in observation])
+    return vector, observation.get("tactile")
+
+
+# -- networks ---------------------------------------------------------------------------------
+class Encoder(nn.Module):
+    """Observation -> features: a 3-layer MLP on the vector, 3 conv layers on each fingertip's images."""
+
+    def __init__(self, vector_dim: int, score_dim: int, tactile_shape: tuple[int, ...] | None, config: SACConfig):
+        super().__init__()
+        h = config.hidden
+        self.score_dim = score_dim
+        # the score window is large and sparse (L keys x 5 x steps): a narrow first layer for it
+        # keeps the MLP's cost down; the joint and wrist values join it in the second layer
+        self.score = nn.Sequential(nn.Linear(score_dim, config.score_features), nn.ReLU())
+        self.vector = nn.Sequential(
+            nn.Linear(config.score_features + vector_dim - score_dim, h), nn.ReLU(), nn.Linear(h, h), nn.ReLU()
+        )
+        self.out_dim = h
+        self.tactile = None
+        if tactile_shape is not None:
+            history, fingers, rows, cols = tactile_shape
+            c = config.tactile_channels
+            self.fingers = fingers
+            self.conv = nn.Sequential(
+                nn.Conv2d(history, c, 3, stride=2), nn.ReLU(), nn.Conv2d(c, c, 3), nn.ReLU(), nn.Conv2d(c, c, 3), nn.ReLU(), nn.Flatten()
+            )
+            with torch.no_grad():
+                flat = self.conv(torch.zeros(1, history, rows, cols)).shape[1]
+            self.tactile = nn.Sequential(self.conv, nn.Linear(flat, config.tactile_features), nn.ReLU())
+            self.out_dim += fingers * config.tactile_features
+
+    def forward(self, vector: torch.Tensor, tactile: torch.Tensor | None) -> torch.Tensor:
+        score = self.score(vector[:, : self.score_dim])
+        features = self.vector(torch.cat([score, vector[:, self.score_dim :]], dim=1))
+        if self.tactile is None:
+            return features
+        batch, history, fingers, rows, cols = tactile.shape
+        # the same convolutions for every finger: fingers go into the batch dimension
+        images = tactile.float().div_(255.0).transpose(1, 2).reshape(batch * fingers, history, rows, cols)
+        touch = self.tactile(images).reshape(batch, -1)
+        return torch.cat([features, touch], dim=1)
+
+
+class EnsembleLinear(nn.Module):
+    """``members`` independent linear layers evaluated in one batched matrix product."""
+
+    def __init__(self, members: int, in_features: int, out_features: int):
+        super().__init__()
+        bound = 1.0 / math.sqrt(in_features)
+        self.weight = nn.Parameter(torch.empty(members, in_features, out_features).uniform_(-bound, bound))
+        self.bias = nn.Parameter(torch.empty(members, 1, out_features).uniform_(-bound, bound))
+
+    def forward(self, x: torch.Tensor) -> torch.Tensor:  # (members, batch, in) -> (members, batch, out)
+        return torch.baddbmm(self.bias, x, self.weight)
+
+
+class Critic(nn.Module):
+    """The encoder and two Q heads (2-layer MLPs over features and action) as one ensemble."""
+
+    def __init__(self, vector_dim: int, score_dim: int, tactile_shape, action_dim: int, config: SACConfig):
+        super().__init__()
+        self.encoder = Encoder(vector_dim, score_dim, tactile_shape, config)
+        h = config.hidden
+        self.layers = nn.ModuleList(
+            [EnsembleLinear(2, self.encoder.out_dim + action_dim, h), EnsembleLinear(2, h, h), EnsembleLinear(2, h, 1)]
+        )
+
+    def q(self, features: torch.Tensor, action: torch.Tensor) -> torch.Tensor:
+        """Both critics' values, shape (2, batch)."""
+        x = torch.cat([features, action], dim=1).unsqueeze(0).expand(2, -1, -1)
+        x = F.relu(self.layers[0](x))
+        x = F.relu(self.layers[1](x))
+        return self.layers[2](x).squeeze(-1)
+
+
+class Actor(nn.Module):
+    """A tanh-squashed Gaussian policy over the critic encoder's features."""
+
+    def __init__(self, feature_dim: int, action_dim: int, config: SACConfig):
+        super().__init__()
+        h = config.hidden
+        self.net = nn.Sequential(nn.Linear(feature_dim, h), nn.ReLU(), nn.Linear(h, h), nn.ReLU(), nn.Linear(h, 2 * action_dim))
+        self.log_std_bounds = config.log_std_bounds
+
+    def forward(self, features: torch.Tensor, deterministic: bool = False) -> tuple[torch.Tensor, torch.Tensor]:
+        mean, log_std = self.net(features).chunk(2, dim=-1)
+        low, high = self.log_std_bounds
+        log_std = low + 0.5 * (high - low) * (torch.tanh(log_std) + 1)
+        if deterministic:
+            return torch.tanh(mean), torch.zeros(mean.shape[0])
+        std = log_std.exp()
+        noise = torch.randn_like(mean)
+        raw = mean + std * noise
+        action = torch.tanh(raw)
+        # log-probability of the squashed sample (change of variables, numerically stable form)
+        log_prob = (-0.5 * noise.pow(2) - log_std - 0.5 * math.log(2 * math.pi)).sum(-1)
+        log_prob = log_prob - (2 * (math.log(2) - raw - F.softplus(-2 * raw))).sum(-1)
+        return action, log_prob
+
+
+# -- the agent --------------------------------------------------------------------------------
+class SAC:
+    """Actor, twin critic with targets, learned temperature; :meth:`update` is one gradient step."""
+
+    def __init__(self, vector_dim: int, score_dim: int, tactile_shape, action_dim: int, config: SACConfig = SACConfig()):
+        self.config = config
+        self.critic = Critic(vector_dim, score_dim, tactile_shape, action_dim, config)
+        self.target = Critic(vector_dim, score_dim, tactile_shape, action_dim, config)
+        self.target.load_state_dict(self.critic.state_dict())
+        self.target.requires_grad_(False)
+        self.actor = Actor(self.critic.encoder.out_dim, action_dim, config)
+        self.log_alpha = torch.tensor(math.log(config.initial_alpha), requires_grad=True)
+        self.target_entropy = -config.target_entropy_scale * action_dim
+        lr = config.learning_rate
+        self.critic_optimizer = torch.optim.Adam(self.critic.parameters(), lr=lr)
+        self.actor_optimizer = torch.optim.Adam(self.actor.parameters(), lr=lr)
+        self.alpha_optimizer = torch.optim.Adam([self.log_alpha], lr=lr)
+        self._critic_params = list(self.critic.parameters())
+        self._target_params = list(self.target.parameters())
+        self.updates = 0
+
+    @property
+    def alpha(self) -> torch.Tensor:
+        return self.log_alpha.exp()
+
+    @torch.no_grad()
+    def act(self, vector: np.ndarray, tactile: np.ndarray | None, deterministic: bool = False) -> np.ndarray:
+        v = torch.from_numpy(np.asarray(vector, np.float32)).unsqueeze(0)
+        t = None if tactile is None else torch.from_numpy(np.asarray(tactile)).unsqueeze(0)
+        action, _ = self.actor(self.critic.encoder(v, t), deterministic)
+        return action[0].numpy()
+
+    def update(self, batch: dict[str, torch.Tensor]) -> dict[str, float]:
+        """One gradient step on critic, actor and temperature from a replay batch."""
+        alpha = self.alpha.detach()
+        now = self.critic.encoder(batch["vector"], batch["tactile"])
+        with torch.no_grad():
+            after = self.critic.encoder(batch["next_vector"], batch["next_tactile"])
+            next_action, next_log_prob = self.actor(after)
+            target_features = self.target.encoder(batch["next_vector"], batch["next_tactile"])
+            next_q = self.target.q(target_features, next_action).min(dim=0).values - alpha * next_log_prob
+            target_q = batch["reward"] + self.config.discount * (1.0 - batch["terminated"]) * next_q
+
+        q = self.critic.q(now, batch["action"])
+        critic_loss = 0.5 * (q - target_q.unsqueeze(0)).pow(2).sum(0).mean()
+        self.critic_optimizer.zero_grad(set_to_none=True)
+        critic_loss.backward()
+        self.critic_optimizer.step()
+
+        action, log_prob = self.actor(now.detach())
+        self.critic.layers.requires_grad_(False)  # the actor's loss needs no gradient for the critic
+        actor_q = self.critic.q(now.detach(), action).min(dim=0).values
+        actor_loss = (alpha * log_prob - actor_q).mean()
+        self.actor_optimizer.zero_grad(set_to_none=True)
+        actor_loss.backward()
+        self.actor_optimizer.step()
+        self.critic.layers.requires_grad_(True)
+
+        alpha_loss = -(self.log_alpha * (log_prob.detach() + self.target_entropy)).mean()
+        self.alpha_optimizer.zero_grad(set_to_none=True)
+        alpha_loss.backward()
+        self.alpha_optimizer.step()
+
+        with torch.no_grad():
+            torch._foreach_lerp_(self._target_params, self._critic_params, self.config.tau)
+        self.updates += 1
+        return {
+            "critic_loss": float(critic_loss.detach()),
+            "actor_loss": float(actor_loss.detach()),
+            "alpha": float(alpha),
+            "entropy": float(-log_prob.detach().mean()),
+            "q": float(q.detach().mean()),
+        }
+
+    # -- (de)serialisation as flat tensors, for safetensors ----------------------------------
+    def tensors(self, with_training_state: bool = True) -> dict[str, torch.Tensor]:
+        """Every tensor of the agent under a flat name. Without training state: the actor and encoder only."""
+        out = {f"actor.{k}": v for k, v in self.actor.state_dict().items()}
+        out.update({f"encoder.{k}": v for k, v in self.critic.encoder.state_dict().items()})
+        if with_training_state:
+            out.update({f"critic.{k}": v for k, v in self.critic.state_dict().items() if not k.startswith("encoder.")})
+            out.update({f"target.{k}": v for k, v in self.target.state_dict().items()})
+            out["log_alpha"] = self.log_alpha.detach().reshape(1)
+            for name, optimizer in self._optimizers().items():
+                for index, state in optimizer.state_dict()["state"].items():
+                    for key, value in state.items():
+                        out[f"optim.{name}.{index}.{key}"] = value.reshape(-1) if value.dim() == 0 else value
+        return {k: v.detach().contiguous().clone() for k, v in out.items()}
+
+    def load_tensors(self, tensors: dict[str, torch.Tensor], with_training_state: bool = True) -> None:
+        def section(prefix: str) -> dict[str, torch.Tensor]:
+            return {k[len(prefix) :]: v for k, v in tensors.items() if k.startswith(prefix)}
+
+        self.actor.load_state_dict(section("actor."))
+        self.critic.encoder.load_state_dict(section("encoder."))
+        if not with_training_state:
+            return
+        critic = section("critic.")
+        critic.update({f"encoder.{k}": v for k, v in section("encoder.").items()})
+        self.critic.load_state_dict(critic)
+        self.target.load_state_dict(section("target."))
+        with torch.no_grad():
+            self.log_alpha.copy_(tensors["log_alpha"][0])
+        for name, optimizer in self._optimizers().items():
+            template = optimizer.state_dict()
+            state: dict[int, dict[str, torch.Tensor]] = {}
+            for key, value in section(f"optim.{name}.").items():
+                index, field = key.split(".", 1)
+                state.setdefault(int(index), {})[field] = value.reshape(()) if field == "step" else value
+            template["state"] = state
+            optimizer.load_state_dict(template)
+
+    def _optimizers(self) -> dict[str, torch.optim.Optimizer]:
+        return {"critic": self.critic_optimizer, "actor": self.actor_optimizer, "alpha": self.alpha_optimizer}
