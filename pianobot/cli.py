@@ -23,7 +23,14 @@ from pianobot.files import atomic_write, check_writable
 from pianobot.metrics import DEFAULT_ONSET_TOLERANCE, compare, plot_report
 from pianobot.music import midi_io
 from pianobot.music.instrument import HandSpec, KeyboardSpec, check_playable
+from pianobot import store
+from pianobot.agent.sac import SACConfig
 from pianobot.env import EnvConfig
+from pianobot.explore import EXPLORATIONS
+from pianobot.music.tasks import TASKS
+from pianobot.rewards import REWARDS, RewardConfig
+from pianobot.sim.world import CONTROL_MODES
+from pianobot.train import PhraseJob, TrainConfig, plan_jobs, run_jobs
 from pianobot.music.load import LoadOptions, load_piece, load_playable
 from pianobot.music.midi_io import write_midi
 from pianobot.perform import CONTROLLERS, perform, write_video
@@ -208,6 +215,90 @@ def play(
     if video is not None:
         write_video(result.frames, video, fps=config.world.control_hz)
         out.print(f"video written to {video}")
+
+
+@app.command()
+@friendly
+def train(
+    song: Optional[Path] = typer.Argument(None, help="A .mid file with fingering; leave out with --task."),
+    task: Optional[str] = typer.Option(None, "--task", help=f"Train on one of the paper's task families instead: {', '.join(TASKS)}."),
+    steps: int = typer.Option(TrainConfig.steps, "--steps", help="Environment steps per phrase, exploration included."),
+    seed: int = typer.Option(TrainConfig.seed, "--seed", help="Seed of the simulation, the exploration and the networks."),
+    workers: int = typer.Option(1, "--workers", help="Train this many phrases at once, in separate processes."),
+    control: str = typer.Option(WorldConfig.control, "--control", help="Finger control: velocity or torque."),
+    reward: str = typer.Option(RewardConfig.kind, "--reward", help="Reward: linear, squared or wasserstein."),
+    explore: str = typer.Option(TrainConfig.explore, "--explore", help=f"Exploration before learning: {', '.join(EXPLORATIONS)}."),
+    exploration_steps: int = typer.Option(SACConfig.exploration_steps, "--exploration-steps", help="Steps of exploration before learning starts."),
+    tactile: bool = typer.Option(True, "--tactile/--no-tactile", help="Observe the fingertips' tactile images."),
+    fingering_gate: bool = typer.Option(RewardConfig.fingering_gate, "--fingering/--no-fingering", help="Credit a key only when the score's finger pressed it."),
+    force: bool = typer.Option(False, "--force", help="Retrain phrases that already have a stored policy."),
+    models: Path = typer.Option(Path("models"), "--models", help="Folder of the model store."),
+    track: Optional[str] = Track,
+    tempo: Optional[float] = Tempo,
+    transpose: int = Transpose,
+    fingering: Optional[Path] = Fingering,
+    lowest_note: str = LowestNote,
+    keys: int = Keys,
+    thumb: bool = Thumb,
+    phrase_notes: int = PhraseNotes,
+):
+    """Train one Soft Actor-Critic policy per phrase of a piece (or one for a task family) and store them."""
+    if (song is None) == (task is None):
+        raise PianobotError("give a .mid file to train on, or --task NAME (not both)")
+    if task is not None and task not in TASKS:
+        raise PianobotError(f"--task {task}: choose one of {', '.join(TASKS)}")
+    if control not in CONTROL_MODES:
+        raise PianobotError(f"--control {control}: choose velocity or torque")
+    if reward not in REWARDS:
+        raise PianobotError(f"--reward {reward}: choose one of {', '.join(REWARDS)}")
+    if explore not in EXPLORATIONS:
+        raise PianobotError(f"--explore {explore}: choose one of {', '.join(EXPLORATIONS)}")
+    if explore == "scripted" and control != "velocity":
+        raise PianobotError("--explore scripted needs --control velocity (the scripted pianist drives joint speeds)")
+    if not 0 <= exploration_steps < steps:
+        raise PianobotError(f"--steps {steps} must exceed --exploration-steps {exploration_steps}, or nothing is learnt")
+    if workers < 1:
+        raise PianobotError(f"--workers {workers}: give 1 or more")
+    if models.exists() and not models.is_dir():
+        raise PianobotError(f"--models {models} is a file: give a folder")
+    keyboard, hand = make_instrument(lowest_note, keys, thumb)
+    world = WorldConfig(keyboard=KeyboardConfig(spec=keyboard), hand=HandConfig(spec=hand), control=control)
+    env = EnvConfig(world=world, reward=RewardConfig(kind=reward, fingering_gate=fingering_gate), tactile=tactile)
+    config = TrainConfig(steps=steps, seed=seed, explore=explore, sac=SACConfig(exploration_steps=exploration_steps), env=env)
+    if task is not None:
+        jobs = [PhraseJob(f"task-{task}", task, store.model_dir(models, f"task-{task}", config), [0], f"task {task}")]
+        todo = [j for j in jobs if force or not store.is_trained(j.folder)]
+        done = [j for j in jobs if j not in todo]
+        label = f"task {task}"
+    else:
+        piece = load_playable(song, make_options(track, tempo, transpose, fingering), keyboard, hand)
+        if not piece.has_fingering:
+            raise PianobotError(f"{song} has notes without fingering: training needs a finger for every note (see docs/fingering.md)")
+        phrases = split_phrases(piece, phrase_notes)
+        todo, done = plan_jobs(phrases, config, models, force, piece=song.name)
+        label = f"{song.name}: {len(phrases)} phrases"
+    models.mkdir(parents=True, exist_ok=True)
+    for job in done:
+        out.print(f"phrase {job.key} ({', '.join(map(str, job.phrases))}) already trained in {job.folder}: skipped (--force retrains)")
+    out.print(f"training {len(todo)} polic{'y' if len(todo) == 1 else 'ies'} for {label}, {steps} steps each")
+    returns: dict[str, float] = {}
+    with Progress(TextColumn("{task.description}"), BarColumn(), TextColumn("{task.completed}/{task.total} steps"),
+                  TextColumn("{task.fields[status]}"), TimeRemainingColumn(), console=out) as bar:
+        rows = {job.key: bar.add_task(f"phrase {job.key[:8]}" if task is None else job.key, total=steps, status="") for job in todo}
+
+        def on_progress(key: str, progress) -> None:
+            status = bar.tasks[rows[key]].fields.get("status", "")
+            if progress.episode_return is not None:
+                returns[key] = progress.episode_return
+            if progress.eval_f1 is not None:
+                status = f"eval F1 {progress.eval_f1:.2f}"
+            elif key in returns:
+                status = f"return {returns[key]:.1f}" + (f" | {status.split(' | ')[-1]}" if "eval" in status else "")
+            bar.update(rows[key], completed=progress.step, status=status)
+
+        results = run_jobs(todo, config, workers, on_progress)
+    table = display.training_table([(job, results.get(job.key) or store.read_manifest(job.folder)) for job in done + todo])
+    out.print(table)
 
 
 def _version(value: bool):

@@ -99,3 +99,18 @@ def report_tables(report: Report) -> list[Table]:
 def print_all(console: Console, tables: list[Table]) -> None:
     for table in tables:
         console.print(table)
+
+
+def training_table(rows) -> Table:
+    """(job, manifest) pairs -> the summary `pianobot train` prints at the end."""
+    table = Table(title="trained policies")
+    for column in ("phrase", "used by", "steps", "eval note F1", "velocity MAE", "minutes", "folder"):
+        table.add_column(column)
+    for job, manifest in rows:
+        evaluation = manifest.get("evaluation", {})
+        table.add_row(
+            job.key, ", ".join(map(str, job.phrases)), str(manifest.get("steps", "-")),
+            _opt(evaluation.get("f1"), ".3f"), _opt(evaluation.get("velocity_mae"), ".1f"),
+            _opt(manifest.get("seconds", 0) / 60 if manifest.get("seconds") is not None else None, ".1f"), str(job.folder),
+        )
+    return table

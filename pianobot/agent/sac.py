@@ -277,10 +277,12 @@ class SAC:
             self.log_alpha.copy_(tensors["log_alpha"][0])
         for name, optimizer in self._optimizers().items():
             template = optimizer.state_dict()
+            params = [p for group in optimizer.param_groups for p in group["params"]]
             state: dict[int, dict[str, torch.Tensor]] = {}
             for key, value in section(f"optim.{name}.").items():
                 index, field = key.split(".", 1)
-                state.setdefault(int(index), {})[field] = value.reshape(()) if field == "step" else value
+                shape = () if field == "step" else params[int(index)].shape  # 0-d tensors were stored as (1,)
+                state.setdefault(int(index), {})[field] = value.reshape(shape)
             template["state"] = state
             optimizer.load_state_dict(template)
 

@@ -1,0 +1,51 @@
+"""How the agent acts before learning starts (paper, "Exploration Strategy"), plus our stronger prior.
+
+- ``uniform``: every action uniform in [-1, 1];
+- ``repeat``: uniform, but each step repeats the previous action with probability 0.8;
+- ``prior``: ``repeat`` plus the wrist stabiliser: the wrist moves in only 10 % of the steps
+  (the paper's best);
+- ``scripted``: the scripted pianist's action plus Gaussian noise (ours: a prior that already
+  knows where the keys are; it fills the replay buffer with mostly good playing).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from pianobot.controllers import ScriptedPianist
+from pianobot.env import EnvConfig
+
+EXPLORATIONS = ("uniform", "repeat", "prior", "scripted")
+REPEAT_PROBABILITY = 0.8
+WRIST_MOVE_PROBABILITY = 0.1
+SCRIPTED_NOISE = 0.2
+
+
+class Explorer:
+    """``reset()`` at each episode start, then ``act(observation)``."""
+
+    def __init__(self, kind: str, action_size: int, config: EnvConfig, rng: np.random.Generator):
+        if kind not in EXPLORATIONS:
+            raise ValueError(f"exploration must be one of {', '.join(EXPLORATIONS)}; got {kind!r}")
+        if kind == "scripted" and config.world.control != "velocity":
+            raise ValueError("--explore scripted needs --control velocity (the scripted pianist drives joint speeds)")
+        self.kind, self.size, self.rng = kind, action_size, rng
+        self.pianist = ScriptedPianist(config) if kind == "scripted" else None
+        self.previous: np.ndarray | None = None
+
+    def reset(self) -> None:
+        self.previous = None
+        if self.pianist is not None:
+            self.pianist.reset()
+
+    def act(self, observation: dict) -> np.ndarray:
+        if self.kind == "scripted":
+            action = self.pianist.act(observation) + self.rng.normal(0.0, SCRIPTED_NOISE, self.size)
+            return np.clip(action, -1.0, 1.0).astype(np.float32)
+        action = self.rng.uniform(-1.0, 1.0, self.size).astype(np.float32)
+        if self.kind in ("repeat", "prior") and self.previous is not None and self.rng.random() < REPEAT_PROBABILITY:
+            action = self.previous.copy()
+        if self.kind == "prior" and self.rng.random() >= WRIST_MOVE_PROBABILITY:
+            action[-1] = 0.0  # the wrist stays where it is
+        self.previous = action
+        return action

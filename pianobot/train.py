@@ -1,0 +1,332 @@
+"""Training: one SAC policy per phrase (or per task family), with evaluation, checkpoints and resume.
+
+:func:`train_policy` is the loop, to be read top to bottom: explore, then act with the policy
+and learn from the replay buffer at ``update_ratio`` gradient steps per environment step;
+evaluate every ``eval_every`` steps; at the first episode end after every
+``checkpoint_every`` steps, write a checkpoint that holds everything (networks, optimisers,
+buffer, random generators), so that running the same command again continues exactly where an
+interrupted run stopped. :func:`train_piece` does the plumbing for a whole piece: phrases,
+skipping what is already trained, parallel workers.
+"""
+
+from __future__ import annotations
+
+import time
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import asdict, dataclass, field, replace
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+import torch
+
+from pianobot import store
+from pianobot.agent.buffer import ReplayBuffer
+from pianobot.agent.sac import SAC, SACConfig, score_size, split_observation, vector_size
+from pianobot.env import EnvConfig, PianoEnv
+from pianobot.errors import PianobotError
+from pianobot.explore import Explorer
+from pianobot.metrics import compare
+from pianobot.music.phrases import Phrase
+from pianobot.music.piece import Piece
+from pianobot.music.tasks import make_task
+from pianobot.sim.recorder import NoteRecorder
+
+EVAL_SEED = 10_000
+"""Evaluation episodes use seeds EVAL_SEED, EVAL_SEED + 1, ...: the same hand starts for every evaluation."""
+
+
+@dataclass(frozen=True)
+class TrainConfig:
+    """One training run of one policy. Its hash (with the phrase's) names the model folder."""
+
+    steps: int = 50_000
+    """Environment steps, exploration included."""
+    seed: int = 0
+    explore: str = "prior"
+    """'uniform', 'repeat', 'prior' (the paper's best) or 'scripted' (ours)."""
+    eval_every: int = 5_000
+    eval_episodes: int = 3
+    checkpoint_every: int = 5_000
+    sac: SACConfig = field(default_factory=SACConfig)
+    env: EnvConfig = field(default_factory=EnvConfig)
+
+
+@dataclass
+class Progress:
+    """What the loop reports to whoever displays it."""
+
+    step: int
+    steps: int
+    episode_return: float | None = None
+    eval_f1: float | None = None
+    losses: dict | None = None
+
+
+def _env_config(config: TrainConfig) -> EnvConfig:
+    """The environment as the agent sees it: tactile images at the agent's resolution."""
+    return replace(config.env, tactile_pool=config.sac.tactile_resolution)
+
+
+def make_agent(env: PianoEnv, config: TrainConfig) -> SAC:
+    space = env.observation_space
+    tactile = space["tactile"].shape if "tactile" in space.spaces else None
+    return SAC(vector_size(space), score_size(space), tactile, env.action_space.shape[0], config.sac)
+
+
+def make_env(target: Piece | str, env_config: EnvConfig) -> PianoEnv:
+    return PianoEnv(task=target, config=env_config) if isinstance(target, str) else PianoEnv(piece=target, config=env_config)
+
+
+def evaluate(agent: SAC, target: Piece | str, env_config: EnvConfig, episodes: int) -> dict:
+    """Deterministic policy on fixed hand starts: mean note F1, velocity error and return."""
+    env = make_env(target, env_config)
+    f1s, errors, returns = [], [], []
+    for i in range(episodes):
+        observation, info = env.reset(seed=EVAL_SEED + i)
+        recorder, total = NoteRecorder(), 0.0
+        while True:
+            observation, reward, terminated, truncated, step_info = env.step(agent.act(*split_observation(observation), deterministic=True))
+            recorder.add(step_info["events"], step_info["fingers"])
+            total += reward
+            if terminated or truncated:
+                break
+        report = compare(info["piece"], recorder.piece(end=env.world.time, start=env.score_start))
+        f1s.append(report.f1)
+        returns.append(total)
+        if report.velocity_mae is not None:
+            errors.append(report.velocity_mae)
+    env.close()
+    return {
+        "f1": float(np.mean(f1s)),
+        "velocity_mae": float(np.mean(errors)) if errors else None,
+        "return": float(np.mean(returns)),
+    }
+
+
+def train_policy(
+    target: Piece | str,
+    config: TrainConfig,
+    folder: Path,
+    report: Callable[[Progress], None] = lambda p: None,
+    stop_after: int | None = None,
+    about: dict | None = None,
+) -> dict:
+    """Train one policy for a phrase (a Piece) or a task family (its name); store it in ``folder``.
+
+    ``stop_after`` ends the run after that many steps as an interruption would (tests);
+    ``about`` goes into the manifest (piece, phrase hash, ...).
+    """
+    torch.manual_seed(config.seed)  # before the networks are made: their first weights come from it
+    env_config = _env_config(config)
+    env = make_env(target, env_config)
+    agent = make_agent(env, config)
+    space = env.observation_space
+    tactile_shape = space["tactile"].shape if "tactile" in space.spaces else None
+    buffer = ReplayBuffer(min(config.sac.buffer_size, config.steps), vector_size(space), tactile_shape, env.action_space.shape[0])
+    rng = np.random.default_rng(config.seed)
+    explorer = Explorer(config.explore, env.action_space.shape[0], env_config, rng)
+    step, episode, update_debt, evaluations = 0, 0, 0.0, []
+
+    checkpoint = store.load_checkpoint(folder)
+    if checkpoint is not None:  # continue an interrupted run exactly
+        tensors, state, buffer_folder = checkpoint
+        agent.load_tensors(tensors)
+        torch.set_rng_state(tensors["torch_rng"])
+        buffer.load(buffer_folder, state["buffer_size"], state["buffer_cursor"])
+        rng.bit_generator.state = state["rng"]
+        step, episode, update_debt, evaluations = state["step"], state["episode"], state["update_debt"], state["evaluations"]
+        agent.updates = state["updates"]
+        env.reset(seed=config.seed)  # creates the env's generator, then restore its state
+        env.np_random.bit_generator.state = state["env_rng"]
+        observation, _ = env.reset()
+    else:
+        observation, _ = env.reset(seed=config.seed)
+    explorer.reset()
+    next_eval = (step // config.eval_every + 1) * config.eval_every
+    next_checkpoint = (step // config.checkpoint_every + 1) * config.checkpoint_every
+    episode_return, losses = 0.0, None
+    started = time.perf_counter()
+
+    while step < config.steps:
+        vector, tactile = split_observation(observation)
+        if step < config.sac.exploration_steps:
+            action = explorer.act(observation)
+        else:
+            action = agent.act(vector, tactile)
+        observation, reward, terminated, truncated, _ = env.step(action)
+        next_vector, next_tactile = split_observation(observation)
+        buffer.add(vector, tactile, action, reward, terminated, next_vector, next_tactile)
+        episode_return += reward
+        step += 1
+
+        if step > config.sac.exploration_steps:  # learn
+            update_debt += config.sac.update_ratio
+            while update_debt >= 1.0:
+                losses = agent.update(buffer.sample(config.sac.batch_size, rng))
+                update_debt -= 1.0
+
+        if terminated or truncated:
+            episode += 1
+            report(Progress(step, config.steps, episode_return=episode_return, losses=losses))
+            episode_return = 0.0
+            if step >= next_eval and step > config.sac.exploration_steps:
+                figures = evaluate(agent, target, env_config, config.eval_episodes)
+                evaluations.append({"step": step, **figures})
+                report(Progress(step, config.steps, eval_f1=figures["f1"]))
+                next_eval = (step // config.eval_every + 1) * config.eval_every
+            if step >= next_checkpoint and step < config.steps:
+                state = {
+                    "step": step, "episode": episode, "update_debt": update_debt, "updates": agent.updates,
+                    "evaluations": evaluations, "rng": rng.bit_generator.state, "env_rng": env.np_random.bit_generator.state,
+                    "buffer_size": buffer.size, "buffer_cursor": buffer.cursor,
+                }
+                store.save_checkpoint(folder, {**agent.tensors(), "torch_rng": torch.get_rng_state()}, state, buffer)
+                next_checkpoint = (step // config.checkpoint_every + 1) * config.checkpoint_every
+            if stop_after is not None and step >= stop_after:
+                env.close()
+                return {"interrupted_at": step}
+            observation, _ = env.reset()
+            explorer.reset()
+        elif step % 200 == 0:
+            report(Progress(step, config.steps))
+    env.close()
+
+    final = evaluate(agent, target, env_config, config.eval_episodes)
+    evaluations.append({"step": step, **final})
+    manifest = {
+        **(about or {}),
+        "target": target if isinstance(target, str) else [asdict(n) for n in target.notes],
+        "steps": step,
+        "updates": agent.updates,
+        "seconds": round(time.perf_counter() - started, 1),
+        "evaluation": final,
+        "evaluations": evaluations,
+        "config": asdict(config),
+    }
+    store.save_policy(folder, agent.tensors(with_training_state=False), manifest)
+    store.drop_checkpoint(folder)
+    return manifest
+
+
+# -- a whole piece -----------------------------------------------------------------------------
+def phrase_target(phrase: Phrase) -> Piece:
+    """A phrase as the piece its policy learns: its first note at time 0."""
+    return phrase.piece(lead_in=0.0)
+
+
+def load_policy(folder: Path, config: TrainConfig, env: PianoEnv) -> SAC:
+    agent = make_agent(env, config)
+    tensors = store.load_tensors(folder / store.POLICY_FILE)
+    try:
+        agent.load_tensors(tensors, with_training_state=False)
+    except (RuntimeError, KeyError) as e:
+        raise PianobotError(f"{folder / store.POLICY_FILE} does not fit this configuration ({str(e).splitlines()[0]}): retrain with --force") from None
+    return agent
+
+
+def config_from_manifest(manifest: dict) -> TrainConfig:
+    """Rebuild the TrainConfig a stored policy was trained with."""
+    from pianobot.music.instrument import HandSpec, KeyboardSpec
+    from pianobot.rewards import RewardConfig
+    from pianobot.sim.hand import FingerGeometry, HandConfig
+    from pianobot.sim.keyboard import KeyboardConfig, KeyGeometry, VelocityCurve
+    from pianobot.sim.tactile import TactileConfig
+    from pianobot.sim.world import WorldConfig
+
+    try:
+        c = manifest["config"]
+        e, w = c["env"], c["env"]["world"]
+        kb, hd = w["keyboard"], w["hand"]
+        keyboard = KeyboardConfig(
+            spec=KeyboardSpec(**kb["spec"]), geometry=KeyGeometry(**kb["geometry"]), curve=VelocityCurve(**kb["curve"]),
+            **{k: v for k, v in kb.items() if k not in ("spec", "geometry", "curve")},
+        )
+        geometry = FingerGeometry(**{**hd["geometry"], "flexion_limits": tuple(map(tuple, hd["geometry"]["flexion_limits"]))})
+        hand = HandConfig(spec=HandSpec(tuple(hd["spec"]["fingers"])), geometry=geometry,
+                          **{k: v for k, v in hd.items() if k not in ("spec", "geometry")})
+        world = WorldConfig(keyboard=keyboard, hand=hand, **{k: v for k, v in w.items() if k not in ("keyboard", "hand")})
+        pool = tuple(e["tactile_pool"]) if e["tactile_pool"] is not None else None
+        env = EnvConfig(world=world, reward=RewardConfig(**e["reward"]), tactile_sensor=TactileConfig(**e["tactile_sensor"]),
+                        tactile_pool=pool, **{k: v for k, v in e.items() if k not in ("world", "reward", "tactile_sensor", "tactile_pool")})
+        s = c["sac"]
+        sac = SACConfig(**{**s, "tactile_resolution": tuple(s["tactile_resolution"]) if s["tactile_resolution"] else None,
+                           "log_std_bounds": tuple(s["log_std_bounds"])})
+        return TrainConfig(sac=sac, env=env, **{k: v for k, v in c.items() if k not in ("sac", "env")})
+    except (KeyError, TypeError, ValueError) as e:
+        raise PianobotError(f"model manifest does not describe a pianobot configuration ({e!r}): retrain with --force") from None
+
+
+@dataclass
+class PhraseJob:
+    """One policy to train: a phrase (by content hash) or a task family, and the phrases that use it."""
+
+    key: str
+    target: Piece | str
+    folder: Path
+    phrases: list[int]
+    piece: str = ""
+
+    def about(self) -> dict:
+        return {"key": self.key, "piece": self.piece, "phrases": self.phrases}
+
+
+def _run_job(job: PhraseJob, config: TrainConfig, queue=None, threads: int | None = None) -> dict:
+    if threads is not None:
+        torch.set_num_threads(threads)
+
+    def report(progress: Progress) -> None:
+        if queue is not None:
+            queue.put((job.key, progress))
+
+    return train_policy(job.target, config, job.folder, report, about=job.about())
+
+
+def plan_jobs(phrases: list[Phrase], config: TrainConfig, root: Path, force: bool, piece: str = "") -> tuple[list[PhraseJob], list[PhraseJob]]:
+    """(jobs to train, jobs already trained): identical phrases share one job."""
+    by_hash: dict[str, PhraseJob] = {}
+    for phrase in phrases:
+        if phrase.hash in by_hash:
+            by_hash[phrase.hash].phrases.append(phrase.index)
+        else:
+            folder = store.model_dir(root, phrase.hash, config)
+            by_hash[phrase.hash] = PhraseJob(phrase.hash, phrase_target(phrase), folder, [phrase.index], piece)
+    todo, done = [], []
+    for job in by_hash.values():
+        if store.is_trained(job.folder) and not force:
+            done.append(job)
+        else:
+            if force and job.folder.exists():
+                for name in (store.POLICY_FILE, store.MANIFEST_FILE):
+                    (job.folder / name).unlink(missing_ok=True)
+            todo.append(job)
+    return todo, done
+
+
+def run_jobs(jobs: list[PhraseJob], config: TrainConfig, workers: int, on_progress: Callable[[str, Progress], None]) -> dict[str, dict]:
+    """Train every job, ``workers`` at a time in separate processes (1: in this process)."""
+    results: dict[str, dict] = {}
+    if workers <= 1 or len(jobs) <= 1:
+        for job in jobs:
+            results[job.key] = train_policy(job.target, config, job.folder, lambda p, key=job.key: on_progress(key, p), about=job.about())
+        return results
+    import multiprocessing
+
+    manager = multiprocessing.Manager()
+    queue = manager.Queue()
+    with ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn")) as pool:
+        futures = {pool.submit(_run_job, job, config, queue, 1): job for job in jobs}
+        pending = set(futures)
+        while pending:
+            while not queue.empty():
+                key, progress = queue.get()
+                on_progress(key, progress)
+            finished = {f for f in pending if f.done()}
+            for future in finished:
+                results[futures[future].key] = future.result()
+            pending -= finished
+            time.sleep(0.2)
+        while not queue.empty():
+            key, progress = queue.get()
+            on_progress(key, progress)
+    return results

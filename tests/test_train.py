@@ -1,0 +1,132 @@
+"""Training: real gradient updates with finite losses, save/load, exact resume, skip-if-trained."""
+
+import json
+from dataclasses import replace
+
+import numpy as np
+import pytest
+import torch
+
+from pianobot import store
+from pianobot.agent.sac import SACConfig
+from pianobot.env import EnvConfig
+from pianobot.errors import PianobotError
+from pianobot.explore import Explorer
+from pianobot.music.phrases import split_phrases
+from pianobot.music.piece import Note, Piece
+from pianobot.train import Progress, TrainConfig, load_policy, make_env, plan_jobs, train_policy
+
+PHRASE = Piece((Note(0.0, 64, 0.5, 80, 3),), bpm=60)  # a one-note phrase: 35 steps an episode
+
+
+def small(**changes) -> TrainConfig:
+    sac = SACConfig(exploration_steps=60, batch_size=32, buffer_size=1000, hidden=32, score_features=16)
+    config = TrainConfig(steps=200, eval_every=10_000, eval_episodes=1, checkpoint_every=70, sac=sac,
+                         env=EnvConfig(tactile=True))
+    return replace(config, **changes)
+
+
+def test_training_runs_real_updates_with_finite_losses(tmp_path):
+    seen: list[Progress] = []
+    manifest = train_policy(PHRASE, small(), tmp_path / "m", seen.append, about={"key": "k", "piece": "p"})
+    assert manifest["steps"] == 200 and manifest["updates"] == 140  # one update per step after exploration
+    losses = [p.losses for p in seen if p.losses]
+    assert losses and all(np.isfinite(v) for l in losses for v in l.values())
+    assert 0.0 <= manifest["evaluation"]["f1"] <= 1.0 and manifest["key"] == "k"
+    assert store.is_trained(tmp_path / "m") and not (tmp_path / "m" / store.CHECKPOINT_DIR).exists()
+    stored = json.loads((tmp_path / "m" / store.MANIFEST_FILE).read_text())
+    assert stored["format"] == store.FORMAT and "torch" in stored["versions"] and stored["config"]["steps"] == 200
+
+
+def test_saved_policy_loads_and_acts_the_same(tmp_path):
+    config = small()
+    train_policy(PHRASE, config, tmp_path / "m")
+    env = make_env(PHRASE, replace(config.env, tactile_pool=config.sac.tactile_resolution))
+    observation, _ = env.reset(seed=0)
+    from pianobot.agent.sac import split_observation
+
+    first = load_policy(tmp_path / "m", config, env).act(*split_observation(observation), deterministic=True)
+    second = load_policy(tmp_path / "m", config, env).act(*split_observation(observation), deterministic=True)
+    assert first.shape == (13,) and np.array_equal(first, second)
+    tensors = store.load_tensors(tmp_path / "m" / store.POLICY_FILE)
+    assert not any(k.startswith(("critic.", "target.", "optim.")) for k in tensors)  # only what acting needs
+
+
+def test_interrupted_training_resumes_to_the_same_state(tmp_path):
+    torch.set_num_threads(1)
+    config = small()
+    straight = tmp_path / "straight"
+    train_policy(PHRASE, config, straight)
+    resumed = tmp_path / "resumed"
+    assert train_policy(PHRASE, config, resumed, stop_after=100) == {"interrupted_at": 105}
+    assert (resumed / store.CHECKPOINT_DIR / "state.json").exists() and not store.is_trained(resumed)
+    train_policy(PHRASE, config, resumed)
+    a = store.load_tensors(straight / store.POLICY_FILE)
+    b = store.load_tensors(resumed / store.POLICY_FILE)
+    assert a.keys() == b.keys() and all(torch.equal(a[k], b[k]) for k in a)
+    assert json.loads((straight / "manifest.json").read_text())["evaluation"] == json.loads((resumed / "manifest.json").read_text())["evaluation"]
+
+
+def test_skip_if_trained_and_identical_phrases_share_a_policy(tmp_path):
+    config = small()
+    repeated = Piece(PHRASE.notes + PHRASE.shift(2.0).notes + (Note(4.0, 67, 4.5, 90, 4),), bpm=60)
+    phrases = split_phrases(repeated, 1)
+    todo, done = plan_jobs(phrases, config, tmp_path, force=False)
+    assert [j.phrases for j in todo] == [[0, 1], [2]] and done == []
+    train_policy(todo[0].target, config, todo[0].folder)
+    todo, done = plan_jobs(phrases, config, tmp_path, force=False)
+    assert [j.phrases for j in done] == [[0, 1]] and [j.phrases for j in todo] == [[2]]
+    todo, done = plan_jobs(phrases, config, tmp_path, force=True)
+    assert len(todo) == 2 and done == []
+    other = plan_jobs(phrases, replace(config, seed=1), tmp_path, force=False)[0]
+    assert len(other) == 2  # another configuration is another model
+
+
+def test_corrupt_and_foreign_model_files_are_clear_errors(tmp_path):
+    folder = tmp_path / "m"
+    folder.mkdir()
+    (folder / store.POLICY_FILE).write_bytes(b"not safetensors")
+    with pytest.raises(PianobotError, match="not a readable safetensors"):
+        store.load_tensors(folder / store.POLICY_FILE)
+    with pytest.raises(PianobotError, match="holds no manifest.json"):
+        store.read_manifest(folder)
+    (folder / store.MANIFEST_FILE).write_text('{"weights": [1, 2]}')
+    with pytest.raises(PianobotError, match="not a pianobot model manifest"):
+        store.read_manifest(folder)
+    (folder / store.MANIFEST_FILE).write_text("{oops")
+    with pytest.raises(PianobotError, match="not a readable manifest"):
+        store.read_manifest(folder)
+
+
+def test_policy_of_another_shape_is_refused(tmp_path):
+    config = small()
+    train_policy(PHRASE, config, tmp_path / "m")
+    bigger = replace(config, sac=replace(config.sac, hidden=64))
+    env = make_env(PHRASE, replace(config.env, tactile_pool=config.sac.tactile_resolution))
+    with pytest.raises(PianobotError, match="does not fit this configuration"):
+        load_policy(tmp_path / "m", bigger, env)
+
+
+@pytest.mark.parametrize("kind", ["uniform", "repeat", "prior", "scripted"])
+def test_exploration_strategies(kind):
+    env = make_env(PHRASE, EnvConfig(tactile=False))
+    observation, _ = env.reset(seed=0)
+    explorer = Explorer(kind, 13, env.config, np.random.default_rng(0))
+    actions = []
+    for _ in range(300):
+        action = explorer.act(observation)
+        actions.append(action)
+        observation, _, _, truncated, _ = env.step(action)
+        if truncated:
+            observation, _ = env.reset()
+            explorer.reset()
+    actions = np.array(actions)
+    assert np.abs(actions).max() <= 1.0
+    repeats = np.mean([np.array_equal(a[:-1], b[:-1]) for a, b in zip(actions, actions[1:])])
+    wrist_moves = np.mean(actions[:, -1] != 0)
+    if kind == "uniform":
+        assert repeats == 0 and wrist_moves == 1
+    if kind == "repeat":
+        assert 0.7 < repeats < 0.9
+    if kind == "prior":
+        assert 0.7 < repeats < 0.9 and wrist_moves < 0.2
