@@ -225,6 +225,7 @@ def train(
     steps: int = typer.Option(TrainConfig.steps, "--steps", help="Environment steps per phrase, exploration included."),
     seed: int = typer.Option(TrainConfig.seed, "--seed", help="Seed of the simulation, the exploration and the networks."),
     workers: int = typer.Option(1, "--workers", help="Train this many phrases at once, in separate processes."),
+    threads: int = typer.Option(1, "--threads", help="Torch threads per training process (workers x threads should not exceed the cores)."),
     control: str = typer.Option(WorldConfig.control, "--control", help="Finger control: velocity or torque."),
     reward: str = typer.Option(RewardConfig.kind, "--reward", help="Reward: linear, squared or wasserstein."),
     explore: str = typer.Option(TrainConfig.explore, "--explore", help=f"Exploration before learning: {', '.join(EXPLORATIONS)}."),
@@ -257,8 +258,8 @@ def train(
         raise PianobotError("--explore scripted needs --control velocity (the scripted pianist drives joint speeds)")
     if not 0 <= exploration_steps < steps:
         raise PianobotError(f"--steps {steps} must exceed --exploration-steps {exploration_steps}, or nothing is learnt")
-    if workers < 1:
-        raise PianobotError(f"--workers {workers}: give 1 or more")
+    if workers < 1 or threads < 1:
+        raise PianobotError(f"--workers {workers} --threads {threads}: give 1 or more of each")
     if models.exists() and not models.is_dir():
         raise PianobotError(f"--models {models} is a file: give a folder")
     keyboard, hand = make_instrument(lowest_note, keys, thumb)
@@ -296,7 +297,7 @@ def train(
                 status = f"return {returns[key]:.1f}" + (f" | {status.split(' | ')[-1]}" if "eval" in status else "")
             bar.update(rows[key], completed=progress.step, status=status)
 
-        results = run_jobs(todo, config, workers, on_progress)
+        results = run_jobs(todo, config, workers, on_progress, threads=threads)
     table = display.training_table([(job, results.get(job.key) or store.read_manifest(job.folder)) for job in done + todo])
     out.print(table)
 

@@ -303,10 +303,14 @@ def plan_jobs(phrases: list[Phrase], config: TrainConfig, root: Path, force: boo
     return todo, done
 
 
-def run_jobs(jobs: list[PhraseJob], config: TrainConfig, workers: int, on_progress: Callable[[str, Progress], None]) -> dict[str, dict]:
-    """Train every job, ``workers`` at a time in separate processes (1: in this process)."""
+def run_jobs(
+    jobs: list[PhraseJob], config: TrainConfig, workers: int, on_progress: Callable[[str, Progress], None], threads: int = 1
+) -> dict[str, dict]:
+    """Train every job, ``workers`` at a time in separate processes (1: in this process), each with
+    ``threads`` torch threads (more threads than cores makes torch's thread pools spin against each other)."""
     results: dict[str, dict] = {}
     if workers <= 1 or len(jobs) <= 1:
+        torch.set_num_threads(threads)
         for job in jobs:
             results[job.key] = train_policy(job.target, config, job.folder, lambda p, key=job.key: on_progress(key, p), about=job.about())
         return results
@@ -315,7 +319,7 @@ def run_jobs(jobs: list[PhraseJob], config: TrainConfig, workers: int, on_progre
     manager = multiprocessing.Manager()
     queue = manager.Queue()
     with ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn")) as pool:
-        futures = {pool.submit(_run_job, job, config, queue, 1): job for job in jobs}
+        futures = {pool.submit(_run_job, job, config, queue, threads): job for job in jobs}
         pending = set(futures)
         while pending:
             while not queue.empty():

@@ -59,3 +59,15 @@ def off(note, channel=0):
 
 def lyric(text):
     return mido.MetaMessage("lyrics", text=text)
+
+
+@pytest.fixture(autouse=True, scope="session")
+def one_torch_thread():
+    """Tests run beside other processes on 2 cores: torch's thread pool must not spin against them."""
+    try:
+        import torch
+    except ImportError:
+        yield
+        return
+    torch.set_num_threads(1)
+    yield

@@ -195,3 +195,31 @@ def test_play_random_controller(tmp_path):
     result = run("play", EXAMPLES / "one-note.mid", "-o", tmp_path / "r.mid", "--controller", "random", "--seed", "3")
     assert result.exit_code == 0, result.output
     assert json.loads((tmp_path / "r.report.json").read_text())["controller"] == "random"
+
+
+def test_train_bad_requests_answer_with_one_line(tmp_path):
+    song = EXAMPLES / "one-note.mid"
+    assert_one_line_error(run("train"), "--task")
+    assert_one_line_error(run("train", song, "--task", "one-note"), "not both")
+    assert_one_line_error(run("train", "--task", "sonata"), "--task sonata")
+    assert_one_line_error(run("train", song, "--steps", "100"), "--steps 100 must exceed --exploration-steps")
+    assert_one_line_error(run("train", song, "--control", "position"), "--control position")
+    assert_one_line_error(run("train", song, "--reward", "cubic"), "--reward cubic")
+    assert_one_line_error(run("train", song, "--explore", "wild"), "--explore wild")
+    assert_one_line_error(run("train", song, "--explore", "scripted", "--control", "torque"), "velocity")
+    (tmp_path / "file").write_text("x")
+    assert_one_line_error(run("train", song, "--models", tmp_path / "file"), "is a file")
+
+
+def test_train_then_skip(tmp_path):
+    args = ("train", EXAMPLES / "one-note.mid", "--steps", "80", "--exploration-steps", "40", "--no-tactile", "--models", tmp_path)
+    first = run(*args)
+    assert first.exit_code == 0, first.output
+    folders = [d for d in tmp_path.iterdir() if d.is_dir()]
+    assert len(folders) == 1 and (folders[0] / "policy.safetensors").exists()
+    manifest = json.loads((folders[0] / "manifest.json").read_text())
+    assert manifest["piece"] == "one-note.mid" and manifest["steps"] == 80 and manifest["config"]["env"]["tactile"] is False
+    second = run(*args)
+    assert second.exit_code == 0 and "already trained" in second.output and "training 0 policies" in second.output
+    third = run(*args, "--force")
+    assert "training 1 policy" in third.output

@@ -1,0 +1,93 @@
+"""SAC gradient updates per second: pianobot's agent against Stable-Baselines3's SAC, same run.
+
+    python benchmarks/sac.py [--repeats 5] [--updates 60] [--threads 1]
+
+Both learn on the same environment (examples/midi/three-note.mid, state only and with tactile
+images of 3 fingertips) with batch size 256, from a replay buffer filled by 1000 random steps.
+Each figure is the median of ``--repeats`` timings of ``--updates`` updates. Stable-Baselines3
+is a benchmark-only dependency (`pip install stable-baselines3`).
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import time
+from pathlib import Path
+
+import numpy as np
+import torch
+
+from pianobot.agent.buffer import ReplayBuffer
+from pianobot.agent.sac import SAC, SACConfig, score_size, split_observation, vector_size
+from pianobot.env import EnvConfig, PianoEnv
+from pianobot.music.load import load_piece
+
+ROOT = Path(__file__).resolve().parent.parent
+FILL = 1000
+
+
+def make_env(tactile: bool) -> PianoEnv:
+    return PianoEnv(piece=load_piece(ROOT / "examples" / "midi" / "three-note.mid"), config=EnvConfig(tactile=tactile))
+
+
+def ours(tactile: bool, updates: int, repeats: int) -> list[float]:
+    env = make_env(tactile)
+    space = env.observation_space
+    shape = space["tactile"].shape if tactile else None
+    agent = SAC(vector_size(space), score_size(space), shape, 13, SACConfig())
+    buffer = ReplayBuffer(FILL, vector_size(space), shape, 13)
+    rng = np.random.default_rng(0)
+    observation, _ = env.reset(seed=0)
+    for _ in range(FILL):
+        action = rng.uniform(-1, 1, 13).astype(np.float32)
+        vector, images = split_observation(observation)
+        observation, reward, terminated, truncated, _ = env.step(action)
+        buffer.add(vector, images, action, reward, terminated, *split_observation(observation))
+        if truncated:
+            observation, _ = env.reset()
+    for _ in range(5):
+        agent.update(buffer.sample(256, rng))
+    rates = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        for _ in range(updates):
+            agent.update(buffer.sample(256, rng))
+        rates.append(updates / (time.perf_counter() - start))
+    return rates
+
+
+def stable_baselines(tactile: bool, updates: int, repeats: int) -> list[float]:
+    from stable_baselines3 import SAC as SB3SAC
+
+    model = SB3SAC("MultiInputPolicy", make_env(tactile), batch_size=256, learning_starts=FILL, buffer_size=FILL + 10, device="cpu", seed=0)
+    model.learn(FILL)  # fills the buffer with random steps
+    model.train(gradient_steps=5, batch_size=256)
+    rates = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        model.train(gradient_steps=updates, batch_size=256)
+        rates.append(updates / (time.perf_counter() - start))
+    return rates
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--repeats", type=int, default=5)
+    parser.add_argument("--updates", type=int, default=60)
+    parser.add_argument("--threads", type=int, default=1, help="torch threads for both")
+    args = parser.parse_args()
+    torch.set_num_threads(args.threads)
+    print(f"torch {torch.__version__}, {args.threads} thread(s), batch 256, {args.updates} updates x {args.repeats} repeats\n")
+    print("| configuration | pianobot updates/s | Stable-Baselines3 updates/s | ratio |")
+    print("| --- | ---: | ---: | ---: |")
+    for tactile in (False, True):
+        mine = ours(tactile, args.updates, args.repeats)
+        theirs = stable_baselines(tactile, args.updates, args.repeats)
+        a, b = statistics.median(mine), statistics.median(theirs)
+        label = "tactile (3 fingertips, 15x20)" if tactile else "state only"
+        print(f"| {label} | {a:.1f} ({', '.join(f'{x:.1f}' for x in mine)}) | {b:.1f} ({', '.join(f'{x:.1f}' for x in theirs)}) | {a / b:.2f}x |")
+
+
+if __name__ == "__main__":
+    main()
