@@ -10,6 +10,7 @@ import functools
 import json
 import os
 import warnings
+from dataclasses import replace
 from pathlib import Path
 from typing import Optional
 
@@ -33,6 +34,7 @@ from pianobot.sim.world import CONTROL_MODES
 from pianobot.train import PhraseJob, TrainConfig, plan_jobs, run_jobs
 from pianobot.music.load import LoadOptions, load_piece, load_playable
 from pianobot.music.midi_io import write_midi
+from pianobot.compose import CompositionalController, missing_phrases, training_config
 from pianobot.perform import CONTROLLERS, perform, write_video
 from pianobot.sim.hand import HandConfig
 from pianobot.sim.keyboard import KeyboardConfig
@@ -170,7 +172,10 @@ def score(
 def play(
     song: Path = typer.Argument(..., help="The piece to play, a .mid file with fingering."),
     output: Path = typer.Option(..., "--output", "-o", help="Write what the simulated piano sounded to this .mid file."),
-    controller: str = typer.Option("scripted", "--controller", help="Who plays: 'scripted' (the hand-written pianist) or 'random'."),
+    controller: str = typer.Option("scripted", "--controller", help="Who plays: 'sac' (the trained phrase policies), 'scripted' (the hand-written pianist) or 'random'."),
+    models: Path = typer.Option(Path("models"), "--models", help="Folder of the model store (for --controller sac)."),
+    fallback: Optional[str] = typer.Option(None, "--fallback", help="'scripted': play phrases that have no trained policy with the scripted pianist."),
+    phrase_notes: int = PhraseNotes,
     seed: int = typer.Option(0, "--seed", help="Seed of the simulation (the hand's start position) and of the random controller."),
     video: Optional[Path] = typer.Option(None, "--video", help="Also record the performance to this .mp4 file."),
     gui: bool = typer.Option(False, "--gui", help="Show the simulation in a PyBullet window (needs a display)."),
@@ -197,19 +202,48 @@ def play(
         raise PianobotError("--gui needs a display (DISPLAY is not set): drop --gui, or use --video to watch it later")
     if controller not in CONTROLLERS:
         raise PianobotError(f"--controller {controller}: choose one of {', '.join(CONTROLLERS)}")
+    if fallback not in (None, "scripted"):
+        raise PianobotError(f"--fallback {fallback}: the only fallback is 'scripted'")
     keyboard, hand = make_instrument(lowest_note, keys, thumb)
     piece = load_playable(song, make_options(track, tempo, transpose, fingering), keyboard, hand)
-    if not piece.has_fingering and controller == "scripted":
+    if not piece.has_fingering and (controller == "scripted" or fallback):
         raise PianobotError(f"{song} has notes without fingering: the scripted pianist needs a finger for every note (see docs/fingering.md)")
     world = WorldConfig(keyboard=KeyboardConfig(spec=keyboard), hand=HandConfig(spec=hand), gui=gui)
     config = EnvConfig(world=world, tactile=False)
+    sources: dict = {}
+    who = controller
+    if controller == "sac":
+        phrases = split_phrases(piece, phrase_notes)
+        missing = missing_phrases(models, phrases)
+        if missing and not fallback:
+            first = missing[0]
+            raise PianobotError(
+                f"phrase {first.index} ({' '.join(n.name for n in first.notes)}) of {song.name} has no trained policy in {models}: "
+                f"train it with `pianobot train {song}` (same reading options), or add --fallback scripted"
+            )
+        trained = training_config(models, phrases)
+        if trained is not None:
+            config = replace(trained.env, tactile_pool=trained.sac.tactile_resolution, world=replace(trained.env.world, gui=gui))
+            if trained.env.world.keyboard.spec != keyboard or trained.env.world.hand.spec != hand:
+                raise PianobotError(f"the policies in {models} were trained for another keyboard or hand: use the same --lowest-note/--keys/--thumb")
+        if missing and config.world.control != "velocity":
+            raise PianobotError("--fallback scripted needs policies trained with --control velocity")
+
+        def who(env):
+            composed = CompositionalController(env, phrases, models, trained, fallback is not None)
+            sources.update({s.phrase.index: s.source for s in composed.sections})
+            return composed
     with Progress(TextColumn("{task.description}"), BarColumn(), TimeRemainingColumn(), console=err, transient=True) as bar:
         task = bar.add_task(f"playing {song.name}", total=None)
-        result = perform(piece, controller, config, seed=seed, video=video is not None,
+        result = perform(piece, who, config, seed=seed, video=video is not None,
                          on_step=lambda done, total: bar.update(task, completed=done, total=total))
     report = compare(piece, result.played)
     write_midi(result.played, output, name=f"pianobot {controller}: {song.stem}")
-    atomic_write(report_path, json.dumps({"controller": controller, "seed": seed, **report.to_dict()}, indent=2) + "\n")
+    extra = {"phrases": {str(k): v for k, v in sources.items()}} if sources else {}
+    atomic_write(report_path, json.dumps({"controller": controller, "seed": seed, **extra, **report.to_dict()}, indent=2) + "\n")
+    fallbacks = [k for k, v in sources.items() if "fallback" in v]
+    if fallbacks:
+        out.print(f"[yellow]phrases {', '.join(map(str, fallbacks))} had no trained policy and were played by the scripted pianist[/yellow]")
     display.print_all(out, display.report_tables(report))
     out.print(f"performance written to {output}, report to {report_path}")
     if video is not None:

@@ -322,9 +322,14 @@ class ScriptedPianist:
         return command
 
     def _low(self, q: np.ndarray) -> bool:
-        """True when the fingertip is lower than the white keys' top plus the clearance (it may touch a key)."""
-        _, drop = lowest_point_in_finger_plane(self.geometry, q[1:])
-        return self.hand.palm_height - drop < self.clearance
+        """True when the fingertip is over the keys and lower than their top plus the clearance (it may touch one).
+
+        A fingertip curled back beyond the keys' front, or below them, touches nothing the hand's
+        slide could drag: it does not hold the wrist (a policy may leave fingers like that)."""
+        reach, drop = lowest_point_in_finger_plane(self.geometry, q[1:])
+        over_keys = 0.0 <= self.hand.palm_y - reach * math.cos(q[0]) <= self.white_length
+        height = self.hand.palm_height - drop
+        return over_keys and -self.white_length * math.tan(self.strike_angle) * 2 < height < self.clearance
 
     def _tip_height(self, q: np.ndarray, key: int) -> float:
         """Height of the fingertip's lowest point over the key's top surface (m), from the joint angles."""

@@ -23,7 +23,7 @@ from pianobot.files import _umask
 from pianobot.music.piece import Piece
 from pianobot.sim.recorder import NoteRecorder
 
-CONTROLLERS = ("scripted", "random")
+CONTROLLERS = ("sac", "scripted", "random")
 
 
 class Controller(Protocol):
@@ -42,6 +42,7 @@ class Performance:
 
 
 def make_controller(name: str, env: PianoEnv, seed: int | None = None) -> Controller:
+    """The scripted or random controller (``sac`` needs the model store: see pianobot.compose)."""
     if name == "scripted":
         return ScriptedPianist(env.config)
     if name == "random":
@@ -51,16 +52,20 @@ def make_controller(name: str, env: PianoEnv, seed: int | None = None) -> Contro
 
 def perform(
     piece: Piece,
-    controller: str = "scripted",
+    controller: str | Callable[[PianoEnv], Controller] = "scripted",
     config: EnvConfig = EnvConfig(tactile=False),
     seed: int = 0,
     video: bool = False,
     on_step: Callable[[int, int], None] | None = None,
 ) -> Performance:
-    """Play ``piece`` from start to end with one controller; ``on_step(done, total)`` reports progress."""
+    """Play ``piece`` from start to end in one continuous simulation.
+
+    ``controller`` is 'scripted', 'random', or a function that makes a controller for the
+    environment (compositional execution passes one). ``on_step(done, total)`` reports progress.
+    """
     env = PianoEnv(piece=piece, config=config)
     try:
-        agent = make_controller(controller, env, seed)
+        agent = controller(env) if callable(controller) else make_controller(controller, env, seed)
         observation, _ = env.reset(seed=seed)
         agent.reset()
         recorder = NoteRecorder()

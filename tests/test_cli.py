@@ -223,3 +223,49 @@ def test_train_then_skip(tmp_path):
     assert second.exit_code == 0 and "already trained" in second.output and "training 0 policies" in second.output
     third = run(*args, "--force")
     assert "training 1 policy" in third.output
+
+
+def test_play_sac_without_policies_names_the_phrase_and_the_train_command(tmp_path):
+    result = run("play", EXAMPLES / "three-note.mid", "-o", tmp_path / "x.mid", "--controller", "sac", "--models", tmp_path)
+    assert_one_line_error(result, "phrase 0 (C4 D4 E4)", "pianobot train", "--fallback scripted")
+    assert not (tmp_path / "x.mid").exists()
+
+
+def test_play_sac_composes_trained_and_fallback_phrases(tmp_path):
+    """Phrase 0 has a (barely) trained policy, phrase 1 none: --fallback scripted plays it and says so."""
+    one = EXAMPLES / "one-note.mid"
+    trained = run("train", one, "--steps", "60", "--exploration-steps", "30", "--no-tactile", "--models", tmp_path / "models")
+    assert trained.exit_code == 0, trained.output
+    note = Piece((Note(0.0, 64, 1.0, 80, 3), Note(3.0, 67, 4.0, 70, 4)), bpm=60)  # phrase 0 = one-note.mid
+    song = write_midi(note, tmp_path / "song.mid")
+    args = ("play", song, "-o", tmp_path / "out.mid", "--controller", "sac", "--models", tmp_path / "models", "--phrase-notes", "1")
+    assert_one_line_error(run(*args), "phrase 1 (G4)")
+    result = run(*args, "--fallback", "scripted")
+    assert result.exit_code == 0, result.output
+    assert "phrases 1 had no trained policy" in result.output
+    report = json.loads((tmp_path / "out.report.json").read_text())
+    assert report["phrases"]["0"].startswith("policy ") and report["phrases"]["1"] == "scripted (fallback)"
+    played = [n for n in read_played(tmp_path / "out.mid") if n.pitch == 67 and n.onset >= 2.0]
+    assert played and played[0].finger == 4  # the scripted pianist took over and played phrase 1
+
+
+def read_played(path):
+    from pianobot.music.midi_io import read_midi
+
+    return read_midi(path).notes
+
+
+def test_sections_hand_over_after_the_last_strike():
+    from pianobot.compose import CompositionalController
+    from pianobot.env import EnvConfig, PianoEnv
+    from pianobot.music.phrases import split_phrases
+
+    piece = Piece((Note(0.0, 60, 0.5, 80, 2), Note(0.5, 62, 1.0, 80, 3), Note(1.0, 64, 1.5, 80, 4)), bpm=60)
+    phrases = split_phrases(piece, 1)
+    env = PianoEnv(piece=piece, config=EnvConfig(tactile=False))
+    composed = CompositionalController(env, phrases, Path("/nonexistent"), None, fallback=True)
+    firsts = [s.first_step for s in composed.sections]
+    assert firsts == [0, 21, 31]  # one step after the previous phrase's onset (lead-in 20 steps)
+    assert composed.section_at(20).phrase.index == 0 and composed.section_at(21).phrase.index == 1
+    window = composed.sections[1].score[30]
+    assert window[:, 0].nonzero()[0].tolist() == [2]  # phrase 1 sees only its own note (D4)

@@ -73,6 +73,7 @@ class PianoWorld:
         self.key_joints = list(range(len(self.boxes)))
         self.sensor = KeySensor(config.keyboard)
         self.time = 0.0
+        self._finger_command = np.zeros(4 * len(config.hand.spec.fingers))
         self._build()
         if config.gui:
             p.resetDebugVisualizerCamera(0.45, 180, -60, [self.width / 2, 0.11, 0], physicsClientId=self.client)
@@ -112,6 +113,9 @@ class PianoWorld:
         body = self._load_urdf(hand_urdf(hand, rail=(0.0, self.width)), [0, hand.palm_y, hand.palm_height])
         index = {p.getJointInfo(body, j, physicsClientId=c)[1].decode(): j for j in range(p.getNumJoints(body, physicsClientId=c))}
         fingers = [index[name] for name in joint_names(hand.spec)]
+        g = hand.geometry
+        per_finger = [(-g.abduction_limit, g.abduction_limit), *g.flexion_limits]
+        self.joint_limits = np.array([per_finger[i % 4] for i in range(len(fingers))]).T
         tips = {f: index[f"f{f}_dip"] for f in hand.spec.fingers}  # the DIP joint's child is the distal link
         for j in [index["wrist"], *fingers]:
             p.changeDynamics(body, j, linearDamping=0, angularDamping=0, physicsClientId=c)
@@ -131,6 +135,7 @@ class PianoWorld:
             p.resetJointState(self.hand, j, float(angle), 0.0, physicsClientId=c)
         self.sensor.reset()
         self.time = 0.0
+        self._finger_command = np.zeros(len(self.finger_joints))
         self._hold(finger_angles, wrist)
 
     def _hold(self, finger_angles: np.ndarray, wrist: float) -> None:
@@ -201,15 +206,10 @@ class PianoWorld:
         action = np.clip(action, -1.0, 1.0)
         fingers, wrist = action[:n], float(action[n])
         if cfg.control == "velocity":
-            p.setJointMotorControlArray(
-                self.hand, self.finger_joints, p.VELOCITY_CONTROL, targetVelocities=(fingers * hand.max_joint_speed).tolist(),
-                forces=[hand.joint_force] * n, physicsClientId=c,
-            )
+            self._finger_command = fingers * hand.max_joint_speed
         else:
+            self._finger_command = fingers * hand.max_joint_torque
             p.setJointMotorControlArray(self.hand, self.finger_joints, p.VELOCITY_CONTROL, forces=[0.0] * n, physicsClientId=c)
-            p.setJointMotorControlArray(
-                self.hand, self.finger_joints, p.TORQUE_CONTROL, forces=(fingers * hand.max_joint_torque).tolist(), physicsClientId=c
-            )
         if cfg.discrete_wrist:
             target = self.discrete_wrist_position(wrist)
             p.setJointMotorControl2(self.hand, self.wrist_joint, p.POSITION_CONTROL, targetPosition=target,
@@ -217,6 +217,27 @@ class PianoWorld:
         else:
             p.setJointMotorControl2(self.hand, self.wrist_joint, p.VELOCITY_CONTROL, targetVelocity=wrist * hand.max_wrist_speed,
                                     force=hand.wrist_force, physicsClientId=c)
+
+    def _drive_fingers(self, torque: bool) -> None:
+        """Apply the finger command for one physics step, never driving a joint past its limit.
+
+        PyBullet's joint limits are soft: a finger motor at full speed pushes the light finger
+        links far past them (we saw the PIP joint at -1.5 rad against a limit of -0.17). So the
+        commanded speed is clipped to what reaches the limit within one physics step, and a
+        torque that pushes further out is dropped (a joint already beyond is pushed back)."""
+        c, hand = self.client, self.config.hand
+        q = np.array([s[0] for s in p.getJointStates(self.hand, self.finger_joints, physicsClientId=c)])
+        low, high = self.joint_limits
+        if not torque:
+            speed = np.clip(self._finger_command, (low - q) / self.dt, (high - q) / self.dt)
+            p.setJointMotorControlArray(self.hand, self.finger_joints, p.VELOCITY_CONTROL, targetVelocities=speed.tolist(),
+                                        forces=[hand.joint_force] * len(q), physicsClientId=c)
+            return
+        tau = self._finger_command.copy()
+        tau = np.where((q >= high) & (tau > 0), 0.0, tau)
+        tau = np.where((q <= low) & (tau < 0), 0.0, tau)
+        tau = np.where(q > high, -hand.max_joint_torque, np.where(q < low, hand.max_joint_torque, tau))
+        p.setJointMotorControlArray(self.hand, self.finger_joints, p.TORQUE_CONTROL, forces=tau.tolist(), physicsClientId=c)
 
     def discrete_wrist_position(self, action: float) -> float:
         """The white-key position that a wrist action in [-1, 1] selects."""
@@ -233,8 +254,7 @@ class PianoWorld:
         pressed_velocity = self.sensor.velocity.copy()
         torque = self.config.control == "torque"
         for _ in range(self.config.substeps):
-            if torque:
-                self._apply_action(action)
+            self._drive_fingers(torque)
             p.stepSimulation(physicsClientId=self.client)
             self.time += self.dt
             angles, speeds = self.key_state()

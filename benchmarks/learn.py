@@ -1,0 +1,94 @@
+"""Learning curves: evaluation note F1 against environment steps, per task and seed.
+
+    python benchmarks/learn.py --tasks one-note three-note --seeds 0 1 2 --steps 100000 \
+        [--explore prior] [--no-tactile] [--workers 2] [--plot docs/learning.png] [--store /tmp/learn]
+
+Trains with `pianobot.train.train_policy` (checkpointed: rerunning the same command resumes),
+evaluating every ``--eval-every`` steps on fixed hand starts. Prints a Markdown table of the
+final figures and the wall-clock time per policy, and draws the curves.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import replace
+from pathlib import Path
+
+from pianobot import store
+from pianobot.agent.sac import SACConfig
+from pianobot.env import EnvConfig
+from pianobot.train import TrainConfig, train_policy
+
+
+def run(task: str, seed: int, args) -> tuple[str, int, dict]:
+    import torch
+
+    torch.set_num_threads(1)
+    config = TrainConfig(
+        steps=args.steps, seed=seed, explore=args.explore, eval_every=args.eval_every, eval_episodes=args.eval_episodes,
+        checkpoint_every=args.eval_every, sac=SACConfig(exploration_steps=args.exploration_steps),
+        env=EnvConfig(tactile=args.tactile),
+    )
+    folder = store.model_dir(Path(args.store), f"task-{task}-seed{seed}", config)
+    if store.is_trained(folder):
+        return task, seed, store.read_manifest(folder)
+    return task, seed, train_policy(task, config, folder, about={"key": f"task-{task}", "piece": f"task {task}"})
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--tasks", nargs="+", default=["one-note", "three-note"])
+    parser.add_argument("--seeds", nargs="+", type=int, default=[0, 1, 2])
+    parser.add_argument("--steps", type=int, default=100_000)
+    parser.add_argument("--exploration-steps", type=int, default=SACConfig.exploration_steps)
+    parser.add_argument("--eval-every", type=int, default=5_000)
+    parser.add_argument("--eval-episodes", type=int, default=5)
+    parser.add_argument("--explore", default=TrainConfig.explore)
+    parser.add_argument("--tactile", action=argparse.BooleanOptionalAction, default=True)
+    parser.add_argument("--workers", type=int, default=1)
+    parser.add_argument("--store", default="/tmp/pianobot-learn")
+    parser.add_argument("--plot", default=None)
+    args = parser.parse_args()
+
+    jobs = [(task, seed) for task in args.tasks for seed in args.seeds]
+    with ProcessPoolExecutor(max_workers=args.workers) as pool:
+        results = list(pool.map(run, *zip(*jobs), [args] * len(jobs)))
+
+    print(f"steps {args.steps}, exploration {args.explore} for {args.exploration_steps} steps, tactile {args.tactile}\n")
+    print("| task | seed | final note F1 | velocity MAE | best F1 (step) | minutes |")
+    print("| --- | ---: | ---: | ---: | --- | ---: |")
+    for task, seed, manifest in results:
+        final = manifest["evaluation"]
+        best = max(manifest["evaluations"], key=lambda e: e["f1"])
+        mae = "n/a" if final["velocity_mae"] is None else f"{final['velocity_mae']:.1f}"
+        print(f"| {task} | {seed} | {final['f1']:.3f} | {mae} | {best['f1']:.3f} ({best['step']}) | {manifest['seconds'] / 60:.1f} |")
+
+    if args.plot:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+
+        fig, ax = plt.subplots(figsize=(7, 4))
+        colours = dict(zip(args.tasks, plt.rcParams["axes.prop_cycle"].by_key()["color"]))
+        for task, seed, manifest in results:
+            points = manifest["evaluations"]
+            ax.plot([p["step"] for p in points], [p["f1"] for p in points], color=colours[task], alpha=0.8,
+                    label=task if seed == args.seeds[0] else None)
+        ax.axhline(0.9, color="grey", linestyle=":", linewidth=1)
+        ax.set_xlabel("environment steps")
+        ax.set_ylabel("evaluation note F1")
+        ax.set_ylim(-0.02, 1.02)
+        ax.legend()
+        ax.set_title(f"SAC, exploration '{args.explore}', tactile {'on' if args.tactile else 'off'}")
+        fig.tight_layout()
+        fig.savefig(args.plot, dpi=100)
+        print(f"\nplot: {args.plot}")
+    Path(args.store).mkdir(parents=True, exist_ok=True)
+    (Path(args.store) / "results.json").write_text(json.dumps([{"task": t, "seed": s, **m} for t, s, m in results], default=str))
+
+
+if __name__ == "__main__":
+    main()

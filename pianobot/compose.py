@@ -1,0 +1,114 @@
+"""Compositional execution (paper, "Compositional Execution for long-horizon task"): a whole piece
+played by the policies of its phrases, one after another, in one continuous simulation.
+
+Each phrase's policy was trained on its phrase alone, seeing a sliding score window of only that
+phrase's notes. During the performance the active policy sees the same thing: the window at the
+current time, masked to its own phrase. Control passes from phrase k-1 to phrase k one step after
+phrase k-1 struck its last note, or one lead-in before phrase k's first note, whichever is later;
+the hand is wherever the previous policy left it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from pianobot import store
+from pianobot.controllers import ScriptedPianist
+from pianobot.env import PianoEnv
+from pianobot.errors import PianobotError
+from pianobot.music.phrases import Phrase
+from pianobot.music.tensor import score_tensor
+from pianobot.train import TrainConfig, config_from_manifest, load_policy, phrase_target
+
+
+@dataclass
+class Section:
+    """One phrase's stretch of the performance."""
+
+    phrase: Phrase
+    first_step: int
+    """Env step at which this phrase's controller takes over."""
+    score: np.ndarray
+    """The whole performance's score timeline with only this phrase's notes."""
+    controller: object
+    source: str
+    """'policy <folder name>' or 'scripted (fallback)'."""
+
+
+def find_policy(models: Path, phrase: Phrase) -> Path | None:
+    found = store.find_policies(models, phrase.hash)
+    return found[0] if found else None
+
+
+def missing_phrases(models: Path, phrases: list[Phrase]) -> list[Phrase]:
+    return [p for p in phrases if find_policy(models, p) is None]
+
+
+def training_config(models: Path, phrases: list[Phrase]) -> TrainConfig | None:
+    """The configuration the stored policies share (None when no phrase has one)."""
+    configs = []
+    for phrase in phrases:
+        folder = find_policy(models, phrase)
+        if folder is not None:
+            configs.append(config_from_manifest(store.read_manifest(folder)))
+    if not configs:
+        return None
+    env_configs = {repr(c.env) + repr(c.sac.tactile_resolution) for c in configs}
+    if len(env_configs) > 1:
+        raise PianobotError(f"the policies in {models} for this piece were trained with different environments: retrain them with one set of options")
+    return configs[0]
+
+
+class CompositionalController:
+    """Acts with the controller of the section the current step falls in."""
+
+    def __init__(self, env: PianoEnv, phrases: list[Phrase], models: Path, config: TrainConfig, fallback: bool):
+        spec = env.spec_score
+        lead = env.lead_steps
+        self.sections: list[Section] = []
+        previous_last_onset = None
+        for phrase in phrases:
+            start = lead + spec.step_of(phrase.start)
+            first = 0 if previous_last_onset is None else max(previous_last_onset + 1, start - lead)
+            timeline = np.zeros_like(env.score)
+            tensor = score_tensor(phrase_target(phrase), spec)
+            end = min(start + len(tensor), len(timeline))
+            timeline[start:end] = tensor[: end - start]
+            folder = find_policy(models, phrase)
+            if folder is not None:
+                controller, source = load_policy(folder, config, env), f"policy {folder.name}"
+            elif fallback:
+                controller, source = ScriptedPianist(env.config), "scripted (fallback)"
+            else:  # checked before simulating; kept as a guard
+                raise PianobotError(f"phrase {phrase.index} has no trained policy in {models}")
+            self.sections.append(Section(phrase, first, timeline, controller, source))
+            previous_last_onset = lead + spec.step_of(phrase.notes[-1].onset)
+        self.lookahead = env.config.lookahead
+        self.step = 0
+
+    def reset(self) -> None:
+        self.step = 0
+        for section in self.sections:
+            if isinstance(section.controller, ScriptedPianist):
+                section.controller.reset()
+
+    def section_at(self, step: int) -> Section:
+        active = self.sections[0]
+        for section in self.sections:
+            if section.first_step <= step:
+                active = section
+        return active
+
+    def act(self, observation: dict) -> np.ndarray:
+        from pianobot.agent.sac import split_observation
+
+        section = self.section_at(self.step)
+        window = section.score[self.step : self.step + self.lookahead + 1]
+        observation = {**observation, "score": window}
+        self.step += 1
+        if isinstance(section.controller, ScriptedPianist):
+            return section.controller.act(observation)
+        return section.controller.act(*split_observation(observation), deterministic=True)
