@@ -8,6 +8,7 @@ BIN := $(VENV)/bin
 $(BIN)/pianobot: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/pip install --quiet --upgrade pip
+	$(BIN)/pip install --quiet torch==2.13.0  # the local CPU wheel; must come before anything that needs torch
 	$(BIN)/pip install --quiet -e ".[test]"
 	touch $(BIN)/pianobot
 
