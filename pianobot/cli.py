@@ -26,7 +26,7 @@ from pianobot.music import midi_io
 from pianobot.music.instrument import HandSpec, KeyboardSpec, check_playable
 from pianobot import store
 from pianobot.agent.sac import SACConfig
-from pianobot.env import EnvConfig
+from pianobot.env import JOINT_KINDS, EnvConfig
 from pianobot.explore import EXPLORATIONS
 from pianobot.music.tasks import TASKS
 from pianobot.rewards import REWARDS, RewardConfig
@@ -265,6 +265,7 @@ def train(
     explore: str = typer.Option(TrainConfig.explore, "--explore", help=f"Exploration before learning: {', '.join(EXPLORATIONS)}."),
     exploration_steps: int = typer.Option(SACConfig.exploration_steps, "--exploration-steps", help="Steps of exploration before learning starts."),
     tactile: bool = typer.Option(True, "--tactile/--no-tactile", help="Observe the fingertips' tactile images."),
+    joints: str = typer.Option(",".join(EnvConfig.actuated), "--joints", help="Finger joints the policy moves, from abd,mcp,pip,dip; the others hold still."),
     fingering_gate: bool = typer.Option(RewardConfig.fingering_gate, "--fingering/--no-fingering", help="Credit a key only when the score's finger pressed it."),
     force: bool = typer.Option(False, "--force", help="Retrain phrases that already have a stored policy."),
     models: Path = typer.Option(Path("models"), "--models", help="Folder of the model store."),
@@ -292,13 +293,17 @@ def train(
         raise PianobotError("--explore scripted needs --control velocity (the scripted pianist drives joint speeds)")
     if not 0 <= exploration_steps < steps:
         raise PianobotError(f"--steps {steps} must exceed --exploration-steps {exploration_steps}, or nothing is learnt")
+    actuated = tuple(j.strip() for j in joints.split(",") if j.strip())
+    if not actuated or set(actuated) - set(JOINT_KINDS):
+        raise PianobotError(f"--joints {joints}: name finger joints from {','.join(JOINT_KINDS)}, e.g. mcp,pip")
     if workers < 1 or threads < 1:
         raise PianobotError(f"--workers {workers} --threads {threads}: give 1 or more of each")
     if models.exists() and not models.is_dir():
         raise PianobotError(f"--models {models} is a file: give a folder")
     keyboard, hand = make_instrument(lowest_note, keys, thumb)
     world = WorldConfig(keyboard=KeyboardConfig(spec=keyboard), hand=HandConfig(spec=hand), control=control)
-    env = EnvConfig(world=world, reward=RewardConfig(kind=reward, fingering_gate=fingering_gate), tactile=tactile)
+    env = EnvConfig(world=world, reward=RewardConfig(kind=reward, fingering_gate=fingering_gate), tactile=tactile,
+                    actuated=tuple(j for j in JOINT_KINDS if j in actuated))
     config = TrainConfig(steps=steps, seed=seed, explore=explore, sac=SACConfig(exploration_steps=exploration_steps), env=env)
     if task is not None:
         jobs = [PhraseJob(f"task-{task}", task, store.model_dir(models, f"task-{task}", config), [0], f"task {task}")]

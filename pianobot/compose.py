@@ -87,6 +87,7 @@ class CompositionalController:
             self.sections.append(Section(phrase, first, timeline, controller, source))
             previous_last_onset = lead + spec.step_of(phrase.notes[-1].onset)
         self.lookahead = env.config.lookahead
+        self.actuated = env.actuated
         self.step = 0
 
     def reset(self) -> None:
@@ -110,5 +111,5 @@ class CompositionalController:
         observation = {**observation, "score": window}
         self.step += 1
         if isinstance(section.controller, ScriptedPianist):
-            return section.controller.act(observation)
+            return section.controller.act(observation)[self.actuated]  # the joints the policies move
         return section.controller.act(*split_observation(observation), deterministic=True)

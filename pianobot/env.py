@@ -28,6 +28,8 @@ from pianobot.sim.hand import finger_ik, joint_names
 from pianobot.sim.tactile import TactileConfig, TactileRenderer, pool, to_uint8
 from pianobot.sim.world import PianoWorld, WorldConfig
 
+JOINT_KINDS = ("abd", "mcp", "pip", "dip")
+"""Each finger's joints, in action order."""
 IDLE_HEIGHT = 0.010
 """At the start the fingertips hover this high (m) over the white keys, 40 mm in from their front."""
 
@@ -72,6 +74,9 @@ class EnvConfig:
     """Seconds after the last note ends."""
     random_start: bool = True
     """Start the wrist at a random position along the keyboard (else at its centre)."""
+    actuated: tuple[str, ...] = ("abd", "mcp", "pip", "dip")
+    """Finger joints the policy moves; the others hold their starting angle (the paper froze the
+    joints not crucial to a task). E.g. ("mcp", "pip") leaves 2 per finger plus the wrist."""
 
     @property
     def score_spec(self) -> ScoreSpec:
@@ -123,7 +128,11 @@ class PianoEnv(gym.Env):
             obs["keys"] = spaces.Box(-SPEED_BOUND, SPEED_BOUND, (keys,), np.float32)
             obs["key_velocities"] = spaces.Box(-SPEED_BOUND, SPEED_BOUND, (keys,), np.float32)
         self.observation_space = spaces.Dict(obs)
-        self.action_space = spaces.Box(-1.0, 1.0, (self.n_joints + 1,), np.float32)
+        unknown = set(config.actuated) - set(JOINT_KINDS)
+        if unknown or not config.actuated:
+            raise ValueError(f"actuated joints must be among {JOINT_KINDS}; got {config.actuated}")
+        self.actuated = np.array([i for i in range(self.n_joints) if JOINT_KINDS[i % 4] in config.actuated] + [self.n_joints])
+        self.action_space = spaces.Box(-1.0, 1.0, (len(self.actuated),), np.float32)
         if piece is not None:
             self._set_piece(piece)
 
@@ -162,8 +171,14 @@ class PianoEnv(gym.Env):
         return self._observe(), {"piece": self.piece}
 
     # -- the step: act, observe, reward ------------------------------------------------------
+    def full_action(self, action) -> np.ndarray:
+        """The policy's action spread over every finger joint and the wrist (frozen joints: speed 0)."""
+        full = np.zeros(self.n_joints + 1)
+        full[self.actuated] = action
+        return full
+
     def step(self, action):
-        result = self.world.step(np.asarray(action, dtype=np.float64))
+        result = self.world.step(self.full_action(np.asarray(action, dtype=np.float64)))
         lowest = self.spec_score.keyboard.lowest
         for event in result.events:
             key = event.pitch - lowest

@@ -24,7 +24,8 @@ SCRIPTED_NOISE = 0.2
 class Explorer:
     """``reset()`` at each episode start, then ``act(observation)``."""
 
-    def __init__(self, kind: str, action_size: int, config: EnvConfig, rng: np.random.Generator):
+    def __init__(self, kind: str, action_size: int, config: EnvConfig, rng: np.random.Generator, select: np.ndarray | None = None):
+        """``select``: which of the scripted pianist's full actions the policy's action holds (frozen joints left out)."""
         if kind not in EXPLORATIONS:
             raise ValueError(f"exploration must be one of {', '.join(EXPLORATIONS)}; got {kind!r}")
         if kind == "scripted" and config.world.control != "velocity":
@@ -32,6 +33,7 @@ class Explorer:
         self.kind, self.size, self.rng = kind, action_size, rng
         self.pianist = ScriptedPianist(config) if kind == "scripted" else None
         self.previous: np.ndarray | None = None
+        self.select = select
 
     def reset(self) -> None:
         self.previous = None
@@ -40,7 +42,8 @@ class Explorer:
 
     def act(self, observation: dict) -> np.ndarray:
         if self.kind == "scripted":
-            action = self.pianist.act(observation) + self.rng.normal(0.0, SCRIPTED_NOISE, self.size)
+            action = self.pianist.act(observation)
+            action = (action if self.select is None else action[self.select]) + self.rng.normal(0.0, SCRIPTED_NOISE, self.size)
             return np.clip(action, -1.0, 1.0).astype(np.float32)
         action = self.rng.uniform(-1.0, 1.0, self.size).astype(np.float32)
         if self.kind in ("repeat", "prior") and self.previous is not None and self.rng.random() < REPEAT_PROBABILITY:

@@ -125,7 +125,7 @@ def train_policy(
     tactile_shape = space["tactile"].shape if "tactile" in space.spaces else None
     buffer = ReplayBuffer(min(config.sac.buffer_size, config.steps), vector_size(space), tactile_shape, env.action_space.shape[0])
     rng = np.random.default_rng(config.seed)
-    explorer = Explorer(config.explore, env.action_space.shape[0], env_config, rng)
+    explorer = Explorer(config.explore, env.action_space.shape[0], env_config, rng, select=env.actuated)
     step, episode, update_debt, evaluations = 0, 0, 0.0, []
 
     checkpoint = store.load_checkpoint(folder)
@@ -248,7 +248,8 @@ def config_from_manifest(manifest: dict) -> TrainConfig:
         world = WorldConfig(keyboard=keyboard, hand=hand, **{k: v for k, v in w.items() if k not in ("keyboard", "hand")})
         pool = tuple(e["tactile_pool"]) if e["tactile_pool"] is not None else None
         env = EnvConfig(world=world, reward=RewardConfig(**e["reward"]), tactile_sensor=TactileConfig(**e["tactile_sensor"]),
-                        tactile_pool=pool, **{k: v for k, v in e.items() if k not in ("world", "reward", "tactile_sensor", "tactile_pool")})
+                        tactile_pool=pool, actuated=tuple(e["actuated"]),
+                        **{k: v for k, v in e.items() if k not in ("world", "reward", "tactile_sensor", "tactile_pool", "actuated")})
         s = c["sac"]
         sac = SACConfig(**{**s, "tactile_resolution": tuple(s["tactile_resolution"]) if s["tactile_resolution"] else None,
                            "log_std_bounds": tuple(s["log_std_bounds"])})

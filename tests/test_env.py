@@ -134,3 +134,19 @@ def test_unplayable_phrase_is_refused():
 
     with pytest.raises(PianobotError, match="outside the keyboard"):
         PianoEnv(piece=Piece((Note(0, 40, 1, 80, 2),)))
+
+
+def test_frozen_joints_shrink_the_action_and_hold_still():
+    env = PianoEnv(piece=PHRASE, config=EnvConfig(tactile=False, actuated=("mcp", "pip")))
+    assert env.action_space.shape == (7,)  # 2 joints x 3 fingers + wrist
+    observation, _ = env.reset(seed=0)
+    start = observation["joints"].reshape(3, 4).copy()
+    action = np.zeros(7)
+    action[[0, 2, 4]] = -0.1  # lift the knuckles (no key is touched)
+    for _ in range(5):
+        observation, *_ = env.step(action)
+    joints = observation["joints"].reshape(3, 4)
+    assert np.allclose(joints[:, [0, 3]], start[:, [0, 3]], atol=0.02)  # abduction and DIP did not move
+    assert np.all(joints[:, 1] < start[:, 1] - 0.1)  # MCP did
+    with pytest.raises(ValueError):
+        PianoEnv(piece=PHRASE, config=EnvConfig(actuated=("elbow",)))
