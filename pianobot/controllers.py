@@ -256,7 +256,7 @@ class ScriptedPianist:
 
     # -- turning plans into joint speeds ------------------------------------------------------
     def _command(self, plans: dict, joints: np.ndarray, wrist: float) -> np.ndarray:
-        hand, geometry = self.hand, self.geometry
+        hand = self.hand
         wrist_target = wrist
         if plans:
             wanted = [self._wrist_for(f, plan.key) for f, plan in plans.items()]

@@ -8,8 +8,6 @@ score it was asked to play.
 
 from __future__ import annotations
 
-import os
-import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable, Protocol
@@ -19,7 +17,7 @@ import numpy as np
 from pianobot.controllers import RandomController, ScriptedPianist
 from pianobot.env import EnvConfig, PianoEnv
 from pianobot.errors import PianobotError
-from pianobot.files import _umask
+from pianobot.files import check_writable, move_into_place, temporary_beside
 from pianobot.music.piece import Piece
 from pianobot.sim.recorder import NoteRecorder
 
@@ -91,15 +89,13 @@ def write_video(frames: list[np.ndarray], path: str | Path, fps: float) -> Path:
     """Encode frames to an MP4 file (imageio with its ffmpeg plugin), written atomically."""
     import imageio.v2 as imageio  # only needed for videos
 
-    path = Path(path)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=path.suffix or ".mp4", dir=path.parent)
-    os.close(fd)
+    path = check_writable(path)
+    tmp = temporary_beside(path)
     try:
-        with imageio.get_writer(tmp, fps=fps, codec="libx264", quality=7, macro_block_size=16) as writer:
+        with imageio.get_writer(tmp, format="FFMPEG", fps=fps, codec="libx264", quality=7, macro_block_size=16) as writer:
             for frame in frames:
                 writer.append_data(frame)
-        os.chmod(tmp, 0o666 & ~_umask())
-        os.replace(tmp, path)
+        move_into_place(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise

@@ -29,7 +29,6 @@ from pianobot.explore import Explorer
 from pianobot.metrics import compare
 from pianobot.music.phrases import Phrase
 from pianobot.music.piece import Piece
-from pianobot.music.tasks import make_task
 from pianobot.sim.recorder import NoteRecorder
 
 EVAL_SEED = 10_000

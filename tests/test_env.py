@@ -6,7 +6,6 @@ import pytest
 from gymnasium.utils.env_checker import check_env
 
 from pianobot.env import EnvConfig, PianoEnv
-from pianobot.music.load import load_piece
 from pianobot.music.piece import Note, Piece
 from pianobot.rewards import RewardConfig
 
