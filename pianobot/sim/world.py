@@ -19,6 +19,8 @@ from pianobot.sim.hand import HandConfig, hand_urdf, joint_names
 from pianobot.sim.keyboard import KeyboardConfig, KeyEvent, KeySensor, key_boxes, keyboard_urdf, keyboard_width
 
 CONTROL_MODES = ("velocity", "torque")
+LIMIT_STOP_TORQUE = 5.0
+"""Torque (N m) with which a joint's mechanical stop holds it at its limit under torque control."""
 
 
 @dataclass(frozen=True)
@@ -224,20 +226,27 @@ class PianoWorld:
         PyBullet's joint limits are soft: a finger motor at full speed pushes the light finger
         links far past them (we saw the PIP joint at -1.5 rad against a limit of -0.17). So the
         commanded speed is clipped to what reaches the limit within one physics step, and a
-        torque that pushes further out is dropped (a joint already beyond is pushed back)."""
+        joint that would pass a limit under torque control is held at it by a motor."""
         c, hand = self.client, self.config.hand
-        q = np.array([s[0] for s in p.getJointStates(self.hand, self.finger_joints, physicsClientId=c)])
+        states = p.getJointStates(self.hand, self.finger_joints, physicsClientId=c)
+        q = np.array([s[0] for s in states])
         low, high = self.joint_limits
+        # speeds that reach a limit within this physics step, and no further
+        slowest, fastest = (low - q) / self.dt, (high - q) / self.dt
         if not torque:
-            speed = np.clip(self._finger_command, (low - q) / self.dt, (high - q) / self.dt)
+            speed = np.clip(self._finger_command, slowest, fastest)
             p.setJointMotorControlArray(self.hand, self.finger_joints, p.VELOCITY_CONTROL, targetVelocities=speed.tolist(),
                                         forces=[hand.joint_force] * len(q), physicsClientId=c)
             return
-        tau = self._finger_command.copy()
-        tau = np.where((q >= high) & (tau > 0), 0.0, tau)
-        tau = np.where((q <= low) & (tau < 0), 0.0, tau)
-        tau = np.where(q > high, -hand.max_joint_torque, np.where(q < low, hand.max_joint_torque, tau))
-        p.setJointMotorControlArray(self.hand, self.finger_joints, p.TORQUE_CONTROL, forces=tau.tolist(), physicsClientId=c)
+        # torque control, except for joints that would pass a limit within this step: a motor holds those at it
+        velocity = np.array([s[1] for s in states])
+        tau = self._finger_command
+        guard = (velocity > fastest) | (velocity < slowest) | ((q >= high) & (tau > 0)) | ((q <= low) & (tau < 0))
+        speed = np.clip(0.0, slowest, fastest)
+        p.setJointMotorControlArray(self.hand, self.finger_joints, p.VELOCITY_CONTROL, targetVelocities=speed.tolist(),
+                                    forces=np.where(guard, LIMIT_STOP_TORQUE, 0.0).tolist(), physicsClientId=c)
+        p.setJointMotorControlArray(self.hand, self.finger_joints, p.TORQUE_CONTROL,
+                                    forces=np.where(guard, 0.0, tau).tolist(), physicsClientId=c)
 
     def discrete_wrist_position(self, action: float) -> float:
         """The white-key position that a wrist action in [-1, 1] selects."""
