@@ -34,6 +34,7 @@ from pianobot.sim.world import CONTROL_MODES
 from pianobot.train import PhraseJob, TrainConfig, plan_jobs, run_jobs
 from pianobot.music.load import LoadOptions, load_piece, load_playable
 from pianobot.music.midi_io import write_midi
+from pianobot.audio import write_wav
 from pianobot.compose import CompositionalController, missing_phrases, training_config
 from pianobot.perform import CONTROLLERS, perform, write_video
 from pianobot.sim.hand import HandConfig
@@ -178,6 +179,7 @@ def play(
     phrase_notes: int = PhraseNotes,
     seed: int = typer.Option(0, "--seed", help="Seed of the simulation (the hand's start position) and of the random controller."),
     video: Optional[Path] = typer.Option(None, "--video", help="Also record the performance to this .mp4 file."),
+    wav: Optional[Path] = typer.Option(None, "--wav", help="Also synthesise what was played to this .wav file."),
     gui: bool = typer.Option(False, "--gui", help="Show the simulation in a PyBullet window (needs a display)."),
     track: Optional[str] = Track,
     tempo: Optional[float] = Tempo,
@@ -193,11 +195,13 @@ def play(
     if output.resolve() == song.resolve():
         raise PianobotError(f"-o {output} would overwrite the piece being played: choose another file name")
     report_path = output.with_suffix(".report.json")
-    for target in (output, report_path, video):
+    for target in (output, report_path, video, wav):
         if target is not None:
             check_writable(target)
     if video is not None and video.suffix.lower() != ".mp4":
         raise PianobotError(f"--video {video}: the video is an MP4 file, name it *.mp4")
+    if wav is not None and wav.suffix.lower() != ".wav":
+        raise PianobotError(f"--wav {wav}: the audio is a WAV file, name it *.wav")
     if gui and not os.environ.get("DISPLAY"):
         raise PianobotError("--gui needs a display (DISPLAY is not set): drop --gui, or use --video to watch it later")
     if controller not in CONTROLLERS:
@@ -249,6 +253,9 @@ def play(
     if video is not None:
         write_video(result.frames, video, fps=config.world.control_hz)
         out.print(f"video written to {video}")
+    if wav is not None:
+        method = write_wav(result.played, wav)
+        out.print(f"audio written to {wav} ({method})")
 
 
 @app.command()

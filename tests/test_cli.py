@@ -3,6 +3,7 @@ from dataclasses import replace
 from pathlib import Path
 
 import mido
+import numpy as np
 import pytest
 from typer.testing import CliRunner
 
@@ -157,7 +158,7 @@ def test_version():
 
 def test_play_scripted_writes_a_performance_that_scores_well(tmp_path):
     out = tmp_path / "out.mid"
-    result = run("play", EXAMPLES / "three-note.mid", "-o", out, "--video", tmp_path / "out.mp4")
+    result = run("play", EXAMPLES / "three-note.mid", "-o", out, "--video", tmp_path / "out.mp4", "--wav", tmp_path / "out.wav")
     assert result.exit_code == 0, result.output
     report = json.loads((tmp_path / "out.report.json").read_text())
     assert report["f1"] >= 0.95 and report["velocity_mae"] <= 10 and report["controller"] == "scripted"
@@ -170,6 +171,11 @@ def test_play_scripted_writes_a_performance_that_scores_well(tmp_path):
     assert json.loads((tmp_path / "s.json").read_text())["f1"] == report["f1"]
     import imageio.v2 as imageio
 
+    from scipy.io import wavfile
+
+    rate, audio = wavfile.read(tmp_path / "out.wav")
+    assert rate == 22050 and len(audio) > 3 * rate and np.abs(audio).max() > 1000  # three seconds of sound
+    assert "audio written" in result.output
     frames = imageio.get_reader(tmp_path / "out.mp4").count_frames()
     assert frames > 50  # one frame per control step
     assert scored.exit_code == 0
@@ -181,6 +187,7 @@ def test_play_bad_requests_answer_with_one_line(tmp_path, scale):
     assert_one_line_error(run("play", song, "-o", song), "overwrite")
     assert_one_line_error(run("play", song, "-o", tmp_path / "x.mid", "--controller", "robot"), "--controller robot")
     assert_one_line_error(run("play", song, "-o", tmp_path / "x.mid", "--video", tmp_path / "v.gif"), "*.mp4")
+    assert_one_line_error(run("play", song, "-o", tmp_path / "x.mid", "--wav", tmp_path / "a.mp3"), "*.wav")
     unfingered = write_midi(scale.without_fingering(), tmp_path / "plain.mid")
     assert_one_line_error(run("play", unfingered, "-o", tmp_path / "x.mid"), "without fingering")
     assert not (tmp_path / "x.mid").exists()
