@@ -26,6 +26,7 @@ from pianobot.music.tensor import FINGER, NOTE, VELOCITY, ScoreSpec, score_tenso
 from pianobot.rewards import RewardConfig, reward_terms
 from pianobot.sim.hand import finger_ik, joint_names
 from pianobot.sim.tactile import TactileConfig, TactileRenderer, pool, to_uint8
+from pianobot.sim.keyboard import strike_points
 from pianobot.sim.world import PianoWorld, WorldConfig
 
 JOINT_KINDS = ("abd", "mcp", "pip", "dip")
@@ -111,6 +112,7 @@ class PianoEnv(gym.Env):
         self.n_joints = len(joint_names(config.world.hand.spec))
         keys = self.spec_score.keyboard.count
         self.lead_steps = steps_for(config.lead_in, self.spec_score)
+        self.strike_points = strike_points(config.world.keyboard)
         self.tactile = (
             TactileRenderer(config.tactile_sensor, config.world.hand.geometry, self.world.boxes) if config.tactile else None
         )
@@ -189,7 +191,8 @@ class PianoEnv(gym.Env):
         target_row = self.score[self.t]
         played = result.pressed_velocity / 127.0
         terms = reward_terms(
-            self.config.reward, played, self.key_finger, target_row[:, VELOCITY] * target_row[:, NOTE], self.target_finger[self.t]
+            self.config.reward, played, self.key_finger, target_row[:, VELOCITY] * target_row[:, NOTE], self.target_finger[self.t],
+            self._fingertip_distances() if self.config.reward.closeness_weight else None,
         )
         reward = float(sum(terms.values()))
         self.t += 1
@@ -202,6 +205,17 @@ class PianoEnv(gym.Env):
             "target": target_row[:, NOTE] > 0.5,
         }
         return self._observe(), reward, False, truncated, info
+
+    def _fingertip_distances(self) -> np.ndarray:
+        """For the keys to play now, or else the next ones in the lookahead: each assigned
+        fingertip's distance (m) to its key's strike point."""
+        window = self.target_finger[self.t : self.t + self.config.lookahead + 1]
+        rows = np.flatnonzero(window.any(axis=1))
+        if rows.size == 0:
+            return np.zeros(0)
+        keys = np.flatnonzero(window[rows[0]])
+        tips = self.world.tip_points()
+        return np.array([np.linalg.norm(tips[window[rows[0], k]] - self.strike_points[k]) for k in keys])
 
     def _tactile_image(self) -> np.ndarray:
         angles, _ = self.world.key_state()

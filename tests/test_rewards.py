@@ -83,3 +83,35 @@ def test_terms_sum_to_the_reward_and_a_perfect_step_scores_the_constant(kind):
 def test_unknown_reward_is_refused():
     with pytest.raises(ValueError, match="linear, squared, wasserstein"):
         RewardConfig(kind="cubic")
+
+
+def test_closeness_bonus_rewards_fingertips_near_their_keys():
+    from pianobot.rewards import closeness
+
+    assert closeness(np.array([0.0, 0.0]), 0.02) == 1.0
+    assert closeness(np.array([0.02]), 0.02) == pytest.approx(np.exp(-1))
+    assert closeness(np.array([0.2]), 0.02) < 1e-10
+    assert closeness(np.zeros(0), 0.02) == 0.0
+    config = RewardConfig(closeness_weight=0.5)
+    terms = reward_terms(config, vec(), np.zeros(L, int), vec(), np.zeros(L, int), np.array([0.0]))
+    assert terms["closeness"] == pytest.approx(0.5)
+    assert "closeness" not in reward_terms(RewardConfig(closeness_weight=0), vec(), np.zeros(L, int), vec(), np.zeros(L, int), np.array([0.0]))
+
+
+def test_the_scripted_pianist_earns_more_than_an_idle_hand():
+    from pianobot.controllers import ScriptedPianist
+    from pianobot.env import EnvConfig, PianoEnv
+    from pianobot.music.piece import Note, Piece
+
+    config = EnvConfig(tactile=False)
+    env = PianoEnv(piece=Piece((Note(0.0, 64, 1.0, 80, 3),), bpm=60), config=config)
+    totals = []
+    for pianist in (ScriptedPianist(config), None):
+        observation, _ = env.reset(seed=0)
+        total = 0.0
+        for _ in range(env.horizon):
+            action = pianist.act(observation) if pianist else np.zeros(13)
+            observation, reward, *_ = env.step(action)
+            total += reward
+        totals.append(total)
+    assert totals[0] > totals[1] + 15  # the closeness bonus and the played note both count

@@ -207,3 +207,19 @@ def keyboard_urdf(config: KeyboardConfig) -> str:
         ]
     parts.append("</robot>")
     return "\n".join(parts) + "\n"
+
+
+WHITE_STRIKE_FROM_FRONT = 0.040
+"""A fingertip strikes a white key this far (m) in from its front edge."""
+BLACK_STRIKE_FROM_FRONT = 0.010
+"""A fingertip strikes a black key this far (m) in from its front edge."""
+
+
+def strike_points(config: KeyboardConfig) -> np.ndarray:
+    """Where on each key's top surface a fingertip strikes it, at rest: array (L, 3) in metres."""
+    points = []
+    for box in key_boxes(config):
+        front = box.center[1] + box.half[1]
+        inset = BLACK_STRIKE_FROM_FRONT if box.black else WHITE_STRIKE_FROM_FRONT
+        points.append((box.center[0], front - inset, box.center[2] + box.half[2]))
+    return np.array(points)

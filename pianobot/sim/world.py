@@ -172,6 +172,15 @@ class PianoWorld:
                 out[key] = (finger, force)
         return out
 
+    def tip_points(self) -> dict[int, np.ndarray]:
+        """World position of each fingertip's lowest point (the bottom of its tip sphere)."""
+        g = self.config.hand.geometry
+        points = {}
+        for finger, link in self.tip_links.items():
+            position, rotation = self.link_pose(link)
+            points[finger] = position + rotation @ np.array([0.0, -(g.distal - g.tip_radius), 0.0]) - np.array([0, 0, g.tip_radius])
+        return points
+
     def tip_forces(self) -> dict[int, float]:
         """Total normal force (N) on each fingertip from the keys."""
         forces = {f: 0.0 for f in self.tip_links}
