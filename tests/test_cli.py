@@ -276,3 +276,24 @@ def test_sections_hand_over_after_the_last_strike():
     assert composed.section_at(20).phrase.index == 0 and composed.section_at(21).phrase.index == 1
     window = composed.sections[1].score[30]
     assert window[:, 0].nonzero()[0].tolist() == [2]  # phrase 1 sees only its own note (D4)
+
+
+def test_train_options_reach_the_stored_configuration(tmp_path):
+    result = run("train", EXAMPLES / "one-note.mid", "--steps", "50", "--exploration-steps", "25", "--no-tactile",
+                 "--control", "torque", "--reward", "wasserstein", "--no-fingering", "--joints", "mcp,pip",
+                 "--explore", "uniform", "--seed", "3", "--models", tmp_path)
+    assert result.exit_code == 0, result.output
+    config = json.loads(next(tmp_path.glob("*/manifest.json")).read_text())["config"]
+    assert config["seed"] == 3 and config["explore"] == "uniform" and config["sac"]["exploration_steps"] == 25
+    assert config["env"]["world"]["control"] == "torque" and config["env"]["actuated"] == ["mcp", "pip"]
+    assert config["env"]["reward"]["kind"] == "wasserstein" and config["env"]["reward"]["fingering_gate"] is False
+    assert_one_line_error(run("train", EXAMPLES / "one-note.mid", "--joints", "elbow"), "--joints elbow")
+
+
+def test_train_workers_train_phrases_in_parallel(tmp_path):
+    song = write_midi(Piece((Note(0.0, 60, 0.5, 80, 2), Note(2.0, 67, 2.5, 70, 4)), bpm=60), tmp_path / "two.mid")
+    result = run("train", song, "--phrase-notes", "1", "--steps", "40", "--exploration-steps", "20", "--no-tactile",
+                 "--workers", "2", "--models", tmp_path / "models")
+    assert result.exit_code == 0, result.output
+    manifests = [json.loads(p.read_text()) for p in (tmp_path / "models").glob("*/manifest.json")]
+    assert sorted(m["phrases"] for m in manifests) == [[0], [1]] and all(m["steps"] == 40 for m in manifests)
