@@ -297,3 +297,17 @@ def test_train_workers_train_phrases_in_parallel(tmp_path):
     assert result.exit_code == 0, result.output
     manifests = [json.loads(p.read_text()) for p in (tmp_path / "models").glob("*/manifest.json")]
     assert sorted(m["phrases"] for m in manifests) == [[0], [1]] and all(m["steps"] == 40 for m in manifests)
+
+
+def test_committed_one_note_policy_plays_from_a_fresh_checkout(tmp_path):
+    """models/ holds the policy trained by the command in docs/benchmarks.md; `play --controller sac` uses it."""
+    models = Path(__file__).parent.parent / "models"
+    f1s = []
+    for seed in (0, 1, 2):
+        result = run("play", EXAMPLES / "one-note.mid", "-o", tmp_path / "o.mid", "--controller", "sac",
+                     "--models", models, "--seed", seed)
+        assert result.exit_code == 0, result.output
+        report = json.loads((tmp_path / "o.report.json").read_text())
+        assert report["phrases"]["0"].startswith("policy ")
+        f1s.append(report["f1"])
+    assert sum(f1s) / 3 >= 0.9
