@@ -20,7 +20,7 @@ import numpy as np
 from pianobot.env import EnvConfig
 from pianobot.music.tensor import FINGER, NOTE, VELOCITY
 from pianobot.sim.hand import FINGER_BASE_X, finger_ik, lowest_point_in_finger_plane
-from pianobot.sim.keyboard import key_boxes
+from pianobot.sim.keyboard import BLACK_STRIKE_FROM_FRONT, WHITE_STRIKE_FROM_FRONT, key_boxes
 
 
 class RandomController:
@@ -61,10 +61,6 @@ class Plan:
 class ScriptedPianist:
     """A hand-written pianist for velocity control. See the module docstring."""
 
-    white_contact_y = 0.110
-    """Where along a white key the fingertip strikes (m from the hinge; the front is at 0.150)."""
-    black_contact_y = 0.085
-    """Where along a black key the fingertip strikes (its front is at 0.095)."""
     idle_height = 0.010
     """Fingertip height over its key's top (or the white keys' top) when it has nothing to do (m)."""
     min_ready_height = 0.003
@@ -111,6 +107,10 @@ class ScriptedPianist:
         self.curve = world.keyboard.curve
         self.strike_angle = world.keyboard.strike_fraction * world.keyboard.geometry.max_angle
         self.white_length = world.keyboard.geometry.white_length
+        # where along a key the fingertip strikes (m from the hinge): the keyboard's strike points
+        geometry = world.keyboard.geometry
+        self.white_contact_y = geometry.white_length - WHITE_STRIKE_FROM_FRONT
+        self.black_contact_y = geometry.black_length - BLACK_STRIKE_FROM_FRONT
         self.black_rise = world.keyboard.geometry.black_rise
         self.black_band_y = world.keyboard.geometry.black_length + world.hand.geometry.tip_radius
         self.reset()
