@@ -18,7 +18,7 @@ from pathlib import Path
 from pianobot import store
 from pianobot.agent.sac import SACConfig
 from pianobot.env import EnvConfig
-from pianobot.train import TrainConfig, train_policy
+from pianobot.train import TRAIN_JOINTS, TrainConfig, train_policy
 
 
 def run(task: str, seed: int, args) -> tuple[str, int, dict]:
@@ -27,8 +27,8 @@ def run(task: str, seed: int, args) -> tuple[str, int, dict]:
     torch.set_num_threads(1)
     config = TrainConfig(
         steps=args.steps, seed=seed, explore=args.explore, eval_every=args.eval_every, eval_episodes=args.eval_episodes,
-        checkpoint_every=args.eval_every, sac=SACConfig(exploration_steps=args.exploration_steps),
-        env=EnvConfig(tactile=args.tactile),
+        checkpoint_every=args.eval_every, until_f1=args.until_f1, sac=SACConfig(exploration_steps=args.exploration_steps),
+        env=EnvConfig(tactile=args.tactile, actuated=tuple(args.joints.split(","))),
     )
     folder = store.model_dir(Path(args.store), f"task-{task}-seed{seed}", config)
     if store.is_trained(folder):
@@ -45,7 +45,9 @@ def main() -> None:
     parser.add_argument("--eval-every", type=int, default=5_000)
     parser.add_argument("--eval-episodes", type=int, default=5)
     parser.add_argument("--explore", default=TrainConfig.explore)
+    parser.add_argument("--until-f1", type=float, default=None, help="stop a run once an evaluation reaches this F1")
     parser.add_argument("--tactile", action=argparse.BooleanOptionalAction, default=True)
+    parser.add_argument("--joints", default=",".join(TRAIN_JOINTS), help="finger joints the policy moves")
     parser.add_argument("--workers", type=int, default=1)
     parser.add_argument("--store", default="/tmp/pianobot-learn")
     parser.add_argument("--plot", default=None)

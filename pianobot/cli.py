@@ -31,7 +31,7 @@ from pianobot.explore import EXPLORATIONS
 from pianobot.music.tasks import TASKS
 from pianobot.rewards import REWARDS, RewardConfig
 from pianobot.sim.world import CONTROL_MODES
-from pianobot.train import PhraseJob, TrainConfig, plan_jobs, run_jobs
+from pianobot.train import TRAIN_JOINTS, PhraseJob, TrainConfig, plan_jobs, run_jobs
 from pianobot.music.load import LoadOptions, load_piece, load_playable
 from pianobot.music.midi_io import write_midi
 from pianobot.audio import write_wav
@@ -213,7 +213,7 @@ def play(
     if not piece.has_fingering and (controller == "scripted" or fallback):
         raise PianobotError(f"{song} has notes without fingering: the scripted pianist needs a finger for every note (see docs/fingering.md)")
     world = WorldConfig(keyboard=KeyboardConfig(spec=keyboard), hand=HandConfig(spec=hand), gui=gui)
-    config = EnvConfig(world=world, tactile=False)
+    config = EnvConfig(world=world, tactile=False, actuated=JOINT_KINDS)  # the scripted pianist moves every joint
     sources: dict = {}
     who = controller
     if controller == "sac":
@@ -265,6 +265,7 @@ def train(
     task: Optional[str] = typer.Option(None, "--task", help=f"Train on one of the paper's task families instead: {', '.join(TASKS)}."),
     steps: int = typer.Option(TrainConfig.steps, "--steps", help="Environment steps per phrase, exploration included."),
     seed: int = typer.Option(TrainConfig.seed, "--seed", help="Seed of the simulation, the exploration and the networks."),
+    until_f1: Optional[float] = typer.Option(None, "--until-f1", help="Stop a phrase early once an evaluation reaches this note F1 (e.g. 0.95)."),
     workers: int = typer.Option(1, "--workers", help="Train this many phrases at once, in separate processes."),
     threads: int = typer.Option(1, "--threads", help="Torch threads per training process (workers x threads should not exceed the cores)."),
     control: str = typer.Option(WorldConfig.control, "--control", help="Finger control: velocity or torque."),
@@ -272,7 +273,7 @@ def train(
     explore: str = typer.Option(TrainConfig.explore, "--explore", help=f"Exploration before learning: {', '.join(EXPLORATIONS)}."),
     exploration_steps: int = typer.Option(SACConfig.exploration_steps, "--exploration-steps", help="Steps of exploration before learning starts."),
     tactile: bool = typer.Option(True, "--tactile/--no-tactile", help="Observe the fingertips' tactile images."),
-    joints: str = typer.Option(",".join(EnvConfig.actuated), "--joints", help="Finger joints the policy moves, from abd,mcp,pip,dip; the others hold still."),
+    joints: str = typer.Option(",".join(TRAIN_JOINTS), "--joints", help="Finger joints the policy moves, from abd,mcp,pip,dip; the others hold still."),
     fingering_gate: bool = typer.Option(RewardConfig.fingering_gate, "--fingering/--no-fingering", help="Credit a key only when the score's finger pressed it."),
     force: bool = typer.Option(False, "--force", help="Retrain phrases that already have a stored policy."),
     models: Path = typer.Option(Path("models"), "--models", help="Folder of the model store."),
@@ -303,6 +304,8 @@ def train(
     actuated = tuple(j.strip() for j in joints.split(",") if j.strip())
     if not actuated or set(actuated) - set(JOINT_KINDS):
         raise PianobotError(f"--joints {joints}: name finger joints from {','.join(JOINT_KINDS)}, e.g. mcp,pip")
+    if until_f1 is not None and not 0.0 < until_f1 <= 1.0:
+        raise PianobotError(f"--until-f1 {until_f1}: give a note F1 between 0 and 1, e.g. 0.95")
     if workers < 1 or threads < 1:
         raise PianobotError(f"--workers {workers} --threads {threads}: give 1 or more of each")
     if models.exists() and not models.is_dir():
@@ -311,7 +314,7 @@ def train(
     world = WorldConfig(keyboard=KeyboardConfig(spec=keyboard), hand=HandConfig(spec=hand), control=control)
     env = EnvConfig(world=world, reward=RewardConfig(kind=reward, fingering_gate=fingering_gate), tactile=tactile,
                     actuated=tuple(j for j in JOINT_KINDS if j in actuated))
-    config = TrainConfig(steps=steps, seed=seed, explore=explore, sac=SACConfig(exploration_steps=exploration_steps), env=env)
+    config = TrainConfig(steps=steps, seed=seed, explore=explore, until_f1=until_f1, sac=SACConfig(exploration_steps=exploration_steps), env=env)
     if task is not None:
         jobs = [PhraseJob(f"task-{task}", task, store.model_dir(models, f"task-{task}", config), [0], f"task {task}")]
         todo = [j for j in jobs if force or not store.is_trained(j.folder)]

@@ -86,6 +86,7 @@ class CompositionalController:
                 raise PianobotError(f"phrase {phrase.index} has no trained policy in {models}")
             self.sections.append(Section(phrase, first, timeline, controller, source))
             previous_last_onset = lead + spec.step_of(phrase.notes[-1].onset)
+        self.env = env
         self.lookahead = env.config.lookahead
         self.actuated = env.actuated
         self.step = 0
@@ -109,6 +110,8 @@ class CompositionalController:
         section = self.section_at(self.step)
         window = section.score[self.step : self.step + self.lookahead + 1]
         observation = {**observation, "score": window}
+        if "targets" in observation:  # what the phrase's own window asks of each finger
+            observation["targets"] = self.env.targets(window)
         self.step += 1
         if isinstance(section.controller, ScriptedPianist):
             return section.controller.act(observation)[self.actuated]  # the joints the policies move

@@ -19,7 +19,7 @@ import numpy as np
 
 from pianobot.env import EnvConfig
 from pianobot.music.tensor import FINGER, NOTE, VELOCITY
-from pianobot.sim.hand import FINGER_BASE_X, finger_ik, lowest_point_in_finger_plane
+from pianobot.sim.hand import FINGER_BASE_X, PREFERRED_TILT, finger_ik, lowest_point_in_finger_plane
 from pianobot.sim.keyboard import BLACK_STRIKE_FROM_FRONT, WHITE_STRIKE_FROM_FRONT, key_boxes
 
 
@@ -83,6 +83,8 @@ class ScriptedPianist:
     """Control steps a finger needs to lift, move over and settle before a strike from the ready height."""
     hold_slide = 0.008
     """How far (m) the wrist may move in one step while a finger holds a key."""
+    tilt_step = 0.15
+    """Most change (rad) of the fingertip's tilt the IK asks for in one control step."""
     hold_reach = 0.030
     """How far (m) the wrist may be from straight over a held key (the abduction makes up for it)."""
     white_gain = 1.0
@@ -123,9 +125,15 @@ class ScriptedPianist:
         return self.black_contact_y if self.black[key] else self.white_contact_y
 
     def _ik(self, reach: float, drop: float, current: np.ndarray) -> np.ndarray:
-        """Flexion angles for a fingertip target; out of reach, the finger keeps its shape."""
+        """Flexion angles for a fingertip target; out of reach, the finger keeps its shape.
+
+        The fingertip's tilt moves towards the preferred one by at most :attr:`tilt_step` per
+        step: letting the IK pick any tilt can flip the finger between very different shapes
+        from one step to the next, faster than its joints follow."""
+        tilt = float(np.sum(current))
+        tilt += float(np.clip(PREFERRED_TILT - tilt, -self.tilt_step, self.tilt_step))
         for change in (0.0, 0.002, -0.002, 0.004, -0.004, 0.008, 0.012, 0.016, 0.02):
-            q = finger_ik(self.geometry, reach, drop + change)  # the nearest height this finger can reach there
+            q = finger_ik(self.geometry, reach, drop + change, tilt)  # the nearest height this finger can reach there
             if q is not None:
                 return q
         return current
@@ -310,7 +318,10 @@ class ScriptedPianist:
         crossing = (reach > band_reach) != (now_reach > band_reach)
         safe = self.black_rise + self.band_clearance
         if crossing and now_height < safe:
-            reach, height = now_reach, safe
+            if reach < now_reach or finger_ik(geometry, now_reach, hand.palm_height - safe) is not None:
+                reach, height = now_reach, safe
+            else:  # curled too close to the palm to rise here: rise while reaching out towards the black key
+                reach, height = now_reach + min(self.max_move, reach - now_reach), safe
         if phase not in ("strike", "hold"):  # positioning moves go in short straight steps, so the tip never dips
             move = np.array([reach - now_reach, height - now_height])
             length = float(np.hypot(*move))

@@ -6,9 +6,11 @@ lead-in (the hand gets ready), the phrase, and a short tail; its end is ``trunca
 
 Observations (a dict, see docs/environment.md): the score's L x (2+F) matrix for the current
 step and ``lookahead`` following steps; the fingertips' tactile images of the last two steps
-(uint8, pooled by default); wrist position and speed; finger joint angles and speeds; and, only
-when asked for (the paper's ablation), key angles and speeds. Actions: finger joints (4 per
-finger) then the wrist, each in [-1, 1].
+(uint8, pooled by default); wrist position and speed; finger joint angles and speeds; for each
+finger, where the next key it has to play lies relative to its fingertip (our addition, see
+docs/training.md); and, only when asked for (the paper's ablation), key angles and speeds.
+Actions: the actuated finger joints (of abduction, MCP, PIP, DIP per finger) then the wrist,
+each in [-1, 1].
 """
 
 from __future__ import annotations
@@ -53,6 +55,28 @@ def _bounded(values) -> np.ndarray:
     return np.clip(np.asarray(values, dtype=np.float32), -SPEED_BOUND, SPEED_BOUND)
 
 
+TARGET_SCALE = 0.1
+"""Fingertip-to-key offsets are observed in units of this many metres (clipped to +-SPEED_BOUND)."""
+
+
+def finger_targets(window: np.ndarray, tips: dict[int, np.ndarray], points: np.ndarray, fingers: tuple[int, ...]) -> np.ndarray:
+    """For each finger, the next key it plays in the score ``window`` (steps x keys x channels):
+    the offset (x, y, z) from its fingertip to that key's strike point in units of
+    :data:`TARGET_SCALE`, and how soon, 1 for now falling to 0 for "not in the window".
+
+    The score names keys by index; this says where they are for the hand, which is what a
+    policy would otherwise have to learn for every key separately.
+    """
+    targets = np.zeros((len(fingers), 4), np.float32)
+    steps = len(window)
+    for i, finger in enumerate(fingers):
+        rows, keys = np.nonzero(window[:, :, FINGER + i] > 0.5)
+        if rows.size:
+            targets[i, :3] = (points[keys[0]] - tips[finger]) / TARGET_SCALE
+            targets[i, 3] = 1.0 - rows[0] / steps
+    return np.clip(targets, -SPEED_BOUND, SPEED_BOUND)
+
+
 @dataclass(frozen=True)
 class EnvConfig:
     """Everything that shapes an episode, its observations and its reward."""
@@ -73,11 +97,14 @@ class EnvConfig:
     """Seconds before the first note, for the hand to get ready (the wrist may have to cross the keyboard)."""
     tail: float = 0.25
     """Seconds after the last note ends."""
+    target_observations: bool = True
+    """Observe each finger's offset to the next key it plays (not in the paper; see docs/training.md)."""
     random_start: bool = True
     """Start the wrist at a random position along the keyboard (else at its centre)."""
-    actuated: tuple[str, ...] = ("abd", "mcp", "pip", "dip")
+    actuated: tuple[str, ...] = JOINT_KINDS
     """Finger joints the policy moves; the others hold their starting angle (the paper froze the
-    joints not crucial to a task). E.g. ("mcp", "pip") leaves 2 per finger plus the wrist."""
+    joints not crucial to a task). E.g. ("mcp", "pip") leaves 2 per finger plus the wrist, the
+    training default (:data:`pianobot.train.TRAIN_JOINTS`)."""
 
     @property
     def score_spec(self) -> ScoreSpec:
@@ -123,6 +150,8 @@ class PianoEnv(gym.Env):
             "joints": spaces.Box(-np.pi, np.pi, (self.n_joints,), np.float32),
             "joint_velocities": spaces.Box(-SPEED_BOUND, SPEED_BOUND, (self.n_joints,), np.float32),
         }
+        if config.target_observations:
+            obs["targets"] = spaces.Box(-SPEED_BOUND, SPEED_BOUND, (self.n_fingers, 4), np.float32)
         if config.tactile:
             rows, cols = config.tactile_pool or (config.tactile_sensor.rows, config.tactile_sensor.cols)
             obs["tactile"] = spaces.Box(0, 255, (2, self.n_fingers, rows, cols), np.uint8)
@@ -217,6 +246,10 @@ class PianoEnv(gym.Env):
         tips = self.world.tip_points()
         return np.array([np.linalg.norm(tips[window[rows[0], k]] - self.strike_points[k]) for k in keys])
 
+    def targets(self, window: np.ndarray) -> np.ndarray:
+        """:func:`finger_targets` for a score window, from the hand's current pose."""
+        return finger_targets(window, self.world.tip_points(), self.strike_points, self.spec_score.hand.fingers)
+
     def _tactile_image(self) -> np.ndarray:
         angles, _ = self.world.key_state()
         forces = self.world.tip_forces()
@@ -239,6 +272,8 @@ class PianoEnv(gym.Env):
             "joints": angles.astype(np.float32),
             "joint_velocities": _bounded(speeds / hand.max_joint_speed),
         }
+        if cfg.target_observations:
+            obs["targets"] = self.targets(obs["score"])
         if self.tactile is not None:
             obs["tactile"] = np.stack(self.tactile_history)
         if cfg.key_observations:

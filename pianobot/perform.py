@@ -15,7 +15,7 @@ from typing import Callable, Protocol
 import numpy as np
 
 from pianobot.controllers import RandomController, ScriptedPianist
-from pianobot.env import EnvConfig, PianoEnv
+from pianobot.env import JOINT_KINDS, EnvConfig, PianoEnv
 from pianobot.errors import PianobotError
 from pianobot.files import check_writable, move_into_place, temporary_beside
 from pianobot.music.piece import Piece
@@ -51,7 +51,7 @@ def make_controller(name: str, env: PianoEnv, seed: int | None = None) -> Contro
 def perform(
     piece: Piece,
     controller: str | Callable[[PianoEnv], Controller] = "scripted",
-    config: EnvConfig = EnvConfig(tactile=False),
+    config: EnvConfig = EnvConfig(tactile=False, actuated=JOINT_KINDS),
     seed: int = 0,
     video: bool = False,
     on_step: Callable[[int, int], None] | None = None,

@@ -57,7 +57,7 @@ class SACConfig:
 
 
 # -- observation layout -----------------------------------------------------------------------
-VECTOR_KEYS = ("score", "wrist", "joints", "joint_velocities", "keys", "key_velocities")
+VECTOR_KEYS = ("score", "wrist", "joints", "joint_velocities", "targets", "keys", "key_velocities")
 
 
 def vector_size(observation_space) -> int:

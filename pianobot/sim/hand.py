@@ -181,7 +181,11 @@ def lowest_point_in_finger_plane(geometry: FingerGeometry, flexion: np.ndarray) 
     return reach + centre * math.cos(a3), drop + centre * math.sin(a3) + geometry.tip_radius
 
 
-def finger_ik(geometry: FingerGeometry, reach: float, drop: float, tilt: float = 1.1) -> np.ndarray | None:
+PREFERRED_TILT = 1.1
+"""The distal link's preferred angle below the horizontal (rad) when a fingertip meets a key."""
+
+
+def finger_ik(geometry: FingerGeometry, reach: float, drop: float, tilt: float = PREFERRED_TILT) -> np.ndarray | None:
     """MCP, PIP and DIP angles that put the fingertip's lowest point at (reach, drop).
 
     Three joints for two coordinates leave one freedom: the distal link's angle below the

@@ -1,0 +1,192 @@
+"""Automatic fingering for the robot hand: dynamic programming over the piece's chords.
+
+The hand slides on a rail along the keyboard; each finger's base sits at a fixed offset from the
+wrist (:data:`pianobot.sim.hand.FINGER_BASE_X`) and reaches sideways by abduction. A *state* is
+one way of playing one chord (a melody note is a chord of one): which finger takes each note and
+where the wrist stands, on a grid of a quarter of a white key. The planner finds the sequence of
+states with the lowest total cost:
+
+- **wrist travel** in white keys, plus a fixed cost for every move (fewer, larger moves are
+  easier to play than many small ones);
+- **stretch**: each finger's sideways offset from straight over its key, squared, in units of
+  its reach (a finger straight over its key strikes most reliably);
+- a **hop** cost when one finger plays two different keys in a row.
+
+Hard constraints (what this hand cannot do): a finger reaches at most :data:`REACH_FRACTION` of
+what its abduction limit allows; simultaneous notes take distinct fingers in pitch order; a
+finger still holding a key is not reused and the wrist keeps that key in its reach; fingertips
+never cross each other in the hand's frame between consecutive chords; and the wrist moves at
+most as fast as its motor allows in the time between onsets, less the time a finger needs to
+lift and settle. Where the tempo makes that last one impossible, the planner still returns its
+best fingering and says which notes and why (:attr:`FingeringPlan.problems`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from itertools import combinations
+
+import numpy as np
+
+from pianobot.errors import PianobotError
+from pianobot.music.piece import Note, Piece
+from pianobot.sim.hand import FINGER_BASE_X, HandConfig
+from pianobot.sim.keyboard import KeyboardConfig, key_boxes, keyboard_width, strike_points
+
+REACH_FRACTION = 0.75
+"""Share of the abduction limit's sideways reach the planner uses (the rest is margin for aim)."""
+BLACK_REACH = 0.6
+"""Share of that reach used on black keys: a slanted fingertip easily slips off their narrow tops."""
+GRID = 4
+"""Wrist positions per white key."""
+MOVE_COST = 0.5
+"""Cost of any wrist move, in white keys of travel."""
+STRETCH_COST = 0.5
+"""Cost of a finger at the edge of its reach (scales with the offset squared)."""
+HOP_COST = 3.0
+"""Cost of one finger playing two different keys in a row."""
+TIP_GAP = 0.015
+"""Least sideways distance (m) between two fingertips, in the hand's frame."""
+SETTLE_TIME = 0.2
+"""Seconds a finger needs to lift and settle around a wrist move (the scripted pianist's 4 steps)."""
+_INFEASIBLE = 1e9
+_TOO_FAST = 1e3
+
+
+@dataclass(frozen=True)
+class FingeringPlan:
+    """The planner's result: the fingered piece, the wrist's path and what could not be met."""
+
+    piece: Piece
+    wrist: tuple[float, ...]
+    """Wrist position (m along the rail) for each chord, in time order."""
+    travel: float
+    """Total wrist travel (m)."""
+    moves: int
+    """Number of wrist moves."""
+    problems: tuple[str, ...] = field(default=())
+    """Notes this hand cannot play as written at this tempo, and why."""
+
+
+class Planner:
+    """Fingering for one hand on one keyboard."""
+
+    def __init__(self, keyboard: KeyboardConfig = KeyboardConfig(), hand: HandConfig = HandConfig()):
+        self.keyboard, self.hand = keyboard, hand
+        self.spec = keyboard.spec
+        self.fingers = hand.spec.fingers
+        self.key_x = np.array([b.center[0] for b in key_boxes(keyboard)])
+        # sideways reach at the white keys' strike points; black keys get no more, since a
+        # slanted fingertip easily slips off their narrow tops
+        forward = hand.palm_y - strike_points(keyboard)[:, 1].max()
+        black = np.array([b.black for b in key_boxes(keyboard)])
+        self.reach = REACH_FRACTION * forward * math.tan(hand.geometry.abduction_limit) * np.where(black, BLACK_REACH, 1.0)
+        self.pitch = keyboard.geometry.white_pitch
+        self.grid = np.arange(0.0, keyboard_width(keyboard) + 1e-9, self.pitch / GRID)
+
+    # -- one chord ---------------------------------------------------------------------------
+    def _states(self, chord: tuple[Note, ...]) -> tuple[list[tuple[int, ...]], np.ndarray, np.ndarray]:
+        """Finger assignments (pitch order = finger order), and per assignment and wrist
+        position: the stretch cost (inf where a finger cannot reach its key) and the offsets."""
+        keys = [self.spec.index(n.pitch) for n in chord]
+        assignments = list(combinations(self.fingers, len(chord)))
+        cost = np.zeros((len(assignments), len(self.grid)))
+        for a, fingers in enumerate(assignments):
+            for key, finger in zip(keys, fingers):
+                offset = (self.key_x[key] - self.grid - FINGER_BASE_X[finger]) / self.reach[key]
+                cost[a] += np.where(np.abs(offset) <= 1.0, STRETCH_COST * offset**2, _INFEASIBLE)
+        return assignments, keys, cost
+
+    def _transition(self, prev: tuple, chord: tuple, fingers_prev: tuple, fingers: tuple, held: list[bool]) -> np.ndarray:
+        """Cost (W_prev x W) of going from one state's fingers to the next's, for every pair of wrist positions."""
+        (prev_notes, prev_keys), (notes, keys) = prev, chord
+        move = self.grid[None, :] - self.grid[:, None]  # wrist displacement, rows: from, columns: to
+        cost = np.abs(move) / self.pitch + MOVE_COST * (np.abs(move) > 1e-9)
+        for key_p, finger_p, is_held in zip(prev_keys, fingers_prev, held):
+            if is_held:  # still sounding at the next onset: finger busy, key kept in reach
+                if finger_p in fingers:
+                    return np.full_like(cost, _INFEASIBLE)
+                offset = np.abs(self.key_x[key_p] - self.grid - FINGER_BASE_X[finger_p]) / self.reach[key_p]
+                cost = cost + np.where(offset <= 1.0, 0.0, _INFEASIBLE)[None, :]
+            for key, finger in zip(keys, fingers):
+                if finger == finger_p:
+                    cost = cost + (HOP_COST if key != key_p else 0.0)
+                    continue
+                # in the hand's frame the new fingertip lies on its own side of the old one
+                relative = (self.key_x[key] - self.key_x[key_p]) - move
+                cost = cost + np.where(np.sign(finger - finger_p) * relative >= TIP_GAP, 0.0, _INFEASIBLE)
+        return cost
+
+    # -- the whole piece ---------------------------------------------------------------------
+    def plan(self, piece: Piece) -> FingeringPlan:
+        chords = piece.chords()
+        too_many = next((c for c in chords if len(c) > len(self.fingers)), None)
+        if too_many is not None:
+            raise PianobotError(
+                f"{len(too_many)} notes start together at {too_many[0].onset:.3f} s ({', '.join(n.name for n in too_many)}) "
+                f"but the hand has {len(self.fingers)} fingers: drop notes from that chord (e.g. with --track) or enable the thumb with --thumb"
+            )
+        states, totals, back = [], [], []
+        for i, chord in enumerate(chords):
+            assignments, keys, local = self._states(chord)
+            if np.all(local >= _INFEASIBLE):
+                span = abs(self.key_x[keys[-1]] - self.key_x[keys[0]]) * 100
+                raise PianobotError(
+                    f"the chord {' '.join(n.name for n in chord)} at {chord[0].onset:.3f} s spans {span:.1f} cm, "
+                    "more than this hand reaches: drop a note from it or transpose part of it"
+                )
+            if i == 0:
+                total = local.ravel()
+                back.append(None)
+            else:
+                p_assign, p_keys = states[-1][0], states[-1][1]
+                prev_chord = chords[i - 1]
+                onset = chord[0].onset
+                held = [n.offset > onset + 1e-6 for n in prev_chord]
+                time = onset - prev_chord[0].onset
+                limit = self.hand.max_wrist_speed * max(0.0, time - SETTLE_TIME)
+                too_fast = np.where(np.abs(self.grid[None, :] - self.grid[:, None]) <= limit + 1e-9, 0.0, _TOO_FAST)
+                blocks = np.empty((len(p_assign), len(self.grid), len(assignments), len(self.grid)))
+                for a_p, f_p in enumerate(p_assign):
+                    for a, f in enumerate(assignments):
+                        blocks[a_p, :, a, :] = self._transition((prev_chord, p_keys), (chord, keys), f_p, f, held) + too_fast
+                step = totals[-1][:, None] + blocks.reshape(len(totals[-1]), -1)
+                best = np.argmin(step, axis=0)
+                total = step[best, np.arange(step.shape[1])] + local.ravel()
+                back.append(best)
+            states.append((assignments, keys))
+            totals.append(total)
+
+        index = int(np.argmin(totals[-1]))
+        if totals[-1][index] >= _INFEASIBLE:
+            raise PianobotError("no fingering lets this hand play the piece: its voices cross or hold keys too far apart; play one voice (--track or --hand)")
+        path = [index]
+        for i in range(len(chords) - 1, 0, -1):
+            path.append(int(back[i][path[-1]]))
+        path.reverse()
+
+        fingers: list[int] = []  # piece.chords() groups piece.notes in order, each chord by pitch
+        wrist = []
+        for (assignments, _), state in zip(states, path):
+            a, w = divmod(state, len(self.grid))
+            wrist.append(float(self.grid[w]))
+            fingers.extend(assignments[a])
+        problems = []
+        for i in range(1, len(chords)):
+            time = chords[i][0].onset - chords[i - 1][0].onset
+            distance = abs(wrist[i] - wrist[i - 1])
+            if distance > self.hand.max_wrist_speed * max(0.0, time - SETTLE_TIME) + 1e-9:
+                problems.append(
+                    f"{' '.join(n.name for n in chords[i - 1])} at {chords[i - 1][0].onset:.3f} s -> "
+                    f"{' '.join(n.name for n in chords[i])} at {chords[i][0].onset:.3f} s: the wrist must move "
+                    f"{distance * 100:.1f} cm in {time:.3f} s, faster than this hand can (slow down with --tempo)"
+                )
+        moves = np.abs(np.diff(wrist)) > 1e-9
+        fingered = piece.with_fingers(fingers)
+        return FingeringPlan(fingered, tuple(wrist), float(np.abs(np.diff(wrist)).sum()), int(moves.sum()), tuple(problems))
+
+
+def plan_fingering(piece: Piece, keyboard: KeyboardConfig = KeyboardConfig(), hand: HandConfig = HandConfig()) -> FingeringPlan:
+    """The lowest-cost fingering of ``piece`` for ``hand`` on ``keyboard`` (see the module's notes)."""
+    return Planner(keyboard, hand).plan(piece)
