@@ -4,6 +4,10 @@ Run `make examples` (or `python examples/make_examples.py`). Every file is writt
 pianobot's own MIDI writer, so the fingering sits in lyric events as docs/fingering.md
 describes. All pieces fit the default keyboard (C4-B5) and the default hand (fingers 2, 3, 4).
 
+`minuet-performed.mid` is made to look like a recording of a human player (two named hand
+tracks, timing off the grid, overlapping legato, dynamics, pedal, a slowing tempo map, no
+fingering); it is generated, not recorded.
+
 Fingerings were chosen by hand for a three-finger hand: within one hand position the index,
 middle and ring fingers lie over three neighbouring white keys, and the wrist moves between
 positions.
@@ -11,8 +15,12 @@ positions.
 
 from __future__ import annotations
 
+import math
 from fractions import Fraction
 from pathlib import Path
+
+import mido
+import numpy as np
 
 from pianobot.music.midi_io import write_midi
 from pianobot.music.pig import write_pig
@@ -83,13 +91,68 @@ MELODIES = {
 SIDECAR = melody(80, "G4:1:2 A4:1:3 B4:1:4 A4:1:3 G4:2:2", [70, 80, 90, 80, 70])
 
 
+# The opening of the Minuet in G (BWV Anh. 114) as a two-hand piano part, no fingering: (pitch, beats).
+MINUET_RIGHT = (
+    "D5:1 G4:1/2 A4:1/2 B4:1/2 C5:1/2 D5:1 G4:1 G4:1 E5:1 C5:1/2 D5:1/2 E5:1/2 F#5:1/2 G5:1 G4:1 G4:1 "
+    "C5:1 D5:1/2 C5:1/2 B4:1/2 A4:1/2 B4:1 C5:1/2 B4:1/2 A4:1/2 G4:1/2 F#4:1 G4:1/2 A4:1/2 B4:1/2 G4:1/2 "
+    "A4:3 D5:1 G4:1/2 A4:1/2 B4:1/2 C5:1/2 D5:1 G4:1 G4:1 E5:1 C5:1/2 D5:1/2 E5:1/2 F#5:1/2 G5:1 G4:1 G4:1 "
+    "C5:1 D5:1/2 C5:1/2 B4:1/2 A4:1/2 B4:1 C5:1/2 B4:1/2 A4:1/2 G4:1/2 A4:1 B4:1/2 A4:1/2 G4:1/2 F#4:1/2 G4+B4+D5+G5:3"
+)
+MINUET_LEFT = "G3+B3:2 A3:1 B3:3 C4:3 B3:3 A3:3 G3:3 D4:1 B3:1 G3:1 D4:1 D3:1 C4:1 " * 1 + (
+    "B3:3 C4:3 B3:3 A3:3 G3:3 D3:3 G3:3 D3:3 G2:3"
+)
+
+
+def performed(right: str, left: str, bpm: float, seed: int = 0) -> mido.MidiFile:
+    """A two-track file the way a recording of a human player looks: named hand tracks, timing a
+    little off the beat, legato notes overlapping, dynamics that swell and fade, a tempo map that
+    slows at the end, and the sustain pedal changed every bar; no fingering."""
+    rng = np.random.default_rng(seed)
+    tpb = 480
+    midi = mido.MidiFile(type=1, ticks_per_beat=tpb)
+    conductor = mido.MidiTrack([mido.MetaMessage("track_name", name="tempo", time=0)])
+    total_beats = sum(float(Fraction(t.split(":")[1])) for t in right.split())
+    changes = [(0, bpm), (total_beats - 6, bpm * 0.92), (total_beats - 3, bpm * 0.8)]
+    last = 0
+    for beat, tempo in changes:
+        tick = round(beat * tpb)
+        conductor.append(mido.MetaMessage("set_tempo", tempo=mido.bpm2tempo(tempo), time=tick - last))
+        last = tick
+    midi.tracks.append(conductor)
+    for name, part, base in (("Right Hand", right, 76), ("Left Hand", left, 56)):
+        events, beat = [], 0.0
+        for token in part.split():
+            pitches, beats = token.split(":")
+            length = float(Fraction(beats))
+            phrase = math.sin(math.pi * (beat % 12) / 12)  # swell within each four-bar phrase
+            for pitch in pitches.split("+"):
+                on = max(0, round((beat + rng.normal(0, 0.02)) * tpb))
+                off = round((beat + length + rng.uniform(0.0, 0.08)) * tpb)  # legato: a little into the next note
+                velocity = int(np.clip(base + 18 * phrase + rng.normal(0, 5), 20, 120))
+                events += [(on, 1, mido.Message("note_on", note=parse_pitch(pitch), velocity=velocity)),
+                           (off, 0, mido.Message("note_off", note=parse_pitch(pitch), velocity=40))]
+            beat += length
+        if name == "Right Hand":
+            for bar in range(int(beat // 3) + 1):  # pedal up and down again just after each downbeat
+                events += [(bar * 3 * tpb + 30, 0, mido.Message("control_change", control=64, value=0)),
+                           (bar * 3 * tpb + 60, 1, mido.Message("control_change", control=64, value=100))]
+        track = mido.MidiTrack([mido.MetaMessage("track_name", name=name, time=0)])
+        last = 0
+        for tick, _, message in sorted(events, key=lambda e: (e[0], e[1])):
+            track.append(message.copy(time=tick - last))
+            last = tick
+        midi.tracks.append(track)
+    return midi
+
+
 def main() -> None:
     OUT.mkdir(parents=True, exist_ok=True)
     for name, piece in {**TASKS, **MELODIES}.items():
         write_midi(piece, OUT / f"{name}.mid", name=name)
     write_midi(SIDECAR.without_fingering(), OUT / "five-finger-sidecar.mid", name="five-finger-sidecar")
     write_pig(SIDECAR, OUT / "five-finger-sidecar_fingering.txt")
-    print(f"wrote {len(TASKS) + len(MELODIES) + 1} pieces to {OUT}")
+    performed(MINUET_RIGHT, MINUET_LEFT, bpm=84).save(OUT / "minuet-performed.mid")
+    print(f"wrote {len(TASKS) + len(MELODIES) + 2} pieces to {OUT}")
 
 
 if __name__ == "__main__":

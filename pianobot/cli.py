@@ -32,7 +32,8 @@ from pianobot.music.tasks import TASKS
 from pianobot.rewards import REWARDS, RewardConfig
 from pianobot.sim.world import CONTROL_MODES
 from pianobot.train import TRAIN_JOINTS, PhraseJob, TrainConfig, plan_jobs, run_jobs
-from pianobot.music.load import LoadOptions, load_piece, load_playable
+from pianobot.fingering import ensure_fingering
+from pianobot.music.load import HANDS, LoadOptions, hand_tracks, load_part, load_piece
 from pianobot.music.midi_io import write_midi
 from pianobot.audio import write_wav
 from pianobot.compose import CompositionalController, missing_phrases, training_config
@@ -41,7 +42,7 @@ from pianobot.sim.hand import HandConfig
 from pianobot.sim.keyboard import KeyboardConfig
 from pianobot.sim.world import WorldConfig
 from pianobot.music.phrases import DEFAULT_MAX_NOTES, split_phrases
-from pianobot.music.piece import parse_pitch, pitch_name
+from pianobot.music.piece import Piece, parse_pitch, pitch_name
 
 app = typer.Typer(
     help="Teach a simulated robot hand with touch sensors to play the piano from MIDI files.",
@@ -91,10 +92,31 @@ LowestNote = typer.Option(
 Keys = typer.Option(KeyboardSpec.count, "--keys", help="Number of keys on the keyboard.")
 Thumb = typer.Option(False, "--thumb", help="Let the hand use its thumb (finger 1) too.")
 PhraseNotes = typer.Option(DEFAULT_MAX_NOTES, "--phrase-notes", help="Most notes in one phrase (one policy each).")
+Hand = typer.Option(None, "--hand", help="Play one hand's part of a two-hand piece: right or left (tracks named for it, else split by pitch).")
+Split = typer.Option("C4", "--split", help="With --hand and no track named for it: lowest note of the right hand's part.")
+Quantize = typer.Option(None, "--quantize", help="Move onsets and offsets to a grid, e.g. 1/16 (for recordings of human players).")
+Refinger = typer.Option(False, "--refinger", help="Replace the file's fingering with the planner's (e.g. human fingering for five fingers).")
 
 
-def make_options(track, tempo, transpose, fingering) -> LoadOptions:
-    return LoadOptions(track=track, tempo=tempo, transpose=transpose, fingering=fingering)
+def make_options(track, tempo, transpose, fingering, hand=None, split="C4", quantize=None, refinger=False) -> LoadOptions:
+    return LoadOptions(track=track, tempo=tempo, transpose=transpose, fingering=fingering, hand=hand,
+                       split=parse_pitch(split), quantize=quantize, refinger=refinger)
+
+
+def read_song(song: Path, options: LoadOptions, keyboard: KeyboardSpec, hand: HandSpec) -> Piece:
+    """Load a piece for this hand and keyboard; finger it with the planner when it has no fingering."""
+    piece = load_part(song, options, hand)
+    piece, plan = ensure_fingering(piece, keyboard, hand, options.refinger)
+    if plan is not None:
+        why = "--refinger" if options.refinger else "it has notes without fingering"
+        warnings.warn(PianobotWarning(
+            f"{song.name}: fingering planned for fingers {', '.join(map(str, hand.fingers))} ({why}): "
+            f"wrist travel {plan.travel * 100:.1f} cm in {plan.moves} moves; `pianobot finger` writes it to a file"
+        ))
+        for problem in plan.problems:
+            warnings.warn(PianobotWarning(problem))
+    check_playable(piece, keyboard, hand)
+    return piece
 
 
 def make_instrument(lowest_note: str, keys: int, thumb: bool) -> tuple[KeyboardSpec, HandSpec]:
@@ -111,28 +133,86 @@ def inspect(
     tempo: Optional[float] = Tempo,
     transpose: int = Transpose,
     fingering: Optional[Path] = Fingering,
+    hand_part: Optional[str] = Hand,
+    split: str = Split,
+    quantize: Optional[str] = Quantize,
+    refinger: bool = Refinger,
     lowest_note: str = LowestNote,
     keys: int = Keys,
     thumb: bool = Thumb,
     phrase_notes: int = PhraseNotes,
 ):
-    """Show a piece's tracks, notes with fingering, phrases, and whether the hand can play it."""
-    keyboard, hand = make_instrument(lowest_note, keys, thumb)
-    piece = load_piece(song, make_options(track, tempo, transpose, fingering))
+    """Explain what a file holds (tracks, hands, pedal, range, polyphony, fingering) and whether the hand can play it."""
+    keyboard, hand_spec = make_instrument(lowest_note, keys, thumb)
+    options = make_options(track, tempo, transpose, fingering, hand_part, split, quantize, refinger)
     if song.suffix.lower() != ".txt":
-        out.print(display.tracks_table(midi_io.describe_tracks(song)))
+        tracks = midi_io.describe_tracks(song)
+        hands = {i: h for h in HANDS for i in hand_tracks(tracks, h)}
+        out.print(display.tracks_table(tracks, hands))
+        with_notes = [t for t in tracks if t.notes]
+        pedal = sum(t.pedal for t in tracks)
+        out.print(
+            f"{len(with_notes)} track(s) with notes"
+            + (f"; named for hands: {', '.join(f'{i} {h}' for i, h in sorted(hands.items()))}" if hands else "")
+            + (f"; sustain pedal pressed {pedal} times (ignored: a note sounds while its key is down)" if pedal else "; no sustain pedal")
+        )
+        if len(with_notes) > 1 and track is None and hand_part is None:
+            out.print("[yellow]several tracks are merged; play one part with --track N or --hand right|left[/yellow]")
+    piece = load_part(song, options, hand_spec)
+    polyphony, _ = piece.max_polyphony()
+    given = sum(n.finger is not None for n in piece.notes)
+    low, high = min(n.pitch for n in piece.notes), max(n.pitch for n in piece.notes)
+    velocities = sorted({n.velocity for n in piece.notes})
+    out.print(
+        f"{len(piece)} notes, {piece.duration:.2f} s at {piece.bpm:.0f} bpm; range {pitch_name(low)}-{pitch_name(high)} "
+        f"({high - low} semitones); at most {polyphony} notes at once; velocities {velocities[0]}-{velocities[-1]}; "
+        f"{given}/{len(piece)} notes fingered in the file"
+    )
+    piece, plan = ensure_fingering(piece, keyboard, hand_spec, refinger)
+    if plan is not None:
+        out.print(f"fingering planned for fingers {hand_spec.describe()}: wrist travel {plan.travel * 100:.1f} cm in {plan.moves} moves")
+        for problem in plan.problems:
+            out.print(f"[yellow]{problem}[/yellow]")
     phrases = split_phrases(piece, phrase_notes)
     out.print(display.notes_table(piece, phrases))
     out.print(display.phrases_table(phrases))
-    polyphony, _ = piece.max_polyphony()
-    fingered = sum(n.finger is not None for n in piece.notes)
-    low, high = min(n.pitch for n in piece.notes), max(n.pitch for n in piece.notes)
+    check_playable(piece, keyboard, hand_spec)
+    out.print(f"[green]playable[/green] on {keyboard.describe()} with fingers {hand_spec.describe()}")
+
+
+@app.command()
+@friendly
+def finger(
+    song: Path = typer.Argument(..., help="A .mid file, with or without fingering."),
+    output: Path = typer.Option(..., "--output", "-o", help="Write the fingered piece to this .mid file."),
+    track: Optional[str] = Track,
+    tempo: Optional[float] = Tempo,
+    transpose: int = Transpose,
+    hand_part: Optional[str] = Hand,
+    split: str = Split,
+    quantize: Optional[str] = Quantize,
+    lowest_note: str = LowestNote,
+    keys: int = Keys,
+    thumb: bool = Thumb,
+):
+    """Plan a fingering for the robot hand (least wrist travel within its reach) and write it to a MIDI file."""
+    if output.suffix.lower() not in (".mid", ".midi"):
+        raise PianobotError(f"-o {output}: the fingered piece is a MIDI file, name it *.mid")
+    if output.resolve() == song.resolve():
+        raise PianobotError(f"-o {output} would overwrite the input: choose another file name")
+    check_writable(output)
+    keyboard, hand_spec = make_instrument(lowest_note, keys, thumb)
+    options = make_options(track, tempo, transpose, None, hand_part, split, quantize)
+    piece = load_part(song, options, hand_spec)
+    piece, plan = ensure_fingering(piece, keyboard, hand_spec, refinger=True)
+    write_midi(piece, output, name=f"{song.stem} fingered by pianobot")
+    out.print(display.notes_table(piece, split_phrases(piece, DEFAULT_MAX_NOTES)))
     out.print(
-        f"duration {piece.duration:.2f} s at {piece.bpm:.0f} bpm; range {pitch_name(low)}-{pitch_name(high)}; "
-        f"at most {polyphony} notes at once; {fingered}/{len(piece)} notes fingered"
+        f"fingering for fingers {hand_spec.describe()} written to {output}: wrist travel {plan.travel * 100:.1f} cm "
+        f"in {plan.moves} moves over {len(piece)} notes"
     )
-    check_playable(piece, keyboard, hand)
-    out.print(f"[green]playable[/green] on {keyboard.describe()} with fingers {hand.describe()}")
+    for problem in plan.problems:
+        out.print(f"[yellow]cannot be played at this tempo:[/yellow] {problem}")
 
 
 @app.command()
@@ -185,6 +265,10 @@ def play(
     tempo: Optional[float] = Tempo,
     transpose: int = Transpose,
     fingering: Optional[Path] = Fingering,
+    hand_part: Optional[str] = Hand,
+    split: str = Split,
+    quantize: Optional[str] = Quantize,
+    refinger: bool = Refinger,
     lowest_note: str = LowestNote,
     keys: int = Keys,
     thumb: bool = Thumb,
@@ -209,9 +293,7 @@ def play(
     if fallback not in (None, "scripted"):
         raise PianobotError(f"--fallback {fallback}: the only fallback is 'scripted'")
     keyboard, hand = make_instrument(lowest_note, keys, thumb)
-    piece = load_playable(song, make_options(track, tempo, transpose, fingering), keyboard, hand)
-    if not piece.has_fingering and (controller == "scripted" or fallback):
-        raise PianobotError(f"{song} has notes without fingering: the scripted pianist needs a finger for every note (see docs/fingering.md)")
+    piece = read_song(song, make_options(track, tempo, transpose, fingering, hand_part, split, quantize, refinger), keyboard, hand)
     world = WorldConfig(keyboard=KeyboardConfig(spec=keyboard), hand=HandConfig(spec=hand), gui=gui)
     config = EnvConfig(world=world, tactile=False, actuated=JOINT_KINDS)  # the scripted pianist moves every joint
     sources: dict = {}
@@ -281,6 +363,10 @@ def train(
     tempo: Optional[float] = Tempo,
     transpose: int = Transpose,
     fingering: Optional[Path] = Fingering,
+    hand_part: Optional[str] = Hand,
+    split: str = Split,
+    quantize: Optional[str] = Quantize,
+    refinger: bool = Refinger,
     lowest_note: str = LowestNote,
     keys: int = Keys,
     thumb: bool = Thumb,
@@ -321,9 +407,7 @@ def train(
         done = [j for j in jobs if j not in todo]
         label = f"task {task}"
     else:
-        piece = load_playable(song, make_options(track, tempo, transpose, fingering), keyboard, hand)
-        if not piece.has_fingering:
-            raise PianobotError(f"{song} has notes without fingering: training needs a finger for every note (see docs/fingering.md)")
+        piece = read_song(song, make_options(track, tempo, transpose, fingering, hand_part, split, quantize, refinger), keyboard, hand)
         phrases = split_phrases(piece, phrase_notes)
         todo, done = plan_jobs(phrases, config, models, force, piece=song.name)
         label = f"{song.name}: {len(phrases)} phrases"

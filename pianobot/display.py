@@ -8,7 +8,7 @@ from rich.table import Table
 from pianobot.metrics import Report
 from pianobot.music.midi_io import TrackInfo
 from pianobot.music.phrases import Phrase
-from pianobot.music.piece import FINGER_NAMES, Piece
+from pianobot.music.piece import FINGER_NAMES, Piece, pitch_name
 
 
 def _finger(finger: int | None) -> str:
@@ -19,12 +19,15 @@ def _opt(value, fmt: str) -> str:
     return "n/a" if value is None else format(value, fmt)
 
 
-def tracks_table(tracks: list[TrackInfo]) -> Table:
+def tracks_table(tracks: list[TrackInfo], hands: dict[int, str] | None = None) -> Table:
+    """The file's tracks; ``hands`` names the hand a track's name says it holds."""
     table = Table(title="tracks")
-    for column in ("track", "name", "notes", "channels"):
+    for column in ("track", "name", "notes", "range", "channels", "pedal", "hand"):
         table.add_column(column)
     for t in tracks:
-        table.add_row(str(t.index), t.name or "-", str(t.notes), ",".join(map(str, t.channels)) or "-")
+        span = f"{pitch_name(t.low)}-{pitch_name(t.high)}" if t.notes else "-"
+        table.add_row(str(t.index), t.name or "-", str(t.notes), span, ",".join(map(str, t.channels)) or "-",
+                      str(t.pedal) if t.pedal else "-", (hands or {}).get(t.index, "-"))
     return table
 
 

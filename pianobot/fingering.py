@@ -30,6 +30,7 @@ from itertools import combinations
 import numpy as np
 
 from pianobot.errors import PianobotError
+from pianobot.music.instrument import HandSpec, KeyboardSpec, check_playable
 from pianobot.music.piece import Note, Piece
 from pianobot.sim.hand import FINGER_BASE_X, HandConfig
 from pianobot.sim.keyboard import KeyboardConfig, key_boxes, keyboard_width, strike_points
@@ -160,7 +161,12 @@ class Planner:
 
         index = int(np.argmin(totals[-1]))
         if totals[-1][index] >= _INFEASIBLE:
-            raise PianobotError("no fingering lets this hand play the piece: its voices cross or hold keys too far apart; play one voice (--track or --hand)")
+            i = next(i for i, total in enumerate(totals) if total.min() >= _INFEASIBLE)
+            raise PianobotError(
+                f"no fingering lets this hand go from {' '.join(n.name for n in chords[i - 1])} to "
+                f"{' '.join(n.name for n in chords[i])} at {chords[i][0].onset:.3f} s: the notes held there cross or lie "
+                "too far apart for its fingers; play one voice (--track or --hand) or shorten the held notes"
+            )
         path = [index]
         for i in range(len(chords) - 1, 0, -1):
             path.append(int(back[i][path[-1]]))
@@ -185,6 +191,16 @@ class Planner:
         moves = np.abs(np.diff(wrist)) > 1e-9
         fingered = piece.with_fingers(fingers)
         return FingeringPlan(fingered, tuple(wrist), float(np.abs(np.diff(wrist)).sum()), int(moves.sum()), tuple(problems))
+
+
+def ensure_fingering(piece: Piece, keyboard: KeyboardSpec, hand: HandSpec, refinger: bool = False) -> tuple[Piece, FingeringPlan | None]:
+    """``piece`` as it is when every note has a finger (and not ``refinger``), else fingered by
+    the planner; the plan is returned too, or None when the piece kept its fingering."""
+    if piece.has_fingering and not refinger:
+        return piece, None
+    check_playable(piece.without_fingering(), keyboard, hand)  # on the keyboard, not too many notes at once
+    plan = plan_fingering(piece, KeyboardConfig(spec=keyboard), HandConfig(spec=hand))
+    return plan.piece, plan
 
 
 def plan_fingering(piece: Piece, keyboard: KeyboardConfig = KeyboardConfig(), hand: HandConfig = HandConfig()) -> FingeringPlan:

@@ -2,14 +2,15 @@
 
 from __future__ import annotations
 
+import re
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 from pianobot.errors import PianobotError, PianobotWarning
 from pianobot.music import midi_io, pig
 from pianobot.music.instrument import HandSpec, KeyboardSpec, check_playable
-from pianobot.music.piece import Piece
+from pianobot.music.piece import Note, Piece, pitch_name
 
 
 @dataclass(frozen=True)
@@ -24,6 +25,104 @@ class LoadOptions:
     """Shift every note by this many semitones."""
     fingering: Path | None = None
     """A PIG fingering file for the notes; None looks for the sidecar ``<name>_fingering.txt``."""
+    hand: str | None = None
+    """'right' or 'left': play that hand's part of a two-hand piece (tracks named for it, else
+    the notes above or below ``split``); chords are thinned to what the robot hand can hold."""
+    split: int = 60
+    """With ``hand`` and no track named for it: the lowest pitch of the right hand's part (60 = C4)."""
+    quantize: str | None = None
+    """Move onsets and offsets to this grid, e.g. '1/16' (for recordings of human players)."""
+    refinger: bool = False
+    """Replace the file's fingering with the planner's (see pianobot.fingering)."""
+
+
+HANDS = ("right", "left")
+_HAND_NAMES = {
+    "right": re.compile(r"right|\brh\b|\br\.h\.|treble|upper|melody", re.IGNORECASE),
+    "left": re.compile(r"left|\blh\b|\bl\.h\.|bass|lower|accomp", re.IGNORECASE),
+}
+
+
+def hand_tracks(tracks: list[midi_io.TrackInfo], hand: str) -> list[int]:
+    """Tracks with notes whose names say they hold ``hand``'s part ('Right Hand', 'RH', 'Treble'...)."""
+    return [t.index for t in tracks if t.notes and _HAND_NAMES[hand].search(t.name) and not _HAND_NAMES[_other(hand)].search(t.name)]
+
+
+def _other(hand: str) -> str:
+    return "left" if hand == "right" else "right"
+
+
+CHORD_SPREAD = 0.06
+"""Notes a human player starts within this many seconds of each other form one chord."""
+
+
+LEGATO_OVERLAP = 0.1
+"""A note that lasts at most this many seconds into the next chord ends where that chord starts."""
+
+
+def gather_chords(piece: Piece, spread: float = CHORD_SPREAD) -> list[tuple[Note, ...]]:
+    """Notes grouped into chords as :meth:`Piece.chords` does, but with a human player's spread:
+    each note joins the chord that started at most ``spread`` seconds before it, and takes its onset."""
+    groups: list[list[Note]] = []
+    for note in piece.notes:
+        if groups and note.onset - groups[-1][0].onset <= spread and note.pitch not in {n.pitch for n in groups[-1]}:
+            start = groups[-1][0].onset
+            groups[-1].append(replace(note, onset=start, offset=max(note.offset, start + 0.001)))
+        else:
+            groups.append([note])
+    return [tuple(g) for g in groups]
+
+
+def thin_chords(piece: Piece, fingers: int) -> tuple[Piece, int]:
+    """A human player's part made playable for a hand of ``fingers`` fingers: notes started
+    within :data:`CHORD_SPREAD` of each other form one chord; a note overlapping the next chord by
+    at most :data:`LEGATO_OVERLAP` ends where it starts; a chord keeps its highest ``fingers``
+    notes; and notes still held from before end where a new chord needs their fingers.
+    Returns the piece and how many notes were dropped."""
+    out: list[Note] = []
+    dropped = 0
+    for chord in gather_chords(piece):
+        onset = chord[0].onset
+        kept = sorted(chord, key=lambda n: n.pitch)[-fingers:]
+        dropped += len(chord) - len(kept)
+        for i, n in enumerate(out):  # a legato overlap is a player's habit, not a voice: it ends here
+            if onset < n.offset <= onset + LEGATO_OVERLAP:
+                out[i] = replace(n, offset=onset)
+        sounding = sorted((i for i, n in enumerate(out) if n.offset > onset), key=lambda i: (out[i].onset, out[i].pitch))
+        for i in sounding[: max(0, len(sounding) + len(kept) - fingers)]:
+            out[i] = replace(out[i], offset=onset)
+        out.extend(kept)
+    return Piece(tuple(out), bpm=piece.bpm), dropped
+
+
+def _read_midi(path: Path, options: LoadOptions, bpm: float | None = None) -> Piece:
+    grid = midi_io.parse_grid(options.quantize) if options.quantize else None
+    if options.hand is None:
+        return midi_io.read_midi(path, track=options.track, bpm=bpm, grid=grid)
+    if options.hand not in HANDS:
+        raise PianobotError(f"--hand {options.hand}: choose right or left")
+    if options.track is not None:
+        raise PianobotError("give --track or --hand, not both")
+    tracks = midi_io.describe_tracks(path)
+    named = hand_tracks(tracks, options.hand)
+    if named:
+        return midi_io.read_midi(path, tracks=named, bpm=bpm, grid=grid)
+    parts = [t for t in tracks if t.notes]
+    if len(parts) == 2:  # two unnamed parts: the higher one is the right hand's
+        high, low = sorted(parts, key=lambda t: t.low + t.high, reverse=True)
+        chosen = high if options.hand == "right" else low
+        warnings.warn(PianobotWarning(f"no track is named for a hand: took track {chosen.index} (the {'higher' if chosen is high else 'lower'} of two) as the {options.hand} hand"))
+        return midi_io.read_midi(path, tracks=[chosen.index], bpm=bpm, grid=grid)
+    warnings.warn(PianobotWarning(f"no track is named for a hand: took the notes {'at or above' if options.hand == 'right' else 'below'} {pitch_name(options.split)} (--split)"))
+    piece = midi_io.read_midi(path, bpm=bpm, grid=grid)
+    if options.hand == "right":
+        notes = [n for n in piece.notes if n.pitch >= options.split]
+    else:
+        notes = [n for n in piece.notes if n.pitch < options.split]
+    if not notes:
+        raise PianobotError(f"{path.name} has no notes {'at or above' if options.hand == 'right' else 'below'} "
+                            f"{pitch_name(options.split)} for the {options.hand} hand: move the split with --split")
+    return Piece(tuple(notes), bpm=piece.bpm)
 
 
 def load_piece(path: str | Path, options: LoadOptions = LoadOptions()) -> Piece:
@@ -34,9 +133,11 @@ def load_piece(path: str | Path, options: LoadOptions = LoadOptions()) -> Piece:
             raise PianobotError("--tempo needs a MIDI file: a PIG file has times in seconds but no beats")
         if options.fingering is not None:
             raise PianobotError("a PIG file carries its own fingering: drop --fingering")
+        if options.hand is not None or options.quantize is not None:
+            raise PianobotError("--hand and --quantize need a MIDI file")
         piece = pig.read_pig(path)
     else:
-        piece = midi_io.read_midi(path, track=options.track)
+        piece = _read_midi(path, options)
         sidecar = options.fingering or pig.sidecar_for(path)
         if options.fingering is not None or sidecar.exists():
             embedded = any(n.finger is not None for n in piece.notes)
@@ -48,15 +149,28 @@ def load_piece(path: str | Path, options: LoadOptions = LoadOptions()) -> Piece:
             fingers = [n.finger for n in piece.notes]
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore", PianobotWarning)  # already reported by the first read
-                retimed = midi_io.read_midi(path, track=options.track, bpm=options.tempo)
+                retimed = _read_midi(path, options, bpm=options.tempo)
             piece = retimed.with_fingers(fingers)
     if not piece.notes:
         raise PianobotError(f"{path} has no notes: give a MIDI file with at least one note")
     return piece.transpose(options.transpose)
 
 
-def load_playable(path: str | Path, options: LoadOptions, keyboard: KeyboardSpec, hand: HandSpec) -> Piece:
-    """:func:`load_piece`, then check that ``hand`` can play it on ``keyboard``."""
+def load_part(path: str | Path, options: LoadOptions, hand: HandSpec) -> Piece:
+    """:func:`load_piece`; with ``options.hand``, also thin chords to what ``hand`` can hold."""
     piece = load_piece(path, options)
+    if options.hand is not None:
+        piece, dropped = thin_chords(piece, len(hand.fingers))
+        if dropped:
+            warnings.warn(PianobotWarning(
+                f"the {options.hand} hand's part has chords of more than {len(hand.fingers)} notes: "
+                f"kept the highest {len(hand.fingers)}, dropped {dropped} note(s)"
+            ))
+    return piece
+
+
+def load_playable(path: str | Path, options: LoadOptions, keyboard: KeyboardSpec, hand: HandSpec) -> Piece:
+    """:func:`load_part`, then check that ``hand`` can play it on ``keyboard``."""
+    piece = load_part(path, options, hand)
     check_playable(piece, keyboard, hand)
     return piece

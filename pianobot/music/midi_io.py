@@ -38,6 +38,11 @@ class TrackInfo:
     name: str
     notes: int
     channels: tuple[int, ...]
+    pedal: int = 0
+    """Sustain pedal presses (control change 64 going down)."""
+    low: int | None = None
+    """Lowest and highest pitch played."""
+    high: int | None = None
 
 
 def parse_finger_text(text: str) -> list[int | None] | None:
@@ -138,8 +143,22 @@ def list_tracks(midi: mido.MidiFile) -> list[TrackInfo]:
     for i, track in enumerate(midi.tracks):
         name = next((m.name for m in track if m.type == "track_name"), "")
         ons = [m for m in track if m.type == "note_on" and m.velocity > 0]
-        infos.append(TrackInfo(i, name, len(ons), tuple(sorted({m.channel for m in ons}))))
+        pedal = sum(1 for m in track if m.type == "control_change" and m.control == 64 and m.value >= 64)
+        pitches = [m.note for m in ons]
+        infos.append(TrackInfo(i, name, len(ons), tuple(sorted({m.channel for m in ons})), pedal,
+                               min(pitches, default=None), max(pitches, default=None)))
     return infos
+
+
+def parse_grid(text: str) -> float:
+    """A quantisation grid like '1/16' (a sixteenth note) as a fraction of a whole note."""
+    try:
+        top, bottom = (int(part) for part in text.strip().split("/"))
+        if top < 1 or bottom < 1:
+            raise ValueError
+    except ValueError:
+        raise PianobotError(f"--quantize {text}: give a note value like 1/8, 1/16 or 1/12 (triplet eighths)") from None
+    return top / bottom
 
 
 def _select_tracks(midi: mido.MidiFile, track: str | int | None, path: Path) -> list[int]:
@@ -198,11 +217,17 @@ def _track_notes(
     return notes, fingering
 
 
-def read_midi(path: str | Path, *, track: str | int | None = None, bpm: float | None = None) -> Piece:
+def read_midi(
+    path: str | Path, *, track: str | int | None = None, bpm: float | None = None, grid: float | None = None,
+    tracks: list[int] | None = None,
+) -> Piece:
     """Read a .mid file into a :class:`Piece`, with fingering from lyric/text events.
 
-    ``track`` picks one track by index or name (default: all tracks merged). ``bpm`` re-times
-    the piece at a constant tempo, ignoring the file's tempo map.
+    ``track`` picks one track by index or name (``tracks`` several by index; default: all
+    tracks merged). ``bpm`` re-times the piece at a constant tempo, ignoring the file's tempo
+    map. ``grid`` (a fraction of a whole note, e.g. 1/16) moves every onset and offset to the
+    nearest grid line, in the file's beats, for recordings of human players; a note lasts at
+    least one grid step. Sustain-pedal events are ignored: a note sounds while its key is down.
     """
     path = Path(path)
     midi = _load(path)
@@ -217,9 +242,15 @@ def read_midi(path: str | Path, *, track: str | int | None = None, bpm: float | 
         seconds = tempo_map.seconds
         nominal = max(10.0, min(1000.0, mido.tempo2bpm(tempo_map.first_tempo)))
 
+    if grid is not None:
+        step = max(1, round(midi.ticks_per_beat * 4 * grid))
+        snap = lambda tick: round(tick / step) * step  # noqa: E731
     notes: list[Note] = []
-    for index in _select_tracks(midi, track, path):
+    for index in tracks if tracks is not None else _select_tracks(midi, track, path):
         raw, fingering = _track_notes(midi.tracks[index], index, seconds, path)
+        if grid is not None:
+            raw = [(snap(on), max(snap(off), snap(on) + step), pitch, vel) for on, off, pitch, vel in raw]
+            fingering = {snap(tick): fingers for tick, fingers in fingering.items()}
         by_tick: dict[int, list[tuple[int, int, int, int]]] = defaultdict(list)
         for item in raw:
             by_tick[item[0]].append(item)
