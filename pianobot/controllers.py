@@ -312,8 +312,8 @@ class ScriptedPianist:
             over = self.black_rise if now_reach > hand.palm_y - self.black_band_y else 0.0
             if now_height < over + self.clearance:
                 abduction = float(q[0])  # straight up out of the key before swinging sideways
-        elif abs(reach - now_reach) > self.path_tolerance:
-            height = max(height, now_height)
+        elif phase != "hold" and abs(reach - now_reach) > self.path_tolerance:
+            height = max(height, now_height)  # (a held key stays pressed while the wrist slides)
         band_reach = hand.palm_y - self.black_band_y  # a tip reaching further lies over the black keys
         crossing = (reach > band_reach) != (now_reach > band_reach)
         safe = self.black_rise + self.band_clearance

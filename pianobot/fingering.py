@@ -41,12 +41,16 @@ BLACK_REACH = 0.6
 """Share of that reach used on black keys: a slanted fingertip easily slips off their narrow tops."""
 GRID = 4
 """Wrist positions per white key."""
-MOVE_COST = 0.5
+MOVE_COST = 1.0
 """Cost of any wrist move, in white keys of travel."""
 STRETCH_COST = 0.5
 """Cost of a finger at the edge of its reach (scales with the offset squared)."""
-HOP_COST = 3.0
-"""Cost of one finger playing two different keys in a row."""
+HOP_COST = 0.75
+"""Cost of one finger playing two different keys in a row, with time to spare."""
+HARD_HOP_COST = 3.0
+"""The same when the onsets are less than :data:`HOP_TIME` apart (lift, move over, strike), or
+from or to a black key (the fingertip must rise over it and move along the keys too)."""
+HOP_TIME = 0.4
 TIP_GAP = 0.015
 """Least sideways distance (m) between two fingertips, in the hand's frame."""
 SETTLE_TIME = 0.2
@@ -81,8 +85,8 @@ class Planner:
         # sideways reach at the white keys' strike points; black keys get no more, since a
         # slanted fingertip easily slips off their narrow tops
         forward = hand.palm_y - strike_points(keyboard)[:, 1].max()
-        black = np.array([b.black for b in key_boxes(keyboard)])
-        self.reach = REACH_FRACTION * forward * math.tan(hand.geometry.abduction_limit) * np.where(black, BLACK_REACH, 1.0)
+        self.black = np.array([b.black for b in key_boxes(keyboard)])
+        self.reach = REACH_FRACTION * forward * math.tan(hand.geometry.abduction_limit) * np.where(self.black, BLACK_REACH, 1.0)
         self.pitch = keyboard.geometry.white_pitch
         self.grid = np.arange(0.0, keyboard_width(keyboard) + 1e-9, self.pitch / GRID)
 
@@ -99,7 +103,7 @@ class Planner:
                 cost[a] += np.where(np.abs(offset) <= 1.0, STRETCH_COST * offset**2, _INFEASIBLE)
         return assignments, keys, cost
 
-    def _transition(self, prev: tuple, chord: tuple, fingers_prev: tuple, fingers: tuple, held: list[bool]) -> np.ndarray:
+    def _transition(self, prev: tuple, chord: tuple, fingers_prev: tuple, fingers: tuple, held: list[bool], time: float) -> np.ndarray:
         """Cost (W_prev x W) of going from one state's fingers to the next's, for every pair of wrist positions."""
         (prev_notes, prev_keys), (notes, keys) = prev, chord
         move = self.grid[None, :] - self.grid[:, None]  # wrist displacement, rows: from, columns: to
@@ -112,7 +116,8 @@ class Planner:
                 cost = cost + np.where(offset <= 1.0, 0.0, _INFEASIBLE)[None, :]
             for key, finger in zip(keys, fingers):
                 if finger == finger_p:
-                    cost = cost + (HOP_COST if key != key_p else 0.0)
+                    easy = time >= HOP_TIME and not (self.black[key] or self.black[key_p])
+                    cost = cost + (0.0 if key == key_p else HOP_COST if easy else HARD_HOP_COST)
                     continue
                 # in the hand's frame the new fingertip lies on its own side of the old one
                 relative = (self.key_x[key] - self.key_x[key_p]) - move
@@ -151,7 +156,7 @@ class Planner:
                 blocks = np.empty((len(p_assign), len(self.grid), len(assignments), len(self.grid)))
                 for a_p, f_p in enumerate(p_assign):
                     for a, f in enumerate(assignments):
-                        blocks[a_p, :, a, :] = self._transition((prev_chord, p_keys), (chord, keys), f_p, f, held) + too_fast
+                        blocks[a_p, :, a, :] = self._transition((prev_chord, p_keys), (chord, keys), f_p, f, held, time) + too_fast
                 step = totals[-1][:, None] + blocks.reshape(len(totals[-1]), -1)
                 best = np.argmin(step, axis=0)
                 total = step[best, np.arange(step.shape[1])] + local.ravel()

@@ -23,7 +23,7 @@ import torch
 from pianobot import store
 from pianobot.agent.buffer import ReplayBuffer
 from pianobot.agent.sac import SAC, SACConfig, score_size, split_observation, vector_size
-from pianobot.env import EnvConfig, PianoEnv
+from pianobot.env import JOINT_KINDS, EnvConfig, PianoEnv
 from pianobot.errors import PianobotError
 from pianobot.explore import Explorer
 from pianobot.metrics import compare
@@ -35,9 +35,9 @@ EVAL_SEED = 10_000
 """Evaluation episodes use seeds EVAL_SEED, EVAL_SEED + 1, ...: the same hand starts for every evaluation."""
 
 
-TRAIN_JOINTS = ("mcp", "pip")
-"""The finger joints a policy moves by default: the paper froze the joints not crucial to a task,
-and with all four per finger our policies learnt far slower (docs/benchmarks.md)."""
+TRAIN_JOINTS = JOINT_KINDS
+"""The finger joints a policy moves by default: all four (abduction is needed for chords and
+for keys beside the wrist's line; freezing joints, as the paper did, is the --joints option)."""
 
 
 @dataclass(frozen=True)
@@ -162,7 +162,8 @@ def train_policy(
             action = agent.act(vector, tactile)
         observation, reward, terminated, truncated, _ = env.step(action)
         next_vector, next_tactile = split_observation(observation)
-        buffer.add(vector, tactile, action, reward, terminated, next_vector, next_tactile)
+        demonstrated = config.explore == "scripted" and step < config.sac.exploration_steps
+        buffer.add(vector, tactile, action, reward, terminated, next_vector, next_tactile, demo=demonstrated)
         episode_return += reward
         step += 1
 

@@ -1,5 +1,6 @@
 """The scripted pianist proves the simulator playable: every example, F1 >= 0.95, velocity MAE <= 10."""
 
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -8,7 +9,10 @@ import pytest
 from pianobot.controllers import RandomController, ScriptedPianist
 from pianobot.env import EnvConfig
 from pianobot.metrics import compare
-from pianobot.music.load import load_piece
+from pianobot.errors import PianobotWarning
+from pianobot.fingering import ensure_fingering
+from pianobot.music.instrument import HandSpec, KeyboardSpec
+from pianobot.music.load import LoadOptions, load_part, load_piece
 from pianobot.music.tasks import TASKS, make_task
 from pianobot.perform import perform
 from pianobot.sim.world import WorldConfig
@@ -18,7 +22,11 @@ EXAMPLES = sorted((Path(__file__).parent.parent / "examples" / "midi").glob("*.m
 
 @pytest.mark.parametrize("path", EXAMPLES, ids=lambda p: p.stem)
 def test_scripted_pianist_plays_every_example(path):
-    reference = load_piece(path)
+    """The performance-style file is read as `--hand right` would, and fingered by the planner."""
+    options = LoadOptions(hand="right") if "performed" in path.stem else LoadOptions()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", PianobotWarning)
+        reference, _ = ensure_fingering(load_part(path, options, HandSpec()), KeyboardSpec(), HandSpec())
     report = compare(reference, perform(reference, "scripted", seed=1).played)
     assert report.f1 >= 0.95, [(r.reference, r.played) for r in report.rows if r.reference is None or r.played is None]
     assert report.velocity_mae <= 10

@@ -101,10 +101,11 @@ def test_overlapping_notes_of_one_pitch_are_resolved_with_a_warning(tmp_path):
 
 
 def test_retriggered_note_in_one_track_is_cut_with_a_warning(tmp_path):
+    """Legato on a repeated note: the first note-off ends the first note, the second the second."""
     path = midi_file(tmp_path / "r.mid", [("a", [(0, on(60)), (240, on(60)), (480, off(60)), (600, off(60))])])
     with pytest.warns(PianobotWarning):
         piece = read_midi(path)
-    assert [(n.onset, n.offset) for n in piece] == [(0.0, 0.25), (0.25, 0.5)]
+    assert [(n.onset, n.offset) for n in piece] == [(0.0, 0.25), (0.25, 0.625)]
 
 
 def test_note_off_and_note_on_at_the_same_tick_keep_both_notes(tmp_path):

@@ -21,6 +21,7 @@ class ReplayBuffer:
             "action": np.zeros((capacity, action_dim), np.float32),
             "reward": np.zeros(capacity, np.float32),
             "terminated": np.zeros(capacity, np.float32),
+            "demo": np.zeros(capacity, np.float32),
         }
         if tactile_shape is not None:
             self.arrays["tactile"] = np.zeros((capacity, *tactile_shape), np.uint8)
@@ -28,11 +29,12 @@ class ReplayBuffer:
         self.size = 0
         self.cursor = 0
 
-    def add(self, vector, tactile, action, reward, terminated, next_vector, next_tactile) -> None:
+    def add(self, vector, tactile, action, reward, terminated, next_vector, next_tactile, demo: bool = False) -> None:
+        """One transition; ``demo`` marks an action taken by a demonstrator (the scripted pianist)."""
         i = self.cursor
         a = self.arrays
         a["vector"][i], a["next_vector"][i], a["action"][i] = vector, next_vector, action
-        a["reward"][i], a["terminated"][i] = reward, float(terminated)
+        a["reward"][i], a["terminated"][i], a["demo"][i] = reward, float(terminated), float(demo)
         if "tactile" in a:
             a["tactile"][i], a["next_tactile"][i] = tactile, next_tactile
         self.cursor = (i + 1) % self.capacity

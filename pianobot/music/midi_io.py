@@ -180,8 +180,13 @@ def _select_tracks(midi: mido.MidiFile, track: str | int | None, path: Path) -> 
 def _track_notes(
     track: mido.MidiTrack, index: int, seconds, path: Path
 ) -> tuple[list[tuple[int, int, int, int]], dict[int, list[int | None]]]:
-    """Notes as (on tick, off tick, pitch, velocity) and finger lists by tick, for one track."""
-    open_notes: dict[tuple[int, int], tuple[int, int]] = {}
+    """Notes as (on tick, off tick, pitch, velocity) and finger lists by tick, for one track.
+
+    A key struck again while it still sounds (a player's legato on a repeated note) opens a
+    second note; a note-off ends the earliest sounding one (first in, first out), and
+    :func:`_resolve_overlaps` then ends the first where the second starts.
+    """
+    open_notes: dict[tuple[int, int], list[tuple[int, int]]] = defaultdict(list)
     notes: list[tuple[int, int, int, int]] = []
     fingering: dict[int, list[int | None]] = defaultdict(list)
     end = 0
@@ -192,28 +197,18 @@ def _track_notes(
             if fingers is not None:
                 fingering[tick].extend(fingers)
         elif msg.type == "note_on" and msg.velocity > 0:
-            key = (msg.channel, msg.note)
-            if key in open_notes:
-                on, vel = open_notes.pop(key)
-                warnings.warn(
-                    PianobotWarning(
-                        f"track {index}: {pitch_name(msg.note)} starts again at {seconds(tick):.3f} s while "
-                        "still sounding; the earlier note now ends there"
-                    )
-                )
-                if tick > on:
-                    notes.append((on, tick, msg.note, vel))
-            open_notes[key] = (tick, msg.velocity)
+            open_notes[(msg.channel, msg.note)].append((tick, msg.velocity))
         elif msg.type in ("note_off", "note_on"):
-            key = (msg.channel, msg.note)
-            if key in open_notes:
-                on, vel = open_notes.pop(key)
+            sounding = open_notes.get((msg.channel, msg.note))
+            if sounding:
+                on, vel = sounding.pop(0)
                 if tick > on:
                     notes.append((on, tick, msg.note, vel))
-    for (_, pitch), (on, vel) in open_notes.items():
-        warnings.warn(PianobotWarning(f"track {index}: {pitch_name(pitch)} never ends; it ends with the track"))
-        if end > on:
-            notes.append((on, end, pitch, vel))
+    for (_, pitch), sounding in open_notes.items():
+        for on, vel in sounding:
+            warnings.warn(PianobotWarning(f"track {index}: {pitch_name(pitch)} never ends; it ends with the track"))
+            if end > on:
+                notes.append((on, end, pitch, vel))
     return notes, fingering
 
 

@@ -1,0 +1,193 @@
+"""The fingering planner, and reading recordings of human players (pieces built in code)."""
+
+import math
+
+import mido
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from pianobot.cli import app
+from pianobot.errors import PianobotError
+from pianobot.fingering import Planner, ensure_fingering, plan_fingering
+from pianobot.metrics import compare
+from pianobot.music.instrument import HandSpec, KeyboardSpec
+from pianobot.music.load import LoadOptions, load_part, load_piece, thin_chords
+from pianobot.music.midi_io import read_midi, write_midi
+from pianobot.music.piece import Note, Piece, parse_pitch
+from pianobot.perform import perform
+from pianobot.sim.hand import FINGER_BASE_X
+
+from conftest import midi_file
+
+MAJOR = [0, 2, 4, 5, 7, 9, 11]
+
+
+def melody(names: str, beat: float = 0.5, velocity: int = 80) -> Piece:
+    return Piece(tuple(Note(i * beat, parse_pitch(n), (i + 1) * beat, velocity) for i, n in enumerate(names.split())), bpm=120)
+
+
+def tune(rng: np.random.Generator, notes: int = 14) -> Piece:
+    """A random single-voice tune in a major key inside C4-B5: steps, small leaps, mixed lengths."""
+    tonic = int(rng.choice([60, 62, 65, 67]))
+    degree, time, out = int(rng.integers(0, 7)), 0.0, []
+    for _ in range(notes):
+        degree = int(np.clip(degree + rng.choice([-2, -1, -1, 0, 1, 1, 2, 3, -3]), 0, 13))
+        pitch = tonic + 12 * (degree // 7) + MAJOR[degree % 7]
+        pitch -= 12 if pitch > 83 else 0
+        length = float(rng.choice([0.3, 0.6, 0.6, 1.2]))
+        out.append(Note(time, pitch, time + length, int(rng.integers(50, 100))))
+        time += length
+    return Piece(tuple(out), bpm=100)
+
+
+def chords_piece(rng: np.random.Generator) -> Piece:
+    notes, time = [], 0.0
+    for _ in range(10):
+        root = int(rng.integers(60, 72))
+        for pitch in sorted({root, root + int(rng.choice([3, 4, 5]))} | ({root + 7} if rng.random() < 0.5 else set())):
+            notes.append(Note(time, pitch, time + 0.8, 70))
+        time += 1.0
+    return Piece(tuple(notes), bpm=60)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_planner_gives_distinct_fingers_in_pitch_order_within_reach(seed):
+    rng = np.random.default_rng(seed)
+    piece = chords_piece(rng) if seed % 2 else tune(rng)
+    planner = Planner()
+    plan = planner.plan(piece)
+    assert plan.piece.has_fingering and [n.pitch for n in plan.piece.notes] == [n.pitch for n in piece.notes]
+    for chord, wrist in zip(plan.piece.chords(), plan.wrist):
+        fingers = [n.finger for n in sorted(chord, key=lambda n: n.pitch)]
+        assert len(set(fingers)) == len(fingers), "one finger for two simultaneous notes"
+        assert fingers == sorted(fingers), "fingers cross within a chord"
+        for note in chord:
+            key = note.pitch - planner.spec.lowest
+            offset = planner.key_x[key] - wrist - FINGER_BASE_X[note.finger]
+            assert abs(offset) <= planner.reach[key] + 1e-9, f"{note} out of reach"
+        assert 0.0 <= wrist <= planner.grid[-1]
+
+
+def test_a_five_note_scale_within_reach_needs_no_wrist_move():
+    plan = plan_fingering(melody("C4 D4 E4 F4 G4 F4 E4 D4 C4"))
+    assert plan.moves == 0 and plan.travel == 0.0
+    assert not plan.problems
+
+
+def test_wrist_moves_only_where_the_hand_must_shift():
+    """C4-E4-G4 fits one hand position, C5-E5-G5 another: one move between the two groups."""
+    plan = plan_fingering(melody("C4 E4 G4 E4 C4 C5 E5 G5 E5 C5", beat=1.0))
+    assert plan.moves == 1
+    assert plan.travel == pytest.approx(7 * Planner().pitch, abs=2 * Planner().pitch)
+
+
+def test_the_planner_is_deterministic():
+    piece = tune(np.random.default_rng(5), 20)
+    first, second = plan_fingering(piece), plan_fingering(piece)
+    assert first == second
+
+
+def test_too_fast_a_leap_is_reported_with_its_notes():
+    plan = plan_fingering(melody("C4 B5 C4", beat=0.15))
+    assert plan.problems and "C4" in plan.problems[0] and "B5" in plan.problems[0] and "--tempo" in plan.problems[0]
+    assert not plan_fingering(melody("C4 B5 C4", beat=1.0)).problems
+
+
+def test_a_chord_wider_than_the_hand_is_a_clear_error():
+    with pytest.raises(PianobotError, match="spans .* more than this hand reaches"):
+        plan_fingering(Piece((Note(0, 60, 1), Note(0, 72, 1))))
+
+
+def test_ensure_fingering_keeps_given_fingering_unless_asked():
+    piece = melody("C4 D4 E4").with_fingers([4, 3, 2]) if False else Piece(tuple(
+        Note(i * 0.5, p, i * 0.5 + 0.5, 80, f) for i, (p, f) in enumerate([(60, 2), (62, 2), (64, 2)])), bpm=120)
+    kept, plan = ensure_fingering(piece, KeyboardSpec(), HandSpec())
+    assert kept is piece and plan is None
+    refingered, plan = ensure_fingering(piece, KeyboardSpec(), HandSpec(), refinger=True)
+    assert plan is not None and [n.finger for n in refingered.notes] != [2, 2, 2]
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_scripted_pianist_plays_planner_fingered_tunes(seed):
+    piece = plan_fingering(tune(np.random.default_rng(seed))).piece
+    played = perform(piece, "scripted", seed=seed).played
+    assert compare(piece, played).f1 >= 0.95
+
+
+# -- recordings of human players -----------------------------------------------------------------
+def _recording(path, names=("Right Hand", "Left Hand"), jitter=0):
+    on = lambda p, v=80: mido.Message("note_on", note=p, velocity=v)  # noqa: E731
+    off = lambda p: mido.Message("note_off", note=p, velocity=0)  # noqa: E731
+    pedal = [(0, mido.Message("control_change", control=64, value=127)), (1900, mido.Message("control_change", control=64, value=0))]
+    right = [(0, on(72, 90)), (500, off(72)), (480 + jitter, on(74, 70)), (960, off(74))]
+    right += [(960, on(67)), (960 + jitter, on(71)), (960 + 2 * jitter, on(74)), (960 + 3 * jitter, on(79)), (1900, off(67)),
+              (1900, off(71)), (1900, off(74)), (1900, off(79))]
+    left = [(0, on(48)), (900, off(48)), (960, on(43)), (1900, off(43))]
+    return midi_file(path, [(names[0], right + pedal), (names[1], left)])
+
+
+def test_hand_option_reads_the_named_track_and_thins_big_chords(tmp_path):
+    path = _recording(tmp_path / "r.mid", jitter=10)
+    with pytest.warns(UserWarning, match="kept the highest 3"):
+        piece = load_part(path, LoadOptions(hand="right"), HandSpec())
+    assert [n.pitch for n in piece.notes] == [72, 74, 71, 74, 79]  # G4 of the rolled chord dropped
+    assert len({n.onset for n in piece.notes[2:]}) == 1  # the rolled chord starts together
+    assert piece.notes[0].offset == piece.notes[1].onset  # the legato overlap is trimmed
+    left = load_part(path, LoadOptions(hand="left"), HandSpec())
+    assert [n.pitch for n in left.notes] == [43, 48] or [n.pitch for n in left.notes] == [48, 43]
+
+
+def test_hand_option_without_named_tracks(tmp_path):
+    path = _recording(tmp_path / "r.mid", names=("Piano 1", "Piano 2"))
+    with pytest.warns(UserWarning, match="higher of two"):
+        piece = load_piece(path, LoadOptions(hand="right"))
+    assert min(n.pitch for n in piece.notes) >= 67
+    one = write_midi(Piece((Note(0, 48, 1), Note(0, 72, 1), Note(1, 50, 2), Note(1, 74, 2))), tmp_path / "one.mid")
+    with pytest.warns(UserWarning, match="--split"):
+        piece = load_piece(one, LoadOptions(hand="right"))
+    assert [n.pitch for n in piece.notes] == [72, 74]
+
+
+def test_quantize_moves_onsets_to_the_grid(tmp_path):
+    path = _recording(tmp_path / "r.mid", jitter=25)
+    raw = read_midi(path, track="Right Hand")
+    snapped = read_midi(path, track="Right Hand", grid=1 / 16)  # 120 ticks at 480 per beat, 0.125 s at 120 bpm
+    assert len({n.onset for n in raw.notes}) > len({n.onset for n in snapped.notes})
+    assert all(math.isclose(n.onset / 0.125, round(n.onset / 0.125), abs_tol=1e-6) for n in snapped.notes)
+
+
+def test_thin_chords_ends_held_notes_that_a_new_chord_needs():
+    piece = Piece((Note(0, 60, 3.0), Note(0, 64, 3.0), Note(1, 67, 2), Note(1, 72, 2)))
+    thinned, dropped = thin_chords(piece, 3)
+    assert dropped == 0 and thinned.max_polyphony()[0] <= 3
+    assert sorted((n.pitch, n.offset) for n in thinned.notes)[0] == (60, 1.0)  # the oldest held note ends
+
+
+def test_finger_command_writes_a_fingered_file_and_inspect_explains_a_recording(tmp_path):
+    runner = CliRunner()
+    song = write_midi(melody("C4 D4 E4 F4 G4 A4 G4 F4 E4 D4 C4"), tmp_path / "plain.mid")
+    out = tmp_path / "fingered.mid"
+    result = runner.invoke(app, ["finger", str(song), "-o", str(out)])
+    assert result.exit_code == 0, result.output
+    assert "wrist travel" in result.output
+    fingered = read_midi(out)
+    assert fingered.has_fingering and all(n.finger in (2, 3, 4) for n in fingered.notes)
+    assert fingered == plan_fingering(read_midi(song)).piece
+
+    recording = _recording(tmp_path / "r.mid", jitter=10)
+    result = runner.invoke(app, ["inspect", str(recording)])
+    assert "Right Hand" in result.output and "pedal" in result.output and "--hand" in result.output
+    result = runner.invoke(app, ["inspect", str(recording), "--hand", "right"])
+    assert result.exit_code == 0, result.output
+    assert "fingering planned" in result.output and "playable" in result.output
+
+
+def test_play_plans_fingering_for_an_unfingered_file_and_says_so(tmp_path):
+    runner = CliRunner()
+    song = write_midi(melody("E4 D4 C4 D4 E4 E4 E4", beat=0.6), tmp_path / "mary.mid")
+    result = runner.invoke(app, ["play", str(song), "-o", str(tmp_path / "out.mid")])
+    assert result.exit_code == 0, result.output
+    assert "fingering planned" in result.stderr
+    played = read_midi(tmp_path / "out.mid")
+    assert compare(plan_fingering(read_midi(song)).piece, played).f1 >= 0.95
