@@ -149,3 +149,21 @@ def test_frozen_joints_shrink_the_action_and_hold_still():
     assert np.all(joints[:, 1] < start[:, 1] - 0.1)  # MCP did
     with pytest.raises(ValueError):
         PianoEnv(piece=PHRASE, config=EnvConfig(actuated=("elbow",)))
+
+
+def test_finger_targets_point_from_each_fingertip_to_its_next_key():
+    env = PianoEnv(piece=PHRASE, config=EnvConfig(tactile=False))
+    observation, _ = env.reset(seed=3)
+    assert observation["targets"].shape == (3, 4)
+    assert not observation["targets"].any()  # nothing in the 0.5 s window yet
+    for _ in range(env.lead_steps - 5):
+        observation, *_ = env.step(np.zeros(13))
+    targets = observation["targets"]
+    tips = env.world.tip_points()
+    # finger 2 plays C4 (key 0) 5 steps ahead, finger 3 D4 (key 2) 15 steps ahead: beyond the window
+    expected = np.clip((env.strike_points[0] - tips[2]) / 0.1, -5, 5)
+    assert np.allclose(targets[0, :3], expected, atol=1e-5)
+    assert targets[0, 3] == pytest.approx(1 - 5 / 11)
+    assert not targets[1].any() and not targets[2].any()
+    without = PianoEnv(piece=PHRASE, config=EnvConfig(tactile=False, target_observations=False))
+    assert "targets" not in without.reset(seed=0)[0]
