@@ -40,10 +40,18 @@ class Explorer:
         if self.pianist is not None:
             self.pianist.reset()
 
-    def act(self, observation: dict) -> np.ndarray:
+    def teach(self, observation: dict) -> np.ndarray | None:
+        """The scripted pianist's noise-free action for this step (call once per step, in order:
+        it remembers the previous score row), or None when exploring without it."""
+        if self.pianist is None:
+            return None
+        action = self.pianist.act(observation)
+        return (action if self.select is None else action[self.select]).astype(np.float32)
+
+    def act(self, observation: dict, taught: np.ndarray | None = None) -> np.ndarray:
+        """An exploration action; ``taught`` is this step's :meth:`teach` result, if already asked."""
         if self.kind == "scripted":
-            action = self.pianist.act(observation)
-            action = (action if self.select is None else action[self.select]) + self.rng.normal(0.0, SCRIPTED_NOISE, self.size)
+            action = (taught if taught is not None else self.teach(observation)) + self.rng.normal(0.0, SCRIPTED_NOISE, self.size)
             return np.clip(action, -1.0, 1.0).astype(np.float32)
         action = self.rng.uniform(-1.0, 1.0, self.size).astype(np.float32)
         if self.kind in ("repeat", "prior") and self.previous is not None and self.rng.random() < REPEAT_PROBABILITY:

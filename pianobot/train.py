@@ -156,14 +156,14 @@ def train_policy(
 
     while step < config.steps:
         vector, tactile = split_observation(observation)
+        taught = explorer.teach(observation)  # the scripted pianist's action here, or None
         if step < config.sac.exploration_steps:
-            action = explorer.act(observation)
+            action = explorer.act(observation, taught)
         else:
             action = agent.act(vector, tactile)
         observation, reward, terminated, truncated, _ = env.step(action)
         next_vector, next_tactile = split_observation(observation)
-        demonstrated = config.explore == "scripted" and step < config.sac.exploration_steps
-        buffer.add(vector, tactile, action, reward, terminated, next_vector, next_tactile, demo=demonstrated)
+        buffer.add(vector, tactile, action, reward, terminated, next_vector, next_tactile, expert=taught)
         episode_return += reward
         step += 1
 

@@ -148,7 +148,7 @@ def _agent_and_batch(demo_weight: float, demo: float):
         "vector": torch.from_numpy(rng.normal(size=(n, dim)).astype(np.float32)),
         "next_vector": torch.from_numpy(rng.normal(size=(n, dim)).astype(np.float32)),
         "action": torch.from_numpy(target), "reward": torch.zeros(n), "terminated": torch.zeros(n),
-        "demo": torch.full((n,), demo), "tactile": None, "next_tactile": None,
+        "demo": torch.full((n,), demo), "expert": torch.from_numpy(target), "tactile": None, "next_tactile": None,
     }
     return agent, batch, target
 

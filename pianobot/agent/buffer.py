@@ -22,6 +22,7 @@ class ReplayBuffer:
             "reward": np.zeros(capacity, np.float32),
             "terminated": np.zeros(capacity, np.float32),
             "demo": np.zeros(capacity, np.float32),
+            "expert": np.zeros((capacity, action_dim), np.float32),
         }
         if tactile_shape is not None:
             self.arrays["tactile"] = np.zeros((capacity, *tactile_shape), np.uint8)
@@ -29,12 +30,14 @@ class ReplayBuffer:
         self.size = 0
         self.cursor = 0
 
-    def add(self, vector, tactile, action, reward, terminated, next_vector, next_tactile, demo: bool = False) -> None:
-        """One transition; ``demo`` marks an action taken by a demonstrator (the scripted pianist)."""
+    def add(self, vector, tactile, action, reward, terminated, next_vector, next_tactile, expert=None) -> None:
+        """One transition; ``expert``: what a teacher (the scripted pianist) would have done here."""
         i = self.cursor
         a = self.arrays
         a["vector"][i], a["next_vector"][i], a["action"][i] = vector, next_vector, action
-        a["reward"][i], a["terminated"][i], a["demo"][i] = reward, float(terminated), float(demo)
+        a["reward"][i], a["terminated"][i] = reward, float(terminated)
+        a["demo"][i] = float(expert is not None)
+        a["expert"][i] = 0.0 if expert is None else expert
         if "tactile" in a:
             a["tactile"][i], a["next_tactile"][i] = tactile, next_tactile
         self.cursor = (i + 1) % self.capacity

@@ -54,9 +54,10 @@ class SACConfig:
     exploration_steps: int = 15_000
     """Environment steps of exploration before learning starts (paper: 15000)."""
     demo_weight: float = 1.0
-    """Behaviour cloning towards demonstrated actions in the batch (the scripted pianist's
-    exploration steps), as in TD3+BC: the actor's loss is ``demo_q_weight * SAC loss / mean |Q|
-    + demo_weight * squared error to the demonstration``. 0 gives plain SAC. Not in the paper."""
+    """Behaviour cloning towards a teacher's actions in the batch (the scripted pianist labels
+    every step when exploring with it, as in DAgger), as in TD3+BC: the actor's loss is
+    ``demo_q_weight * SAC loss / mean |Q| + demo_weight * squared error to the teacher's
+    action``. 0 gives plain SAC. Not in the paper."""
     demo_q_weight: float = 2.5
     """TD3+BC's alpha: how much the critic counts against the demonstrations."""
     log_std_bounds: tuple[float, float] = (-5.0, 2.0)
@@ -236,7 +237,7 @@ class SAC:
         if self.config.demo_weight > 0 and demo is not None and bool(demo.any()):
             # TD3+BC: the critic's term normalised by the scale of Q, plus cloning the demonstrations
             mean_action, _ = self.actor(features, deterministic=True)
-            cloning = ((mean_action - batch["action"]).pow(2).sum(-1) * demo).sum() / demo.sum()
+            cloning = ((mean_action - batch["expert"]).pow(2).sum(-1) * demo).sum() / demo.sum()
             scale = self.config.demo_q_weight / actor_q.abs().mean().detach().clamp(min=1e-3)
             actor_loss = scale * actor_loss + self.config.demo_weight * cloning
         self.actor_optimizer.zero_grad(set_to_none=True)
