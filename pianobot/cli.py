@@ -103,6 +103,14 @@ def make_options(track, tempo, transpose, fingering, hand=None, split="C4", quan
                        split=parse_pitch(split), quantize=quantize, refinger=refinger)
 
 
+def check_midi_output(output: Path, song: Path, what: str) -> None:
+    """-o must name a .mid file other than the input."""
+    if output.suffix.lower() not in (".mid", ".midi"):
+        raise PianobotError(f"-o {output}: {what} is a MIDI file, name it *.mid")
+    if output.resolve() == song.resolve():
+        raise PianobotError(f"-o {output} would overwrite the input {song.name}: choose another file name")
+
+
 def read_song(song: Path, options: LoadOptions, keyboard: KeyboardSpec, hand: HandSpec) -> Piece:
     """Load a piece for this hand and keyboard; finger it with the planner when it has no fingering."""
     piece = load_part(song, options, hand)
@@ -196,10 +204,7 @@ def finger(
     thumb: bool = Thumb,
 ):
     """Plan a fingering for the robot hand (least wrist travel within its reach) and write it to a MIDI file."""
-    if output.suffix.lower() not in (".mid", ".midi"):
-        raise PianobotError(f"-o {output}: the fingered piece is a MIDI file, name it *.mid")
-    if output.resolve() == song.resolve():
-        raise PianobotError(f"-o {output} would overwrite the input: choose another file name")
+    check_midi_output(output, song, "the fingered piece")
     check_writable(output)
     keyboard, hand_spec = make_instrument(lowest_note, keys, thumb)
     options = make_options(track, tempo, transpose, None, hand_part, split, quantize)
@@ -274,10 +279,7 @@ def play(
     thumb: bool = Thumb,
 ):
     """Perform a piece in the simulator; write the played notes (velocities, fingers) and a velocity-error report."""
-    if output.suffix.lower() not in (".mid", ".midi"):
-        raise PianobotError(f"-o {output}: the performance is a MIDI file, name it *.mid")
-    if output.resolve() == song.resolve():
-        raise PianobotError(f"-o {output} would overwrite the piece being played: choose another file name")
+    check_midi_output(output, song, "the performance")
     report_path = output.with_suffix(".report.json")
     for target in (output, report_path, video, wav):
         if target is not None:

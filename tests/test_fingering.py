@@ -194,3 +194,13 @@ def test_play_plans_fingering_for_an_unfingered_file_and_says_so(tmp_path):
     assert "fingering planned" in result.stderr
     played = read_midi(tmp_path / "out.mid")
     assert compare(plan_fingering(read_midi(song)).piece, played).f1 >= 0.95
+
+
+def test_finger_command_refuses_bad_output_names(tmp_path):
+    runner = CliRunner()
+    song = write_midi(melody("C4 D4 E4"), tmp_path / "s.mid")
+    before = song.read_bytes()
+    for target, word in ((tmp_path / "f.txt", "*.mid"), (song, "overwrite")):
+        result = runner.invoke(app, ["finger", str(song), "-o", str(target)])
+        assert result.exit_code == 2 and word in result.stderr and "Traceback" not in result.output
+    assert song.read_bytes() == before and not (tmp_path / "f.txt").exists()
