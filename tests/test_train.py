@@ -167,3 +167,21 @@ def test_behaviour_cloning_pulls_the_actor_towards_demonstrations():
     cloned, unflagged, off = error_after_updates(1.0, 1.0), error_after_updates(1.0, 0.0), error_after_updates(0.0, 1.0)
     assert cloned < 0.1  # measured 0.07 against 0.20 for both others
     assert unflagged > 2 * cloned and off > 2 * cloned
+
+
+def test_until_f1_stops_at_the_first_good_evaluation(tmp_path, monkeypatch):
+    import pianobot.train as train
+
+    calls = []
+
+    def perfect(agent, target, env_config, episodes):
+        calls.append(agent.updates)
+        return {"f1": 1.0, "velocity_mae": 0.0, "return": 1.0}
+
+    monkeypatch.setattr(train, "evaluate", perfect)
+    config = small(steps=400, eval_every=100, until_f1=0.95)
+    manifest = train_policy(PHRASE, config, tmp_path / "m")
+    assert manifest["steps"] < 200 and len(calls) == 1  # stopped at the first evaluation, not evaluated twice
+    assert manifest["evaluation"]["f1"] == 1.0 and store.is_trained(tmp_path / "m")
+    whole = train_policy(PHRASE, replace(config, until_f1=None), tmp_path / "n")
+    assert whole["steps"] == 400
