@@ -214,6 +214,7 @@ def test_train_bad_requests_answer_with_one_line(tmp_path):
     assert_one_line_error(run("train", song, "--reward", "cubic"), "--reward cubic")
     assert_one_line_error(run("train", song, "--explore", "wild"), "--explore wild")
     assert_one_line_error(run("train", song, "--explore", "scripted", "--control", "torque"), "velocity")
+    assert_one_line_error(run("train", song, "--until-f1", "1.5"), "--until-f1 1.5")
     (tmp_path / "file").write_text("x")
     assert_one_line_error(run("train", song, "--models", tmp_path / "file"), "is a file")
 
