@@ -193,6 +193,7 @@ class PianoEnv(gym.Env):
         world = self.world
         wrist = float(self.np_random.uniform(0.0, world.width)) if self.config.random_start else world.width / 2
         world.reset(wrist, np.tile(idle_pose(self.config.world), self.n_fingers))
+        self._tip_cache = None
         self.t = 0
         self.key_finger = np.zeros(self.spec_score.keyboard.count, dtype=int)
         if self.tactile is not None:
@@ -210,6 +211,7 @@ class PianoEnv(gym.Env):
 
     def step(self, action):
         result = self.world.step(self.full_action(np.asarray(action, dtype=np.float64)))
+        self._tip_cache = None  # the hand has moved
         lowest = self.spec_score.keyboard.lowest
         for event in result.events:
             key = event.pitch - lowest
@@ -243,12 +245,18 @@ class PianoEnv(gym.Env):
         if rows.size == 0:
             return np.zeros(0)
         keys = np.flatnonzero(window[rows[0]])
-        tips = self.world.tip_points()
+        tips = self._tips()
         return np.array([np.linalg.norm(tips[window[rows[0], k]] - self.strike_points[k]) for k in keys])
+
+    def _tips(self) -> dict[int, np.ndarray]:
+        """The fingertips' points, asked of the simulator once per step (reward and observation share them)."""
+        if self._tip_cache is None:
+            self._tip_cache = self.world.tip_points()
+        return self._tip_cache
 
     def targets(self, window: np.ndarray) -> np.ndarray:
         """:func:`finger_targets` for a score window, from the hand's current pose."""
-        return finger_targets(window, self.world.tip_points(), self.strike_points, self.spec_score.hand.fingers)
+        return finger_targets(window, self._tips(), self.strike_points, self.spec_score.hand.fingers)
 
     def _tactile_image(self) -> np.ndarray:
         angles, _ = self.world.key_state()
