@@ -164,11 +164,14 @@ class Actor(nn.Module):
         self.log_std_bounds = config.log_std_bounds
 
     def forward(self, features: torch.Tensor, deterministic: bool = False) -> tuple[torch.Tensor, torch.Tensor]:
+        """(action, log-probability); deterministic: (tanh of the mean, zeros). The tanh of the
+        mean of the last call is kept in ``self.mean_action`` (behaviour cloning reads it)."""
         mean, log_std = self.net(features).chunk(2, dim=-1)
+        self.mean_action = torch.tanh(mean)
         low, high = self.log_std_bounds
         log_std = low + 0.5 * (high - low) * (torch.tanh(log_std) + 1)
         if deterministic:
-            return torch.tanh(mean), torch.zeros(mean.shape[0])
+            return self.mean_action, torch.zeros(mean.shape[0])
         std = log_std.exp()
         noise = torch.randn_like(mean)
         raw = mean + std * noise
@@ -236,8 +239,7 @@ class SAC:
         demo = batch.get("demo")
         if self.config.demo_weight > 0 and demo is not None and bool(demo.any()):
             # TD3+BC: the critic's term normalised by the scale of Q, plus cloning the demonstrations
-            mean_action, _ = self.actor(features, deterministic=True)
-            cloning = ((mean_action - batch["expert"]).pow(2).sum(-1) * demo).sum() / demo.sum()
+            cloning = ((self.actor.mean_action - batch["expert"]).pow(2).sum(-1) * demo).sum() / demo.sum()
             scale = self.config.demo_q_weight / actor_q.abs().mean().detach().clamp(min=1e-3)
             actor_loss = scale * actor_loss + self.config.demo_weight * cloning
         self.actor_optimizer.zero_grad(set_to_none=True)
