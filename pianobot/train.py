@@ -5,7 +5,9 @@ and learn from the replay buffer at ``update_ratio`` gradient steps per environm
 evaluate every ``eval_every`` steps; at the first episode end after every
 ``checkpoint_every`` steps, write a checkpoint that holds everything (networks, optimisers,
 buffer, random generators), so that running the same command again continues exactly where an
-interrupted run stopped. :func:`train_piece` does the plumbing for a whole piece: phrases,
+interrupted run stopped. The policy stored at the end is the best one evaluated (SAC's
+evaluations swing by tenths of F1 from one to the next; the last is not always the best).
+:func:`train_piece` does the plumbing for a whole piece: phrases,
 skipping what is already trained, parallel workers.
 """
 
@@ -110,6 +112,17 @@ def evaluate(agent: SAC, target: Piece | str, env_config: EnvConfig, episodes: i
     }
 
 
+BEST_PREFIX = "best."
+"""Checkpoint tensors of the best policy evaluated so far are stored under this prefix."""
+
+
+def better(figures: dict, than: dict | None) -> bool:
+    """Whether an evaluation beats another: higher note F1 first, then higher return."""
+    if than is None:
+        return True
+    return (figures["f1"], figures["return"]) > (than["f1"], than["return"])
+
+
 def train_policy(
     target: Piece | str,
     config: TrainConfig,
@@ -133,11 +146,15 @@ def train_policy(
     rng = np.random.default_rng(config.seed)
     explorer = Explorer(config.explore, env.action_space.shape[0], env_config, rng, select=env.actuated)
     step, episode, update_debt, evaluations = 0, 0, 0.0, []
+    best, best_tensors = None, None  # the best evaluation so far and its policy's tensors
 
     checkpoint = store.load_checkpoint(folder)
     if checkpoint is not None:  # continue an interrupted run exactly
         tensors, state, buffer_folder = checkpoint
-        agent.load_tensors(tensors)
+        agent.load_tensors({k: v for k, v in tensors.items() if not k.startswith(BEST_PREFIX)})
+        if state.get("best") is not None:
+            best = state["best"]
+            best_tensors = {k[len(BEST_PREFIX) :]: v for k, v in tensors.items() if k.startswith(BEST_PREFIX)}
         torch.set_rng_state(tensors["torch_rng"])
         buffer.load(buffer_folder, state["buffer_size"], state["buffer_cursor"])
         rng.bit_generator.state = state["rng"]
@@ -180,18 +197,21 @@ def train_policy(
             if step >= next_eval and step > config.sac.exploration_steps:
                 figures = evaluate(agent, target, env_config, config.eval_episodes)
                 evaluations.append({"step": step, **figures})
+                if better(figures, best):
+                    best, best_tensors = {"step": step, **figures}, agent.tensors(with_training_state=False)
                 report(Progress(step, config.steps, eval_f1=figures["f1"]))
                 next_eval = (step // config.eval_every + 1) * config.eval_every
                 if config.until_f1 is not None and figures["f1"] >= config.until_f1:
-                    final = figures  # good enough: stop here
+                    final = {"step": step, **figures}  # good enough: stop here
                     break
             if step >= next_checkpoint and step < config.steps:
                 state = {
                     "step": step, "episode": episode, "update_debt": update_debt, "updates": agent.updates,
                     "evaluations": evaluations, "rng": rng.bit_generator.state, "env_rng": env.np_random.bit_generator.state,
-                    "buffer_size": buffer.size, "buffer_cursor": buffer.cursor,
+                    "buffer_size": buffer.size, "buffer_cursor": buffer.cursor, "best": best,
                 }
-                store.save_checkpoint(folder, {**agent.tensors(), "torch_rng": torch.get_rng_state()}, state, buffer)
+                kept = {BEST_PREFIX + k: v for k, v in (best_tensors or {}).items()}
+                store.save_checkpoint(folder, {**agent.tensors(), "torch_rng": torch.get_rng_state(), **kept}, state, buffer)
                 next_checkpoint = (step // config.checkpoint_every + 1) * config.checkpoint_every
             if stop_after is not None and step >= stop_after:
                 env.close()
@@ -202,9 +222,12 @@ def train_policy(
             report(Progress(step, config.steps))
     env.close()
 
+    tensors = agent.tensors(with_training_state=False)
     if final is None:
-        final = evaluate(agent, target, env_config, config.eval_episodes)
-        evaluations.append({"step": step, **final})
+        final = {"step": step, **evaluate(agent, target, env_config, config.eval_episodes)}
+        evaluations.append(final)
+        if best is not None and better(best, final):  # an earlier policy played better: keep that one
+            final, tensors = best, best_tensors
     manifest = {
         **(about or {}),
         "target": target if isinstance(target, str) else [asdict(n) for n in target.notes],
@@ -215,7 +238,7 @@ def train_policy(
         "evaluations": evaluations,
         "config": asdict(config),
     }
-    store.save_policy(folder, agent.tensors(with_training_state=False), manifest)
+    store.save_policy(folder, tensors, manifest)
     store.drop_checkpoint(folder)
     return manifest
 

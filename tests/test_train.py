@@ -185,3 +185,39 @@ def test_until_f1_stops_at_the_first_good_evaluation(tmp_path, monkeypatch):
     assert manifest["evaluation"]["f1"] == 1.0 and store.is_trained(tmp_path / "m")
     whole = train_policy(PHRASE, replace(config, until_f1=None), tmp_path / "n")
     assert whole["steps"] == 400
+
+
+def test_the_best_evaluated_policy_is_kept_across_an_interruption(tmp_path, monkeypatch):
+    import pianobot.train as train
+
+    def scripted(record):
+        scores = iter([0.2, 0.9, 0.4, 0.3])  # the second evaluation is the best; the last (final) is worse
+
+        def evaluate(agent, target, env_config, episodes):
+            record.append((agent.updates, agent.tensors(with_training_state=False)))
+            return {"f1": next(scores), "velocity_mae": 1.0, "return": 0.0}
+
+        return evaluate
+
+    config = small(steps=400, eval_every=100)
+    seen: list = []
+    monkeypatch.setattr(train, "evaluate", scripted(seen))
+    manifest = train_policy(PHRASE, config, tmp_path / "straight")
+    assert len(seen) == 4 and manifest["evaluation"]["f1"] == 0.9 and manifest["evaluation"]["step"] == manifest["evaluations"][1]["step"]
+    assert [e["f1"] for e in manifest["evaluations"]] == [0.2, 0.9, 0.4, 0.3]
+    stored = store.load_tensors(tmp_path / "straight" / store.POLICY_FILE)
+    assert all(torch.equal(stored[k], seen[1][1][k]) for k in stored)
+    assert not all(torch.equal(stored[k], seen[3][1][k]) for k in stored)  # not the last policy
+
+    # interrupted after the best evaluation, resumed: the checkpoint carried the best policy
+    first: list = []
+    monkeypatch.setattr(train, "evaluate", scripted(first))
+    train_policy(PHRASE, config, tmp_path / "resumed", stop_after=260)
+    assert len(first) == 2
+    rest: list = []
+    scores = iter([0.4, 0.3])
+    monkeypatch.setattr(train, "evaluate", lambda *a: (rest.append(1), {"f1": next(scores), "velocity_mae": 1.0, "return": 0.0})[1])
+    resumed = train_policy(PHRASE, config, tmp_path / "resumed")
+    assert len(rest) == 2 and resumed["evaluation"] == manifest["evaluation"]
+    kept = store.load_tensors(tmp_path / "resumed" / store.POLICY_FILE)
+    assert all(torch.equal(kept[k], stored[k]) for k in stored)
