@@ -1,0 +1,77 @@
+"""How precise must a policy be? The scripted pianist with Gaussian noise on its actions.
+
+    python benchmarks/precision.py [examples/midi/three-note.mid] [--sigmas 0 0.02 0.05 0.1] [--starts 4]
+
+A learned policy imitates the scripted pianist (behaviour cloning) and acts on top of it (SAC);
+its action is never exactly the teacher's. This measures what a given action error costs: the
+noise-free teacher's actions plus N(0, sigma) on every joint, on the finger joints only, or on
+the wrist only, over several hand starts of the piece's first phrase (the starts evaluation
+uses). Prints a Markdown table of mean note F1, per-step F1 and median onset error.
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+import numpy as np
+
+from pianobot.controllers import ScriptedPianist
+from pianobot.metrics import compare
+from pianobot.music.instrument import HandSpec
+from pianobot.music.load import LoadOptions, load_part
+from pianobot.music.phrases import split_phrases
+from pianobot.sim.recorder import NoteRecorder
+from pianobot.train import EVAL_SEED, TrainConfig, _env_config, make_env, phrase_target
+
+PARTS = ("all", "fingers", "wrist")
+
+
+def play(env, pianist: ScriptedPianist, sigma: float, part: str, start: int) -> tuple[float, float, float | None]:
+    """One noisy performance: (note F1, step F1, median |onset error| of the matched notes)."""
+    rng = np.random.default_rng(start)
+    observation, info = env.reset(seed=EVAL_SEED + start)
+    pianist.reset()
+    recorder = NoteRecorder()
+    while True:
+        action = pianist.act(observation)
+        noise = sigma * rng.standard_normal(action.shape)
+        if part == "fingers":
+            noise[-1] = 0.0  # the last action is the wrist's
+        elif part == "wrist":
+            noise[:-1] = 0.0
+        observation, _, terminated, truncated, step = env.step(np.clip(action + noise, -1.0, 1.0))
+        recorder.add(step["events"], step["fingers"])
+        if terminated or truncated:
+            break
+    report = compare(info["piece"], recorder.piece(end=env.world.time, start=env.score_start))
+    return report.f1, report.step_f1, report.onset_error_mean
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("song", nargs="?", default="examples/midi/three-note.mid")
+    parser.add_argument("--sigmas", type=float, nargs="+", default=[0.0, 0.02, 0.05, 0.1])
+    parser.add_argument("--starts", type=int, default=4, help="hand starts per setting")
+    args = parser.parse_args()
+
+    env_config = _env_config(TrainConfig())
+    piece = load_part(Path(args.song), LoadOptions(), HandSpec())
+    env = make_env(phrase_target(split_phrases(piece)[0]), env_config)
+    pianist = ScriptedPianist(env_config)
+    print(f"{Path(args.song).name}, first phrase, {args.starts} hand starts; action noise N(0, sigma) on [-1, 1] actions\n")
+    print("| noise on | sigma | note F1 (mean) | note F1 per start | step F1 | mean onset error of matched notes (ms) |")
+    print("| --- | ---: | ---: | --- | ---: | ---: |")
+    for sigma in args.sigmas:
+        for part in PARTS if sigma > 0 else ("all",):
+            runs = [play(env, pianist, sigma, part, start) for start in range(args.starts)]
+            f1s = [r[0] for r in runs]
+            onsets = [r[2] for r in runs if r[2] is not None]
+            onset = f"{1000 * np.mean(onsets):.0f}" if onsets else "n/a"
+            per_start = " ".join(f"{f:.2f}" for f in f1s)
+            print(f"| {part} | {sigma:g} | {np.mean(f1s):.2f} | {per_start} | {np.mean([r[1] for r in runs]):.2f} | {onset} |", flush=True)
+    env.close()
+
+
+if __name__ == "__main__":
+    main()
