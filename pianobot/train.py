@@ -147,6 +147,7 @@ def train_policy(
     explorer = Explorer(config.explore, env.action_space.shape[0], env_config, rng, select=env.actuated)
     step, episode, update_debt, evaluations = 0, 0, 0.0, []
     best, best_tensors = None, None  # the best evaluation so far and its policy's tensors
+    seconds_before = 0.0  # wall-clock time spent before an interruption
 
     checkpoint = store.load_checkpoint(folder)
     if checkpoint is not None:  # continue an interrupted run exactly
@@ -160,6 +161,7 @@ def train_policy(
         rng.bit_generator.state = state["rng"]
         step, episode, update_debt, evaluations = state["step"], state["episode"], state["update_debt"], state["evaluations"]
         agent.updates = state["updates"]
+        seconds_before = state.get("seconds", 0.0)
         env.reset(seed=config.seed)  # creates the env's generator, then restore its state
         env.np_random.bit_generator.state = state["env_rng"]
         observation, _ = env.reset()
@@ -209,6 +211,7 @@ def train_policy(
                     "step": step, "episode": episode, "update_debt": update_debt, "updates": agent.updates,
                     "evaluations": evaluations, "rng": rng.bit_generator.state, "env_rng": env.np_random.bit_generator.state,
                     "buffer_size": buffer.size, "buffer_cursor": buffer.cursor, "best": best,
+                    "seconds": seconds_before + time.perf_counter() - started,
                 }
                 kept = {BEST_PREFIX + k: v for k, v in (best_tensors or {}).items()}
                 store.save_checkpoint(folder, {**agent.tensors(), "torch_rng": torch.get_rng_state(), **kept}, state, buffer)
@@ -233,7 +236,7 @@ def train_policy(
         "target": target if isinstance(target, str) else [asdict(n) for n in target.notes],
         "steps": step,
         "updates": agent.updates,
-        "seconds": round(time.perf_counter() - started, 1),
+        "seconds": round(seconds_before + time.perf_counter() - started, 1),  # across interruptions
         "evaluation": final,
         "evaluations": evaluations,
         "config": asdict(config),
