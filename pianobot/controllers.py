@@ -71,9 +71,9 @@ class ScriptedPianist:
     """The hand does not slide while a finger that has let go is lower than this over the white keys (m)."""
     band_clearance = 0.004
     """Crossing into or out of the black keys' band, the fingertip stays this far (m) above their tops."""
-    band_overshoot = 0.001
-    """Rising to cross the band, the fingertip aims this much (m) over the safe height: one that
-    stopped a hair short of it would wait there for ever."""
+    band_tolerance = 0.0002
+    """A fingertip this little (m) under the safe height for crossing counts as over it: one that
+    rose towards it could stop a hair short of it and wait there for ever."""
     aim_tolerance = 0.004
     """A finger waits at idle height until its tip is this close (m) to above its key."""
     strike_margin = 0.001
@@ -320,12 +320,11 @@ class ScriptedPianist:
         band_reach = hand.palm_y - self.black_band_y  # a tip reaching further lies over the black keys
         crossing = (reach > band_reach) != (now_reach > band_reach)
         safe = self.black_rise + self.band_clearance
-        if crossing and now_height < safe:
-            rise = safe + self.band_overshoot
-            if reach < now_reach or finger_ik(geometry, now_reach, hand.palm_height - rise) is not None:
-                reach, height = now_reach, rise
+        if crossing and now_height < safe - self.band_tolerance:
+            if reach < now_reach or finger_ik(geometry, now_reach, hand.palm_height - safe) is not None:
+                reach, height = now_reach, safe
             else:  # curled too close to the palm to rise here: rise while reaching out towards the black key
-                reach, height = now_reach + min(self.max_move, reach - now_reach), rise
+                reach, height = now_reach + min(self.max_move, reach - now_reach), safe
         if phase not in ("strike", "hold"):  # positioning moves go in short straight steps, so the tip never dips
             move = np.array([reach - now_reach, height - now_height])
             length = float(np.hypot(*move))
