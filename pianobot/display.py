@@ -107,12 +107,12 @@ def print_all(console: Console, tables: list[Table]) -> None:
 def training_table(rows) -> Table:
     """(job, manifest) pairs -> the summary `pianobot train` prints at the end."""
     table = Table(title="trained policies")
-    for column in ("phrase", "used by", "steps", "eval note F1", "velocity MAE", "minutes", "folder"):
+    for column in ("phrase", "used by", "steps", "kept from step", "eval note F1", "velocity MAE", "minutes", "folder"):
         table.add_column(column)
     for job, manifest in rows:
-        evaluation = manifest.get("evaluation", {})
+        evaluation = manifest.get("evaluation", {})  # the kept (best evaluated) policy's figures
         table.add_row(
-            job.key, ", ".join(map(str, job.phrases)), str(manifest.get("steps", "-")),
+            job.key, ", ".join(map(str, job.phrases)), str(manifest.get("steps", "-")), str(evaluation.get("step", "-")),
             _opt(evaluation.get("f1"), ".3f"), _opt(evaluation.get("velocity_mae"), ".1f"),
             _opt(manifest.get("seconds", 0) / 60 if manifest.get("seconds") is not None else None, ".1f"), str(job.folder),
         )

@@ -227,6 +227,7 @@ def test_train_then_skip(tmp_path):
     assert len(folders) == 1 and (folders[0] / "policy.safetensors").exists()
     manifest = json.loads((folders[0] / "manifest.json").read_text())
     assert manifest["piece"] == "one-note.mid" and manifest["steps"] == 80 and manifest["config"]["env"]["tactile"] is False
+    assert manifest["evaluation"]["step"] == 80 and "kept" in first.output  # the summary says which evaluation's policy was kept
     second = run(*args)
     assert second.exit_code == 0 and "already trained" in second.output and "training 0 policies" in second.output
     third = run(*args, "--force")
