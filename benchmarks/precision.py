@@ -6,7 +6,7 @@ A learned policy imitates the scripted pianist (behaviour cloning) and acts on t
 its action is never exactly the teacher's. This measures what a given action error costs: the
 noise-free teacher's actions plus N(0, sigma) on every joint, on the finger joints only, or on
 the wrist only, over several hand starts of the piece's first phrase (the starts evaluation
-uses). Prints a Markdown table of mean note F1, per-step F1 and median onset error.
+uses). Prints a Markdown table of mean note F1, per-step F1 and mean onset error.
 """
 
 from __future__ import annotations
@@ -28,7 +28,7 @@ PARTS = ("all", "fingers", "wrist")
 
 
 def play(env, pianist: ScriptedPianist, sigma: float, part: str, start: int) -> tuple[float, float, float | None]:
-    """One noisy performance: (note F1, step F1, median |onset error| of the matched notes)."""
+    """One noisy performance: (note F1, step F1, mean onset error of the matched notes, or None)."""
     rng = np.random.default_rng(start)
     observation, info = env.reset(seed=EVAL_SEED + start)
     pianist.reset()
