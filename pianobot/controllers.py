@@ -163,9 +163,20 @@ class ScriptedPianist:
         """How far below the key's top surface the fingertip is when the key sounds (m)."""
         return self._contact_y(key) * math.tan(self.strike_angle)
 
+    def _strike_point(self, tip_speed: float) -> float:
+        """When in the onset's control step (0 = its start, 1 = its end) the key should sound.
+
+        The environment's steps are centred on the score's rows, so the middle of the step is
+        on time. A loud (fast) strike sounds later in the step: the fingertip goes on at the
+        strike speed for the rest of the step and must stop short of the key's bottom
+        (:attr:`hold_depth_margin` past the strike depth), or the step's speed would drop."""
+        room = self.hold_depth_margin - min(self.strike_margin, tip_speed * self.dt / 4)  # below the strike depth
+        return float(np.clip(1.0 - room / (tip_speed * self.dt), 0.5, 1.0))
+
     def _ready_steps(self, tip_speed: float, depth: float) -> int:
-        """Control steps of constant-speed travel from the ready height to the strike."""
-        return max(1, math.ceil((self.min_ready_height + depth) / (tip_speed * self.dt)))
+        """Control steps of constant-speed travel from the ready height before the onset's step."""
+        point = self._strike_point(tip_speed)
+        return max(1, math.ceil((self.min_ready_height + depth) / (tip_speed * self.dt) - point))
 
     def act(self, observation: dict) -> np.ndarray:
         """One action from the score window, the wrist position and the joint angles."""
@@ -252,16 +263,15 @@ class ScriptedPianist:
         speed = self._tip_speed(key, velocity)
         depth = self._strike_depth(key)
         steps = self._ready_steps(speed, depth)
-        height = steps * speed * self.dt - depth
+        point = self._strike_point(speed)
+        height = (steps + point) * speed * self.dt - depth
         if start > steps:
             return Plan(key, "ready", height=height, start=start, lead=steps)
-        # closed loop: after this step the fingertip should be where constant-speed travel for the
-        # remaining (start - 1) steps passes the strike depth just before the onset
+        # closed loop: after this step the fingertip should be where constant-speed travel passes
+        # the strike depth at the strike point of the onset's step, (start - 1 + point) steps on
         tip_height = self._tip_height(q, key)
         past = min(self.strike_margin, speed * self.dt / 4)
-        goal = tip_height - speed * self.dt if start == 0 else -depth - past + speed * self.dt * (start - 1)
-        if start <= 1:  # the last step never runs slower than the strike speed (too low a start: strike early)
-            goal = min(goal, tip_height - speed * self.dt)
+        goal = tip_height - speed * self.dt if start == 0 else -depth - past + speed * self.dt * (start - 1 + point)
         floor = -depth - self.hold_depth_margin
         return Plan(key, "strike", height=height, goal=float(np.clip(goal, floor, tip_height)), start=start, lead=steps)
 

@@ -183,8 +183,14 @@ class PianoEnv(gym.Env):
 
     @property
     def score_start(self) -> float:
-        """World time (s) at which the piece's time 0 falls."""
-        return self.lead_steps / self.spec_score.control_hz
+        """World time (s) at which the piece's time 0 falls.
+
+        The score tensor puts a note in the row nearest its onset (row r stands for r * dt
+        +- dt/2), so control step t, which sounds whatever the keys do from world time t * dt
+        to (t + 1) * dt, stands for the same span: the piece's time 0 is the middle of the
+        first step after the lead-in. The reward of a step thus credits onsets within half a
+        step either side of the score's, inside the note F1's 50 ms tolerance."""
+        return (self.lead_steps + 0.5) / self.spec_score.control_hz
 
     def reset(self, *, seed: int | None = None, options: dict | None = None):
         super().reset(seed=seed)
