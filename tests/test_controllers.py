@@ -85,3 +85,31 @@ def test_scripted_pianist_plays_a_phrase_from_every_hand_start():
                 break
         assert compare(info["piece"], recorder.piece(end=env.world.time, start=env.score_start)).f1 == 1.0, start
     env.close()
+
+
+def test_scripted_pianist_strikes_in_the_step_of_each_onset():
+    """Control steps are centred on the score's rows, and the reward compares a step's keys with
+    its row: a key played on time must sound in the step of its onset's row, not the one before
+    (before the steps were centred, the on-time strike fell in the row before and was penalised)."""
+    from pianobot.music.phrases import split_phrases
+    from pianobot.train import EVAL_SEED, make_env, phrase_target
+
+    phrase = split_phrases(load_piece(Path(__file__).parent.parent / "examples" / "midi" / "rhythmic.mid"))[0]
+    config = EnvConfig(tactile=False)
+    env, pianist = make_env(phrase_target(phrase), config), ScriptedPianist(config)
+    observation, _ = env.reset(seed=EVAL_SEED)
+    pianist.reset()
+    previous = np.zeros(config.world.keyboard.spec.count, dtype=bool)
+    onsets = 0
+    while True:
+        observation, _, terminated, truncated, step = env.step(pianist.act(observation))
+        for event in step["events"]:
+            if event.on:
+                key = event.pitch - config.world.keyboard.spec.lowest
+                assert step["target"][key] and not previous[key], (event, "not in its onset's step")
+                onsets += 1
+        previous = step["target"]
+        if terminated or truncated:
+            break
+    assert onsets == len(phrase.notes)
+    env.close()
