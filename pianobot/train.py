@@ -13,6 +13,8 @@ skipping what is already trained, parallel workers.
 
 from __future__ import annotations
 
+import os
+import threading
 import time
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import asdict, dataclass, field, replace
@@ -309,6 +311,22 @@ class PhraseJob:
         return {"key": self.key, "piece": self.piece, "phrases": self.phrases}
 
 
+def _exit_with_parent(parent: int, every: float = 0.5) -> None:
+    """Worker initializer: end this process when the process that started it is gone.
+
+    Ctrl-C reaches every process in the terminal's group, but a parent killed on its own
+    (``kill PID``, a closed session) would leave its workers training on unseen. Checkpoints
+    are written atomically, so ending a worker at any moment loses at most the steps since its
+    last checkpoint, which the same command trains again."""
+
+    def watch() -> None:
+        while os.getppid() == parent:
+            time.sleep(every)
+        os._exit(1)
+
+    threading.Thread(target=watch, daemon=True, name="exit-with-parent").start()
+
+
 def _run_job(job: PhraseJob, config: TrainConfig, queue=None, threads: int | None = None) -> dict:
     if threads is not None:
         torch.set_num_threads(threads)
@@ -356,7 +374,8 @@ def run_jobs(
 
     manager = multiprocessing.Manager()
     queue = manager.Queue()
-    with ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn")) as pool:
+    context = multiprocessing.get_context("spawn")
+    with ProcessPoolExecutor(max_workers=workers, mp_context=context, initializer=_exit_with_parent, initargs=(os.getpid(),)) as pool:
         futures = {pool.submit(_run_job, job, config, queue, threads): job for job in jobs}
         pending = set(futures)
         while pending:

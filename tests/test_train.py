@@ -221,3 +221,43 @@ def test_the_best_evaluated_policy_is_kept_across_an_interruption(tmp_path, monk
     assert len(rest) == 2 and resumed["evaluation"] == manifest["evaluation"]
     kept = store.load_tensors(tmp_path / "resumed" / store.POLICY_FILE)
     assert all(torch.equal(kept[k], stored[k]) for k in stored)
+
+
+def test_training_workers_end_when_their_parent_is_killed(tmp_path):
+    """`kill PID` of `pianobot train --workers N` must not leave its workers training on unseen."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    script = tmp_path / "parent.py"
+    script.write_text(
+        "import multiprocessing, os, time\n"
+        "from concurrent.futures import ProcessPoolExecutor\n"
+        "from pianobot.train import _exit_with_parent\n"
+        "def nap():\n"
+        "    print(os.getpid(), flush=True)\n"
+        "    time.sleep(60)\n"
+        "if __name__ == '__main__':\n"
+        "    context = multiprocessing.get_context('spawn')\n"
+        "    with ProcessPoolExecutor(2, mp_context=context, initializer=_exit_with_parent, initargs=(os.getpid(),)) as pool:\n"
+        "        futures = [pool.submit(nap) for _ in range(2)]\n"
+        "        time.sleep(60)\n"
+    )
+    parent = subprocess.Popen([sys.executable, str(script)], stdout=subprocess.PIPE, text=True)
+    workers = [int(parent.stdout.readline()) for _ in range(2)]
+    os.kill(parent.pid, signal.SIGKILL)
+    parent.wait()
+
+    def alive(pid: int) -> bool:
+        try:
+            with open(f"/proc/{pid}/stat") as stat:
+                return stat.read().rsplit(")", 1)[1].split()[0] != "Z"  # a zombie has ended
+        except FileNotFoundError:
+            return False
+
+    deadline = time.monotonic() + 20
+    while any(alive(p) for p in workers) and time.monotonic() < deadline:
+        time.sleep(0.2)
+    assert not any(alive(p) for p in workers)
