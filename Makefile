@@ -16,7 +16,7 @@ install: $(BIN)/pianobot
 
 demo: install
 	mkdir -p out
-	$(BIN)/pianobot play examples/midi/twinkle.mid -o out/twinkle.mid --video out/twinkle.mp4
+	$(BIN)/pianobot play examples/midi/twinkle.mid -o out/twinkle.mid --video out/twinkle.mp4  # the policies in models/
 	$(BIN)/pianobot score out/twinkle.mid examples/midi/twinkle.mid --no-notes --plot out/twinkle.png
 
 test: install

@@ -258,7 +258,7 @@ def score(
 def play(
     song: Path = typer.Argument(..., help="The piece to play, a .mid file with fingering."),
     output: Path = typer.Option(..., "--output", "-o", help="Write what the simulated piano sounded to this .mid file."),
-    controller: str = typer.Option("scripted", "--controller", help="Who plays: 'sac' (the trained phrase policies), 'scripted' (the hand-written pianist) or 'random'."),
+    controller: str = typer.Option("sac", "--controller", help="Who plays: 'sac' (the trained phrase policies), 'scripted' (the hand-written pianist) or 'random'."),
     models: Path = typer.Option(Path("models"), "--models", help="Folder of the model store (for --controller sac)."),
     fallback: Optional[str] = typer.Option(None, "--fallback", help="'scripted': play phrases that have no trained policy with the scripted pianist."),
     phrase_notes: int = PhraseNotes,
@@ -307,7 +307,8 @@ def play(
             first = missing[0]
             raise PianobotError(
                 f"phrase {first.index} ({' '.join(n.name for n in first.notes)}) of {song.name} has no trained policy in {models}: "
-                f"train it with `pianobot train {song}` (same reading options), or add --fallback scripted"
+                f"train it with `pianobot train {song}` (same reading options), add --fallback scripted, "
+                f"or play with --controller scripted"
             )
         trained = training_config(models, phrases)
         if trained is not None:

@@ -158,7 +158,7 @@ def test_version():
 
 def test_play_scripted_writes_a_performance_that_scores_well(tmp_path):
     out = tmp_path / "out.mid"
-    result = run("play", EXAMPLES / "three-note.mid", "-o", out, "--video", tmp_path / "out.mp4", "--wav", tmp_path / "out.wav")
+    result = run("play", EXAMPLES / "three-note.mid", "-o", out, "--controller", "scripted", "--video", tmp_path / "out.mp4", "--wav", tmp_path / "out.wav")
     assert result.exit_code == 0, result.output
     report = json.loads((tmp_path / "out.report.json").read_text())
     assert report["f1"] >= 0.95 and report["velocity_mae"] <= 10 and report["controller"] == "scripted"
@@ -235,8 +235,9 @@ def test_train_then_skip(tmp_path):
 
 
 def test_play_sac_without_policies_names_the_phrase_and_the_train_command(tmp_path):
-    result = run("play", EXAMPLES / "three-note.mid", "-o", tmp_path / "x.mid", "--controller", "sac", "--models", tmp_path)
-    assert_one_line_error(result, "phrase 0 (C4 D4 E4)", "pianobot train", "--fallback scripted")
+    """The trained policies play by default: without them, one line says how to get them or what else to do."""
+    result = run("play", EXAMPLES / "three-note.mid", "-o", tmp_path / "x.mid", "--models", tmp_path)
+    assert_one_line_error(result, "phrase 0 (C4 D4 E4)", "pianobot train", "--fallback scripted", "--controller scripted")
     assert not (tmp_path / "x.mid").exists()
 
 

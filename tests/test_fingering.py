@@ -189,7 +189,7 @@ def test_finger_command_writes_a_fingered_file_and_inspect_explains_a_recording(
 def test_play_plans_fingering_for_an_unfingered_file_and_says_so(tmp_path):
     runner = CliRunner()
     song = write_midi(melody("E4 D4 C4 D4 E4 E4 E4", beat=0.6), tmp_path / "mary.mid")
-    result = runner.invoke(app, ["play", str(song), "-o", str(tmp_path / "out.mid")])
+    result = runner.invoke(app, ["play", str(song), "-o", str(tmp_path / "out.mid"), "--controller", "scripted"])
     assert result.exit_code == 0, result.output
     assert "fingering planned" in result.stderr
     played = read_midi(tmp_path / "out.mid")
