@@ -163,6 +163,10 @@ class ScriptedPianist:
         """How far below the key's top surface the fingertip is when the key sounds (m)."""
         return self._contact_y(key) * math.tan(self.strike_angle)
 
+    def _overshoot(self, tip_speed: float) -> float:
+        """How far (m) past the strike depth the fingertip is planned to be when the key sounds."""
+        return min(self.strike_margin, tip_speed * self.dt / 4)
+
     def _strike_point(self, tip_speed: float) -> float:
         """When in the onset's control step (0 = its start, 1 = its end) the key should sound.
 
@@ -170,7 +174,7 @@ class ScriptedPianist:
         on time. A loud (fast) strike sounds later in the step: the fingertip goes on at the
         strike speed for the rest of the step and must stop short of the key's bottom
         (:attr:`hold_depth_margin` past the strike depth), or the step's speed would drop."""
-        room = self.hold_depth_margin - min(self.strike_margin, tip_speed * self.dt / 4)  # below the strike depth
+        room = self.hold_depth_margin - self._overshoot(tip_speed)  # below the strike depth
         return float(np.clip(1.0 - room / (tip_speed * self.dt), 0.5, 1.0))
 
     def _ready_steps(self, tip_speed: float, depth: float) -> int:
@@ -270,8 +274,7 @@ class ScriptedPianist:
         # closed loop: after this step the fingertip should be where constant-speed travel passes
         # the strike depth at the strike point of the onset's step, (start - 1 + point) steps on
         tip_height = self._tip_height(q, key)
-        past = min(self.strike_margin, speed * self.dt / 4)
-        goal = tip_height - speed * self.dt if start == 0 else -depth - past + speed * self.dt * (start - 1 + point)
+        goal = tip_height - speed * self.dt if start == 0 else -depth - self._overshoot(speed) + speed * self.dt * (start - 1 + point)
         floor = -depth - self.hold_depth_margin
         return Plan(key, "strike", height=height, goal=float(np.clip(goal, floor, tip_height)), start=start, lead=steps)
 
