@@ -36,7 +36,7 @@ from pianobot.fingering import ensure_fingering
 from pianobot.music.load import HANDS, LoadOptions, hand_tracks, load_part, load_piece
 from pianobot.music.midi_io import write_midi
 from pianobot.audio import write_wav
-from pianobot.compose import CompositionalController, missing_phrases, training_config
+from pianobot.compose import CompositionalController, missing_phrases, trained_split, training_config
 from pianobot.perform import CONTROLLERS, perform, write_video
 from pianobot.sim.hand import HandConfig
 from pianobot.sim.keyboard import KeyboardConfig
@@ -92,6 +92,9 @@ LowestNote = typer.Option(
 Keys = typer.Option(KeyboardSpec.count, "--keys", help="Number of keys on the keyboard.")
 Thumb = typer.Option(False, "--thumb", help="Let the hand use its thumb (finger 1) too.")
 PhraseNotes = typer.Option(DEFAULT_MAX_NOTES, "--phrase-notes", help="Most notes in one phrase (one policy each).")
+PlayPhraseNotes = typer.Option(
+    None, "--phrase-notes", help=f"Most notes in one phrase (default: the longest phrases, up to {DEFAULT_MAX_NOTES} notes, whose policies are all trained)."
+)
 Hand = typer.Option(None, "--hand", help="Play one hand's part of a two-hand piece: right or left (tracks named for it, else split by pitch).")
 Split = typer.Option("C4", "--split", help="With --hand and no track named for it: lowest note of the right hand's part.")
 Quantize = typer.Option(None, "--quantize", help="Move onsets and offsets to a grid, e.g. 1/16 (for recordings of human players).")
@@ -261,7 +264,7 @@ def play(
     controller: str = typer.Option("sac", "--controller", help="Who plays: 'sac' (the trained phrase policies), 'scripted' (the hand-written pianist) or 'random'."),
     models: Path = typer.Option(Path("models"), "--models", help="Folder of the model store (for --controller sac)."),
     fallback: Optional[str] = typer.Option(None, "--fallback", help="'scripted': play phrases that have no trained policy with the scripted pianist."),
-    phrase_notes: int = PhraseNotes,
+    phrase_notes: Optional[int] = PlayPhraseNotes,
     seed: int = typer.Option(0, "--seed", help="Seed of the simulation (the hand's start position) and of the random controller."),
     video: Optional[Path] = typer.Option(None, "--video", help="Also record the performance to this .mp4 file."),
     wav: Optional[Path] = typer.Option(None, "--wav", help="Also synthesise what was played to this .wav file."),
@@ -301,8 +304,11 @@ def play(
     sources: dict = {}
     who = controller
     if controller == "sac":
-        phrases = split_phrases(piece, phrase_notes)
+        phrases = trained_split(models, piece, phrase_notes)
         missing = missing_phrases(models, phrases)
+        if phrase_notes is None and phrases != split_phrases(piece, DEFAULT_MAX_NOTES):
+            most = max(len(p.notes) for p in phrases)
+            out.print(f"[dim]{len(phrases)} phrases of at most {most} note{'s' * (most > 1)}: the split the policies in {models} were trained for[/dim]")
         if missing and not fallback:
             first = missing[0]
             raise PianobotError(

@@ -19,7 +19,8 @@ from pianobot import store
 from pianobot.controllers import ScriptedPianist
 from pianobot.env import PianoEnv
 from pianobot.errors import PianobotError
-from pianobot.music.phrases import Phrase
+from pianobot.music.phrases import DEFAULT_MAX_NOTES, Phrase, split_phrases
+from pianobot.music.piece import Piece
 from pianobot.music.tensor import score_tensor
 from pianobot.train import TrainConfig, config_from_manifest, load_policy, phrase_target
 
@@ -45,6 +46,24 @@ def find_policy(models: Path, phrase: Phrase) -> Path | None:
 
 def missing_phrases(models: Path, phrases: list[Phrase]) -> list[Phrase]:
     return [p for p in phrases if find_policy(models, p) is None]
+
+
+def trained_split(models: Path, piece: Piece, phrase_notes: int | None) -> list[Phrase]:
+    """The piece's phrases for compositional play.
+
+    ``phrase_notes`` given: the split it makes. Otherwise the longest phrases (at most
+    :data:`DEFAULT_MAX_NOTES` notes) whose policies are all stored, so that a piece trained with
+    ``--phrase-notes 3`` plays without repeating the option; when no split is fully trained,
+    the default split (whose missing phrases are then reported, or played by the fallback).
+    """
+    if phrase_notes is not None:
+        return split_phrases(piece, phrase_notes)
+    widest = max((len(c) for c in piece.chords()), default=1)  # a chord is never split across phrases
+    for most in range(DEFAULT_MAX_NOTES, widest - 1, -1):
+        phrases = split_phrases(piece, most)
+        if not missing_phrases(models, phrases):
+            return phrases
+    return split_phrases(piece, DEFAULT_MAX_NOTES)
 
 
 def training_config(models: Path, phrases: list[Phrase]) -> TrainConfig | None:

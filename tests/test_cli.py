@@ -300,6 +300,12 @@ def test_train_workers_train_phrases_in_parallel(tmp_path):
     assert result.exit_code == 0, result.output
     manifests = [json.loads(p.read_text()) for p in (tmp_path / "models").glob("*/manifest.json")]
     assert sorted(m["phrases"] for m in manifests) == [[0], [1]] and all(m["steps"] == 40 for m in manifests)
+    # play finds the split the policies were trained for without being told --phrase-notes 1
+    played = run("play", song, "-o", tmp_path / "out.mid", "--models", tmp_path / "models")
+    assert played.exit_code == 0, played.output
+    assert "2 phrases of at most 1 note:" in played.output
+    phrases = json.loads((tmp_path / "out.report.json").read_text())["phrases"]
+    assert sorted(phrases) == ["0", "1"] and all(v.startswith("policy ") for v in phrases.values())
 
 
 MODELS = Path(__file__).parent.parent / "models"
@@ -307,12 +313,11 @@ MODELS = Path(__file__).parent.parent / "models"
 
 def _committed_examples() -> list[Path]:
     """Examples whose every phrase has a policy committed in models/."""
-    from pianobot.compose import missing_phrases
+    from pianobot.compose import missing_phrases, trained_split
     from pianobot.music.load import load_piece
-    from pianobot.music.phrases import split_phrases
 
     return [p for p in sorted(EXAMPLES.glob("*.mid")) if "performed" not in p.stem
-            and not missing_phrases(MODELS, split_phrases(load_piece(p)))]
+            and not missing_phrases(MODELS, trained_split(MODELS, load_piece(p), None))]
 
 
 def test_the_committed_policies_cover_the_one_note_task_at_least():
