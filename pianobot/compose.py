@@ -3,9 +3,11 @@ played by the policies of its phrases, one after another, in one continuous simu
 
 Each phrase's policy was trained on its phrase alone, seeing a sliding score window of only that
 phrase's notes. During the performance the active policy sees the same thing: the window at the
-current time, masked to its own phrase. Control passes from phrase k-1 to phrase k one step after
-phrase k-1 struck its last note, or one lead-in before phrase k's first note, whichever is later;
-the hand is wherever the previous policy left it.
+current time, masked to its own phrase. Control passes from phrase k-1 to phrase k once the
+onset tolerance of phrase k-1's last note has run out (a strike up to 50 ms late still counts, so
+its policy keeps the hand until then), or one lead-in before phrase k's first note, whichever is
+later, but at the latest one step before phrase k's first onset; the hand is wherever the
+previous policy left it.
 """
 
 from __future__ import annotations
@@ -13,12 +15,15 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
+import math
+
 import numpy as np
 
 from pianobot import store
 from pianobot.controllers import ScriptedPianist
 from pianobot.env import PianoEnv
 from pianobot.errors import PianobotError
+from pianobot.metrics import DEFAULT_ONSET_TOLERANCE
 from pianobot.music.phrases import DEFAULT_MAX_NOTES, Phrase, split_phrases
 from pianobot.music.piece import Piece
 from pianobot.music.tensor import score_tensor
@@ -87,11 +92,16 @@ class CompositionalController:
     def __init__(self, env: PianoEnv, phrases: list[Phrase], models: Path, config: TrainConfig, fallback: bool):
         spec = env.spec_score
         lead = env.lead_steps
+        grace = math.ceil(DEFAULT_ONSET_TOLERANCE * spec.control_hz - 1e-9)  # steps a strike may come late
         self.sections: list[Section] = []
         previous_last_onset = None
         for phrase in phrases:
             start = lead + spec.step_of(phrase.start)
-            first = 0 if previous_last_onset is None else max(previous_last_onset + 1, start - lead)
+            if previous_last_onset is None:
+                first = 0
+            else:
+                latest = max(start - 1, previous_last_onset + 1)
+                first = max(min(previous_last_onset + 1 + grace, latest), start - lead)
             timeline = np.zeros_like(env.score)
             tensor = score_tensor(phrase_target(phrase), spec)
             end = min(start + len(tensor), len(timeline))
