@@ -151,7 +151,8 @@ def inspect(
     lowest_note: str = LowestNote,
     keys: int = Keys,
     thumb: bool = Thumb,
-    phrase_notes: int = PhraseNotes,
+    phrase_notes: Optional[int] = PlayPhraseNotes,
+    models: Path = typer.Option(Path("models"), "--models", help="Model store whose trained phrase split to show (as play uses it)."),
 ):
     """Explain what a file holds (tracks, hands, pedal, range, polyphony, fingering) and whether the hand can play it."""
     keyboard, hand_spec = make_instrument(lowest_note, keys, thumb)
@@ -184,9 +185,10 @@ def inspect(
         out.print(f"fingering planned for fingers {hand_spec.describe()}: wrist travel {plan.travel * 100:.1f} cm in {plan.moves} moves")
         for problem in plan.problems:
             out.print(f"[yellow]{problem}[/yellow]")
-    phrases = split_phrases(piece, phrase_notes)
+    phrases = trained_split(models, piece, phrase_notes)
     out.print(display.notes_table(piece, phrases))
-    out.print(display.phrases_table(phrases))
+    missing = {p.index for p in missing_phrases(models, phrases)}
+    out.print(display.phrases_table(phrases, {p.index for p in phrases} - missing))
     check_playable(piece, keyboard, hand_spec)
     out.print(f"[green]playable[/green] on {keyboard.describe()} with fingers {hand_spec.describe()}")
 

@@ -44,15 +44,17 @@ def notes_table(piece: Piece, phrases: list[Phrase]) -> Table:
     return table
 
 
-def phrases_table(phrases: list[Phrase]) -> Table:
-    table = Table(title=f"{len(phrases)} phrases")
-    for column in ("phrase", "hash", "notes", "start s", "end s", "pitches"):
+def phrases_table(phrases: list[Phrase], trained: set[int] | None = None) -> Table:
+    """The phrases; with ``trained`` (indices of the phrases with a stored policy), a column saying which are trained."""
+    table = Table(title=f"{len(phrases)} phrase{'s' * (len(phrases) != 1)}")
+    columns = ("phrase", "hash", "notes", "start s", "end s", "pitches") + (("policy",) if trained is not None else ())
+    for column in columns:
         table.add_column(column)
     for p in phrases:
-        table.add_row(
-            str(p.index), p.hash, str(len(p.notes)), f"{p.start:.3f}", f"{p.end:.3f}",
-            " ".join(n.name for n in p.notes),
-        )
+        row = [str(p.index), p.hash, str(len(p.notes)), f"{p.start:.3f}", f"{p.end:.3f}", " ".join(n.name for n in p.notes)]
+        if trained is not None:
+            row.append("trained" if p.index in trained else "[yellow]none[/yellow]")
+        table.add_row(*row)
     return table
 
 

@@ -1,4 +1,5 @@
 import json
+import re
 from dataclasses import replace
 from pathlib import Path
 
@@ -68,6 +69,14 @@ def test_inspect_shows_notes_phrases_and_range():
     assert result.exit_code == 0, result.output
     assert "14 notes" in result.output and "3 phrases" in result.output
     assert "playable on C4-B5" in result.output
+
+
+def test_inspect_shows_the_phrase_split_play_uses_and_which_phrases_are_trained(tmp_path):
+    """chord.mid's policies were trained as three one-chord phrases (models/README.md)."""
+    trained = run("inspect", EXAMPLES / "chord.mid")
+    assert "3 phrases" in trained.output and trained.output.count("trained") >= 3
+    bare = run("inspect", EXAMPLES / "chord.mid", "--models", tmp_path)  # nothing trained: the default split
+    assert re.search(r"\b1 phrase\b(?!s)", bare.output) and "none" in bare.output and "trained" not in bare.output
 
 
 def test_inspect_with_transpose_tempo_and_keyboard_options(tmp_path):
