@@ -1,6 +1,7 @@
 """SAC gradient updates per second: pianobot's agent against Stable-Baselines3's SAC, same run.
 
     python benchmarks/sac.py [--repeats 5] [--updates 60] [--threads 1]
+    python benchmarks/sac.py --compile      # ours with and without torch.compile instead
 
 Both learn on the same environment (examples/midi/three-note.mid, state only and with tactile
 images of 3 fingertips) with batch size 256, from a replay buffer filled by 1000 random steps.
@@ -31,11 +32,22 @@ def make_env(tactile: bool) -> PianoEnv:
     return PianoEnv(piece=load_piece(ROOT / "examples" / "midi" / "three-note.mid"), config=EnvConfig(tactile=tactile))
 
 
-def ours(tactile: bool, updates: int, repeats: int) -> list[float]:
+def compile_agent(agent: SAC) -> SAC:
+    """torch.compile (inductor) on every network pass an update makes: encoders, Q heads, actor."""
+    for critic in (agent.critic, agent.target):
+        critic.encoder.forward = torch.compile(critic.encoder.forward)
+        critic.q = torch.compile(critic.q)
+    agent.actor.forward = torch.compile(agent.actor.forward)
+    return agent
+
+
+def ours(tactile: bool, updates: int, repeats: int, compiled: bool = False) -> list[float]:
     env = make_env(tactile)
     space = env.observation_space
     shape = space["tactile"].shape if tactile else None
     agent = SAC(vector_size(space), score_size(space), shape, 13, SACConfig())
+    if compiled:
+        agent = compile_agent(agent)
     buffer = ReplayBuffer(FILL, vector_size(space), shape, 13)
     rng = np.random.default_rng(0)
     observation, _ = env.reset(seed=0)
@@ -76,8 +88,12 @@ def main() -> None:
     parser.add_argument("--repeats", type=int, default=5)
     parser.add_argument("--updates", type=int, default=60)
     parser.add_argument("--threads", type=int, default=1, help="torch threads for both")
+    parser.add_argument("--compile", action="store_true", help="compare ours with torch.compile instead of Stable-Baselines3")
     args = parser.parse_args()
     torch.set_num_threads(args.threads)
+    if args.compile:
+        compare_compile(args)
+        return
     print(f"torch {torch.__version__}, {args.threads} thread(s), batch 256, {args.updates} updates x {args.repeats} repeats\n")
     print("| configuration | pianobot updates/s | Stable-Baselines3 updates/s | ratio |")
     print("| --- | ---: | ---: | ---: |")
@@ -87,6 +103,18 @@ def main() -> None:
         a, b = statistics.median(mine), statistics.median(theirs)
         label = "tactile (3 fingertips, 15x20)" if tactile else "state only"
         print(f"| {label} | {a:.1f} ({', '.join(f'{x:.1f}' for x in mine)}) | {b:.1f} ({', '.join(f'{x:.1f}' for x in theirs)}) | {a / b:.2f}x |")
+
+
+def compare_compile(args) -> None:
+    print(f"torch {torch.__version__}, {args.threads} thread(s), batch 256, {args.updates} updates x {args.repeats} repeats\n")
+    print("| configuration | eager updates/s | torch.compile updates/s | ratio |")
+    print("| --- | ---: | ---: | ---: |")
+    for tactile in (False, True):
+        eager = ours(tactile, args.updates, args.repeats)
+        compiled = ours(tactile, args.updates, args.repeats, compiled=True)  # compiles during its warm-up updates
+        a, b = statistics.median(eager), statistics.median(compiled)
+        label = "tactile (3 fingertips, 15x20)" if tactile else "state only"
+        print(f"| {label} | {a:.1f} ({', '.join(f'{x:.1f}' for x in eager)}) | {b:.1f} ({', '.join(f'{x:.1f}' for x in compiled)}) | {b / a:.2f}x |")
 
 
 if __name__ == "__main__":
