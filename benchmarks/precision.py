@@ -22,7 +22,7 @@ from pianobot.music.instrument import HandSpec
 from pianobot.music.load import LoadOptions, load_part
 from pianobot.music.phrases import split_phrases
 from pianobot.sim.recorder import NoteRecorder
-from pianobot.train import EVAL_SEED, TrainConfig, _env_config, make_env, phrase_target
+from pianobot.train import EVAL_SEED, TrainConfig, agent_env_config, make_env, phrase_target
 
 PARTS = ("all", "fingers", "wrist")
 
@@ -55,7 +55,7 @@ def main() -> None:
     parser.add_argument("--starts", type=int, default=4, help="hand starts per setting")
     args = parser.parse_args()
 
-    env_config = _env_config(TrainConfig())
+    env_config = agent_env_config(TrainConfig())
     piece = load_part(Path(args.song), LoadOptions(), HandSpec())
     env = make_env(phrase_target(split_phrases(piece)[0]), env_config)
     pianist = ScriptedPianist(env_config)

@@ -5,7 +5,10 @@
 - ``prior``: ``repeat`` plus the wrist stabiliser: the wrist moves in only 10 % of the steps
   (the paper's best);
 - ``scripted``: the scripted pianist's action plus Gaussian noise (ours: a prior that already
-  knows where the keys are; it fills the replay buffer with mostly good playing).
+  knows where the keys are). The noise's scale is drawn once per episode, log-uniformly in
+  :data:`SCRIPTED_NOISE`: a strike fails with noise above about 0.02 (docs/benchmarks.md, "How
+  precise must a policy be?"), so quiet episodes fill the buffer with notes played right and
+  noisy ones with the states a learner's mistakes lead to.
 """
 
 from __future__ import annotations
@@ -18,7 +21,8 @@ from pianobot.env import EnvConfig
 EXPLORATIONS = ("uniform", "repeat", "prior", "scripted")
 REPEAT_PROBABILITY = 0.8
 WRIST_MOVE_PROBABILITY = 0.1
-SCRIPTED_NOISE = 0.2
+SCRIPTED_NOISE = (0.005, 0.2)
+"""Range of the per-episode noise scale of ``scripted`` exploration (log-uniform)."""
 
 
 class Explorer:
@@ -34,11 +38,14 @@ class Explorer:
         self.pianist = ScriptedPianist(config) if kind == "scripted" else None
         self.previous: np.ndarray | None = None
         self.select = select
+        self.noise = 0.0
 
     def reset(self) -> None:
         self.previous = None
         if self.pianist is not None:
             self.pianist.reset()
+            low, high = np.log(SCRIPTED_NOISE)
+            self.noise = float(np.exp(self.rng.uniform(low, high)))
 
     def teach(self, observation: dict) -> np.ndarray | None:
         """The scripted pianist's noise-free action for this step (call once per step, in order:
@@ -51,7 +58,7 @@ class Explorer:
     def act(self, observation: dict, taught: np.ndarray | None = None) -> np.ndarray:
         """An exploration action; ``taught`` is this step's :meth:`teach` result, if already asked."""
         if self.kind == "scripted":
-            action = (taught if taught is not None else self.teach(observation)) + self.rng.normal(0.0, SCRIPTED_NOISE, self.size)
+            action = (taught if taught is not None else self.teach(observation)) + self.rng.normal(0.0, self.noise, self.size)
             return np.clip(action, -1.0, 1.0).astype(np.float32)
         action = self.rng.uniform(-1.0, 1.0, self.size).astype(np.float32)
         if self.kind in ("repeat", "prior") and self.previous is not None and self.rng.random() < REPEAT_PROBABILITY:

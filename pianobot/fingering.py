@@ -105,7 +105,7 @@ class Planner:
 
     def _transition(self, prev: tuple, chord: tuple, fingers_prev: tuple, fingers: tuple, held: list[bool], time: float) -> np.ndarray:
         """Cost (W_prev x W) of going from one state's fingers to the next's, for every pair of wrist positions."""
-        (prev_notes, prev_keys), (notes, keys) = prev, chord
+        (_, prev_keys), (_, keys) = prev, chord
         move = self.grid[None, :] - self.grid[:, None]  # wrist displacement, rows: from, columns: to
         cost = np.abs(move) / self.pitch + MOVE_COST * (np.abs(move) > 1e-9)
         for key_p, finger_p, is_held in zip(prev_keys, fingers_prev, held):

@@ -73,7 +73,7 @@ class Progress:
     losses: dict | None = None
 
 
-def _env_config(config: TrainConfig) -> EnvConfig:
+def agent_env_config(config: TrainConfig) -> EnvConfig:
     """The environment as the agent sees it: tactile images at the agent's resolution."""
     return replace(config.env, tactile_pool=config.sac.tactile_resolution)
 
@@ -88,12 +88,13 @@ def make_env(target: Piece | str, env_config: EnvConfig) -> PianoEnv:
     return PianoEnv(task=target, config=env_config) if isinstance(target, str) else PianoEnv(piece=target, config=env_config)
 
 
-def evaluate(agent: SAC, target: Piece | str, env_config: EnvConfig, episodes: int) -> dict:
-    """Deterministic policy on fixed hand starts: mean note F1, velocity error and return."""
+def evaluate(agent: SAC, target: Piece | str, env_config: EnvConfig, episodes: int, first_seed: int = EVAL_SEED) -> dict:
+    """Deterministic policy on fixed hand starts (and task instances), seeds ``first_seed``,
+    ``first_seed + 1``, ...: mean note F1, velocity error and return."""
     env = make_env(target, env_config)
     f1s, errors, returns = [], [], []
     for i in range(episodes):
-        observation, info = env.reset(seed=EVAL_SEED + i)
+        observation, info = env.reset(seed=first_seed + i)
         recorder, total = NoteRecorder(), 0.0
         while True:
             observation, reward, terminated, truncated, step_info = env.step(agent.act(*split_observation(observation), deterministic=True))
@@ -139,7 +140,7 @@ def train_policy(
     ``about`` goes into the manifest (piece, phrase hash, ...).
     """
     torch.manual_seed(config.seed)  # before the networks are made: their first weights come from it
-    env_config = _env_config(config)
+    env_config = agent_env_config(config)
     env = make_env(target, env_config)
     agent = make_agent(env, config)
     space = env.observation_space
@@ -200,7 +201,8 @@ def train_policy(
             episode_return = 0.0
             if step >= next_eval and step > config.sac.exploration_steps:
                 figures = evaluate(agent, target, env_config, config.eval_episodes)
-                evaluations.append({"step": step, **figures})
+                temperature = {k: round(losses[k], 4) for k in ("alpha", "entropy")} if losses else {}
+                evaluations.append({"step": step, **figures, **temperature})
                 if better(figures, best):
                     best, best_tensors = {"step": step, **figures}, agent.tensors(with_training_state=False)
                 report(Progress(step, config.steps, eval_f1=figures["f1"]))

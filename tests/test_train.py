@@ -132,6 +132,31 @@ def test_exploration_strategies(kind):
         assert 0.7 < repeats < 0.9 and wrist_moves < 0.2
 
 
+def test_scripted_exploration_mixes_quiet_episodes_that_play_with_noisy_ones():
+    """A strike fails with noise much above 0.02: the noise scale is drawn per episode, so the
+    buffer gets episodes that play the note (a fixed 0.2 played none) and ones that go astray."""
+    from pianobot.metrics import compare
+    from pianobot.sim.recorder import NoteRecorder
+
+    env = make_env(PHRASE, EnvConfig(tactile=False))
+    explorer = Explorer("scripted", env.action_space.shape[0], env.config, np.random.default_rng(0), select=env.actuated)
+    noises, f1s = [], []
+    for episode in range(10):
+        observation, info = env.reset(seed=episode)
+        explorer.reset()
+        recorder = NoteRecorder()
+        while True:
+            observation, _, _, truncated, step = env.step(explorer.act(observation))
+            recorder.add(step["events"], step["fingers"])
+            if truncated:
+                break
+        noises.append(explorer.noise)
+        f1s.append(compare(info["piece"], recorder.piece(end=env.world.time, start=env.score_start)).f1)
+    noises, f1s = np.array(noises), np.array(f1s)
+    assert np.all((0.005 <= noises) & (noises <= 0.2)) and noises.min() < 0.02 and noises.max() > 0.05
+    assert np.all(f1s[noises < 0.02] == 1.0)
+
+
 def _agent_and_batch(demo_weight: float, demo: float):
     from pianobot.agent.sac import SAC
 

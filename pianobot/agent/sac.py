@@ -33,8 +33,11 @@ class SACConfig:
     """Adam, for actor, critic and temperature (paper)."""
     initial_alpha: float = 0.02
     """Initial entropy temperature (paper)."""
-    target_entropy_scale: float = 1.0
-    """Target entropy = -scale * action dimensions."""
+    target_entropy_scale: float = 2.5
+    """Target entropy = -scale * action dimensions. A Gaussian's entropy is 1.42 + ln(sigma) per
+    dimension, so 2.5 lets the policy explore with a noise of about 0.02 per action on average:
+    more than that and a strike fails (docs/benchmarks.md, "How precise must a policy be?").
+    The usual 1.0 (sigma near 0.09) failed most of the policy's own training episodes."""
     tau: float = 0.005
     """Polyak factor of the target critic."""
     hidden: int = 256
