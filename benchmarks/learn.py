@@ -22,6 +22,7 @@ from pianobot import store
 from pianobot.agent.sac import SACConfig
 from pianobot.env import EnvConfig
 from pianobot.train import (
+    TASK_EVAL_EPISODES,
     TRAIN_JOINTS,
     TrainConfig,
     agent_env_config,
@@ -67,7 +68,7 @@ def main() -> None:
     parser.add_argument("--steps", type=int, default=100_000)
     parser.add_argument("--exploration-steps", type=int, default=SACConfig.exploration_steps)
     parser.add_argument("--eval-every", type=int, default=5_000)
-    parser.add_argument("--eval-episodes", type=int, default=20)
+    parser.add_argument("--eval-episodes", type=int, default=TASK_EVAL_EPISODES)
     parser.add_argument("--explore", default=TrainConfig.explore)
     parser.add_argument("--check-episodes", type=int, default=30, help="fresh instances the kept policy plays at the end")
     parser.add_argument("--until-f1", type=float, default=None, help="stop a run once an evaluation reaches this F1")

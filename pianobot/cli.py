@@ -31,7 +31,7 @@ from pianobot.explore import EXPLORATIONS
 from pianobot.music.tasks import TASKS
 from pianobot.rewards import REWARDS, RewardConfig
 from pianobot.sim.world import CONTROL_MODES
-from pianobot.train import TRAIN_JOINTS, PhraseJob, TrainConfig, plan_jobs, run_jobs
+from pianobot.train import TASK_EVAL_EPISODES, TRAIN_JOINTS, PhraseJob, TrainConfig, plan_jobs, run_jobs
 from pianobot.fingering import ensure_fingering
 from pianobot.music.load import HANDS, LoadOptions, hand_tracks, load_part, load_piece
 from pianobot.music.midi_io import write_midi
@@ -411,7 +411,8 @@ def train(
     world = WorldConfig(keyboard=KeyboardConfig(spec=keyboard), hand=HandConfig(spec=hand), control=control)
     env = EnvConfig(world=world, reward=RewardConfig(kind=reward, fingering_gate=fingering_gate), tactile=tactile,
                     actuated=tuple(j for j in JOINT_KINDS if j in actuated))
-    config = TrainConfig(steps=steps, seed=seed, explore=explore, until_f1=until_f1, sac=SACConfig(exploration_steps=exploration_steps), env=env)
+    config = TrainConfig(steps=steps, seed=seed, explore=explore, until_f1=until_f1, sac=SACConfig(exploration_steps=exploration_steps), env=env,
+                         eval_episodes=TASK_EVAL_EPISODES if task is not None else TrainConfig.eval_episodes)
     if task is not None:
         jobs = [PhraseJob(f"task-{task}", task, store.model_dir(models, f"task-{task}", config), [0], f"task {task}")]
         todo = [j for j in jobs if force or not store.is_trained(j.folder)]

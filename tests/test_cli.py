@@ -243,6 +243,18 @@ def test_train_then_skip(tmp_path):
     assert "training 1 policy" in third.output
 
 
+def test_train_a_task_family_evaluates_on_many_instances(tmp_path):
+    """A task's instances all differ: its evaluation plays TASK_EVAL_EPISODES of them, not a phrase's 3."""
+    from pianobot.train import TASK_EVAL_EPISODES
+
+    result = run("train", "--task", "one-note", "--steps", "60", "--exploration-steps", "30", "--no-tactile", "--models", tmp_path)
+    assert result.exit_code == 0, result.output
+    (folder,) = [d for d in tmp_path.iterdir() if d.is_dir()]
+    manifest = json.loads((folder / "manifest.json").read_text())
+    assert folder.name.startswith("task-one-note-") and manifest["target"] == "one-note"
+    assert manifest["config"]["eval_episodes"] == TASK_EVAL_EPISODES > 3
+
+
 def test_play_sac_without_policies_names_the_phrase_and_the_train_command(tmp_path):
     """The trained policies play by default: without them, one line says how to get them or what else to do."""
     result = run("play", EXAMPLES / "three-note.mid", "-o", tmp_path / "x.mid", "--models", tmp_path)
