@@ -7,8 +7,8 @@ lead-in (the hand gets ready), the phrase, and a short tail; its end is ``trunca
 Observations (a dict, see docs/environment.md): the score's L x (2+F) matrix for the current
 step and ``lookahead`` following steps; the fingertips' tactile images of the last two steps
 (uint8, pooled by default); wrist position and speed; finger joint angles and speeds; for each
-finger, where the next key it has to play lies relative to its fingertip (our addition, see
-docs/training.md); and, only when asked for (the paper's ablation), key angles and speeds.
+finger, where the next key it has to play lies relative to its fingertip, how soon and how loud
+(our addition, see docs/training.md); and, only when asked for (the paper's ablation), key angles and speeds.
 Actions: the actuated finger joints (of abduction, MCP, PIP, DIP per finger) then the wrist,
 each in [-1, 1].
 """
@@ -59,21 +59,26 @@ TARGET_SCALE = 0.1
 """Fingertip-to-key offsets are observed in units of this many metres (clipped to +-SPEED_BOUND)."""
 
 
-def finger_targets(window: np.ndarray, tips: dict[int, np.ndarray], points: np.ndarray, fingers: tuple[int, ...]) -> np.ndarray:
+def finger_targets(
+    window: np.ndarray, tips: dict[int, np.ndarray], points: np.ndarray, fingers: tuple[int, ...], velocity: bool = True
+) -> np.ndarray:
     """For each finger, the next key it plays in the score ``window`` (steps x keys x channels):
     the offset (x, y, z) from its fingertip to that key's strike point in units of
-    :data:`TARGET_SCALE`, and how soon, 1 for now falling to 0 for "not in the window".
+    :data:`TARGET_SCALE`, how soon, 1 for now falling to 0 for "not in the window", and (with
+    ``velocity``) how loud, the score's velocity channel (0 when nothing is to be played).
 
-    The score names keys by index; this says where they are for the hand, which is what a
-    policy would otherwise have to learn for every key separately.
+    The score names keys by index; this says where they are for the hand and how hard to strike
+    them, which is what a policy would otherwise have to learn for every key separately.
     """
-    targets = np.zeros((len(fingers), 4), np.float32)
+    targets = np.zeros((len(fingers), 5 if velocity else 4), np.float32)
     steps = len(window)
     for i, finger in enumerate(fingers):
         rows, keys = np.nonzero(window[:, :, FINGER + i] > 0.5)
         if rows.size:
             targets[i, :3] = (points[keys[0]] - tips[finger]) / TARGET_SCALE
             targets[i, 3] = 1.0 - rows[0] / steps
+            if velocity:
+                targets[i, 4] = window[rows[0], keys[0], VELOCITY]
     return np.clip(targets, -SPEED_BOUND, SPEED_BOUND)
 
 
@@ -99,6 +104,9 @@ class EnvConfig:
     """Seconds after the last note ends."""
     target_observations: bool = True
     """Observe each finger's offset to the next key it plays (not in the paper; see docs/training.md)."""
+    target_velocity: bool = True
+    """With the target observations, also the velocity that key is to sound at (policies trained
+    before 2026-11-22 were trained without it)."""
     random_start: bool = True
     """Start the wrist at a random position along the keyboard (else at its centre)."""
     actuated: tuple[str, ...] = JOINT_KINDS
@@ -151,7 +159,7 @@ class PianoEnv(gym.Env):
             "joint_velocities": spaces.Box(-SPEED_BOUND, SPEED_BOUND, (self.n_joints,), np.float32),
         }
         if config.target_observations:
-            obs["targets"] = spaces.Box(-SPEED_BOUND, SPEED_BOUND, (self.n_fingers, 4), np.float32)
+            obs["targets"] = spaces.Box(-SPEED_BOUND, SPEED_BOUND, (self.n_fingers, 5 if config.target_velocity else 4), np.float32)
         if config.tactile:
             rows, cols = config.tactile_pool or (config.tactile_sensor.rows, config.tactile_sensor.cols)
             obs["tactile"] = spaces.Box(0, 255, (2, self.n_fingers, rows, cols), np.uint8)
@@ -262,7 +270,7 @@ class PianoEnv(gym.Env):
 
     def targets(self, window: np.ndarray) -> np.ndarray:
         """:func:`finger_targets` for a score window, from the hand's current pose."""
-        return finger_targets(window, self._tips(), self.strike_points, self.spec_score.hand.fingers)
+        return finger_targets(window, self._tips(), self.strike_points, self.spec_score.hand.fingers, self.config.target_velocity)
 
     def _tactile_image(self) -> np.ndarray:
         angles, _ = self.world.key_state()

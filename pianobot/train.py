@@ -294,7 +294,8 @@ def config_from_manifest(manifest: dict) -> TrainConfig:
         pool = tuple(e["tactile_pool"]) if e["tactile_pool"] is not None else None
         env = EnvConfig(world=world, reward=RewardConfig(**e["reward"]), tactile_sensor=TactileConfig(**e["tactile_sensor"]),
                         tactile_pool=pool, actuated=tuple(e["actuated"]),
-                        **{k: v for k, v in e.items() if k not in ("world", "reward", "tactile_sensor", "tactile_pool", "actuated")})
+                        target_velocity=e.get("target_velocity", False),  # manifests from before it existed: without
+                        **{k: v for k, v in e.items() if k not in ("world", "reward", "tactile_sensor", "tactile_pool", "actuated", "target_velocity")})
         s = c["sac"]
         sac = SACConfig(**{**s, "tactile_resolution": tuple(s["tactile_resolution"]) if s["tactile_resolution"] else None,
                            "log_std_bounds": tuple(s["log_std_bounds"])})

@@ -154,7 +154,7 @@ def test_frozen_joints_shrink_the_action_and_hold_still():
 def test_finger_targets_point_from_each_fingertip_to_its_next_key():
     env = PianoEnv(piece=PHRASE, config=EnvConfig(tactile=False))
     observation, _ = env.reset(seed=3)
-    assert observation["targets"].shape == (3, 4)
+    assert observation["targets"].shape == (3, 5)
     assert not observation["targets"].any()  # nothing in the 0.5 s window yet
     for _ in range(env.lead_steps - 5):
         observation, *_ = env.step(np.zeros(13))
@@ -164,6 +164,9 @@ def test_finger_targets_point_from_each_fingertip_to_its_next_key():
     expected = np.clip((env.strike_points[0] - tips[2]) / 0.1, -5, 5)
     assert np.allclose(targets[0, :3], expected, atol=1e-5)
     assert targets[0, 3] == pytest.approx(1 - 5 / 11)
+    assert targets[0, 4] == pytest.approx(PHRASE.notes[0].velocity / 127)  # how loud
     assert not targets[1].any() and not targets[2].any()
+    older = PianoEnv(piece=PHRASE, config=EnvConfig(tactile=False, target_velocity=False))  # as policies before it
+    assert older.reset(seed=3)[0]["targets"].shape == (3, 4)
     without = PianoEnv(piece=PHRASE, config=EnvConfig(tactile=False, target_observations=False))
     assert "targets" not in without.reset(seed=0)[0]
