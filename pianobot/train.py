@@ -298,7 +298,8 @@ def config_from_manifest(manifest: dict) -> TrainConfig:
                         **{k: v for k, v in e.items() if k not in ("world", "reward", "tactile_sensor", "tactile_pool", "actuated", "target_velocity")})
         s = c["sac"]
         sac = SACConfig(**{**s, "tactile_resolution": tuple(s["tactile_resolution"]) if s["tactile_resolution"] else None,
-                           "log_std_bounds": tuple(s["log_std_bounds"])})
+                           "log_std_bounds": tuple(s["log_std_bounds"]),
+                           "score_input": s.get("score_input", True)})  # manifests from before it existed read the score
         return TrainConfig(sac=sac, env=env, **{k: v for k, v in c.items() if k not in ("sac", "env")})
     except (KeyError, TypeError, ValueError) as e:
         raise PianobotError(f"model manifest does not describe a pianobot configuration ({e!r}): retrain with --force") from None

@@ -42,8 +42,15 @@ class SACConfig:
     """Polyak factor of the target critic."""
     hidden: int = 256
     """Width of the MLP layers."""
+    score_input: bool = False
+    """Feed the score window (L keys x 5 channels x lookahead steps, the paper's input) to the
+    networks. Off by default: the finger targets in the observation say, for each finger, where
+    its next key is, how soon and how loud, which is what the window's key-indexed one-hots say
+    in a form that does not depend on the key; with the window a policy learns the keys it has
+    seen one by one (docs/benchmarks.md, Learning item 10). Policies stored before 2026-11-22
+    read it."""
     score_features: int = 64
-    """Width of the first layer over the (large, sparse) score window."""
+    """Width of the first layer over the (large, sparse) score window, when it is read."""
     tactile_channels: int = 8
     """Channels of the tactile convolutions."""
     tactile_features: int = 32
@@ -94,11 +101,11 @@ class Encoder(nn.Module):
         h = config.hidden
         self.score_dim = score_dim
         # the score window is large and sparse (L keys x 5 x steps): a narrow first layer for it
-        # keeps the MLP's cost down; the joint and wrist values join it in the second layer
-        self.score = nn.Sequential(nn.Linear(score_dim, config.score_features), nn.ReLU())
-        self.vector = nn.Sequential(
-            nn.Linear(config.score_features + vector_dim - score_dim, h), nn.ReLU(), nn.Linear(h, h), nn.ReLU()
-        )
+        # keeps the MLP's cost down; the joint and wrist values join it in the second layer.
+        # Without score input the vector's first score_dim values are skipped.
+        self.score = nn.Sequential(nn.Linear(score_dim, config.score_features), nn.ReLU()) if config.score_input else None
+        score_width = config.score_features if config.score_input else 0
+        self.vector = nn.Sequential(nn.Linear(score_width + vector_dim - score_dim, h), nn.ReLU(), nn.Linear(h, h), nn.ReLU())
         self.out_dim = h
         self.tactile = None
         if tactile_shape is not None:
@@ -114,8 +121,8 @@ class Encoder(nn.Module):
             self.out_dim += fingers * config.tactile_features
 
     def forward(self, vector: torch.Tensor, tactile: torch.Tensor | None) -> torch.Tensor:
-        score = self.score(vector[:, : self.score_dim])
-        features = self.vector(torch.cat([score, vector[:, self.score_dim :]], dim=1))
+        rest = vector[:, self.score_dim :]
+        features = self.vector(rest if self.score is None else torch.cat([self.score(vector[:, : self.score_dim]), rest], dim=1))
         if self.tactile is None:
             return features
         batch, history, fingers, rows, cols = tactile.shape
