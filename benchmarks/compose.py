@@ -99,7 +99,7 @@ def main() -> None:
         end_to_end_minutes = (time.perf_counter() - started) / 60
 
         play_config = replace(env, tactile_pool=config.sac.tactile_resolution)
-        composed = play(piece, lambda e: CompositionalController(e, phrases, models, config, fallback=False), play_config)
+        composed = play(piece, lambda e: CompositionalController(e, phrases, models, fallback=False), play_config)
         single = play(piece, lambda e: EndToEnd(load_policy(folder, whole, e)), play_config)
         scripted = play(piece, "scripted", replace(play_config, actuated=("abd", "mcp", "pip", "dip")))
         for name, (f1s, maes, factor), minutes in (

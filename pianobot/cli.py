@@ -327,7 +327,7 @@ def play(
             raise PianobotError("--fallback scripted needs policies trained with --control velocity")
 
         def who(env):
-            composed = CompositionalController(env, phrases, models, trained, fallback is not None)
+            composed = CompositionalController(env, phrases, models, fallback is not None)
             sources.update({s.phrase.index: s.source for s in composed.sections})
             return composed
     with Progress(TextColumn("{task.description}"), BarColumn(), TimeRemainingColumn(), console=err, transient=True) as bar:

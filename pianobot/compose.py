@@ -88,7 +88,7 @@ def training_config(models: Path, phrases: list[Phrase]) -> TrainConfig | None:
 class CompositionalController:
     """Acts with the controller of the section the current step falls in."""
 
-    def __init__(self, env: PianoEnv, phrases: list[Phrase], models: Path, config: TrainConfig, fallback: bool):
+    def __init__(self, env: PianoEnv, phrases: list[Phrase], models: Path, fallback: bool):
         spec = env.spec_score
         lead = env.lead_steps
         grace = math.ceil(DEFAULT_ONSET_TOLERANCE * spec.control_hz - 1e-9)  # steps a strike may come late
@@ -107,7 +107,8 @@ class CompositionalController:
             timeline[start:end] = tensor[: end - start]
             folder = find_policy(models, phrase)
             if folder is not None:
-                controller, source = load_policy(folder, config, env), f"policy {folder.name}"
+                own = config_from_manifest(store.read_manifest(folder))  # its agent's settings (the env is shared)
+                controller, source = load_policy(folder, own, env), f"policy {folder.name}"
             elif fallback:
                 controller, source = ScriptedPianist(env.config), "scripted (fallback)"
             else:  # checked before simulating; kept as a guard

@@ -19,7 +19,7 @@ import numpy as np
 
 from pianobot.env import EnvConfig
 from pianobot.music.tensor import FINGER, NOTE, VELOCITY
-from pianobot.sim.hand import FINGER_BASE_X, PREFERRED_TILT, finger_ik, lowest_point_in_finger_plane
+from pianobot.sim.hand import FINGER_BASE_X, PREFERRED_TILT, TILT_RANGE, finger_ik, lowest_point_in_finger_plane
 from pianobot.sim.keyboard import BLACK_STRIKE_FROM_FRONT, WHITE_STRIKE_FROM_FRONT, key_boxes
 
 
@@ -133,7 +133,9 @@ class ScriptedPianist:
         The fingertip's tilt moves towards the preferred one by at most :attr:`tilt_step` per
         step: letting the IK pick any tilt can flip the finger between very different shapes
         from one step to the next, faster than its joints follow."""
-        tilt = float(np.sum(current))
+        # a finger curled (or stretched) beyond the IK's tilts, as a policy may leave it, starts
+        # from the nearest one: from outside them no point would be in reach and it would stay so
+        tilt = float(np.clip(np.sum(current), *TILT_RANGE))
         tilt += float(np.clip(PREFERRED_TILT - tilt, -self.tilt_step, self.tilt_step))
         for change in (0.0, 0.002, -0.002, 0.004, -0.004, 0.008, 0.012, 0.016, 0.02):
             q = finger_ik(self.geometry, reach, drop + change, tilt)  # the nearest height this finger can reach there
@@ -329,7 +331,10 @@ class ScriptedPianist:
             if now_height < over + self.clearance:
                 abduction = float(q[0])  # straight up out of the key before swinging sideways
         elif phase != "hold" and abs(reach - now_reach) > self.path_tolerance:
-            height = max(height, now_height)  # (a held key stays pressed while the wrist slides)
+            across = max(height, now_height)  # (a held key stays pressed while the wrist slides)
+            if finger_ik(geometry, reach, hand.palm_height - across) is not None:
+                height = across  # else the finger, raised high (as a policy may leave it), goes there directly
+
         band_reach = hand.palm_y - self.black_band_y  # a tip reaching further lies over the black keys
         crossing = (reach > band_reach) != (now_reach > band_reach)
         safe = self.black_rise + self.band_clearance

@@ -280,6 +280,29 @@ def test_play_sac_composes_trained_and_fallback_phrases(tmp_path):
     assert played and played[0].finger == 4  # the scripted pianist took over and played phrase 1
 
 
+def test_play_composes_policies_with_different_agent_settings(tmp_path):
+    """Each phrase's policy is loaded with its own manifest's agent settings: one that reads the
+    score window (as policies stored before 2026-11-22 do) beside one that does not."""
+    from dataclasses import replace
+
+    from pianobot import store
+    from pianobot.agent.sac import SACConfig
+    from pianobot.env import EnvConfig
+    from pianobot.music.phrases import split_phrases
+    from pianobot.train import TrainConfig, phrase_target, train_policy
+
+    piece = Piece((Note(0.0, 64, 1.0, 80, 3), Note(3.0, 67, 4.0, 70, 4)), bpm=60)
+    song = write_midi(piece, tmp_path / "song.mid")
+    base = TrainConfig(steps=40, eval_episodes=1, sac=SACConfig(exploration_steps=20, batch_size=16, hidden=16), env=EnvConfig(tactile=False))
+    for phrase, reads_score in zip(split_phrases(piece, 1), (True, False)):
+        config = replace(base, sac=replace(base.sac, score_input=reads_score))
+        train_policy(phrase_target(phrase), config, store.model_dir(tmp_path / "models", phrase.hash, config))
+    result = run("play", song, "-o", tmp_path / "out.mid", "--models", tmp_path / "models", "--phrase-notes", "1")
+    assert result.exit_code == 0, result.output
+    report = json.loads((tmp_path / "out.report.json").read_text())
+    assert report["phrases"]["0"].startswith("policy ") and report["phrases"]["1"].startswith("policy ")
+
+
 def read_played(path):
     from pianobot.music.midi_io import read_midi
 
@@ -294,7 +317,7 @@ def test_sections_hand_over_after_the_last_strike():
     piece = Piece((Note(0.0, 60, 0.5, 80, 2), Note(0.5, 62, 1.0, 80, 3), Note(1.0, 64, 1.5, 80, 4)), bpm=60)
     phrases = split_phrases(piece, 1)
     env = PianoEnv(piece=piece, config=EnvConfig(tactile=False))
-    composed = CompositionalController(env, phrases, Path("/nonexistent"), None, fallback=True)
+    composed = CompositionalController(env, phrases, Path("/nonexistent"), fallback=True)
     firsts = [s.first_step for s in composed.sections]
     # the previous phrase keeps the hand through its last note's onset tolerance (50 ms = 1 step):
     # control passes 2 steps after that note's onset step (lead-in 20 steps, notes 10 steps apart)
@@ -305,7 +328,7 @@ def test_sections_hand_over_after_the_last_strike():
 
     fast = Piece((Note(0.0, 60, 0.1, 80, 2), Note(0.1, 62, 0.2, 80, 3)), bpm=60)  # onsets 2 steps apart
     env = PianoEnv(piece=fast, config=EnvConfig(tactile=False))
-    composed = CompositionalController(env, split_phrases(fast, 1), Path("/nonexistent"), None, fallback=True)
+    composed = CompositionalController(env, split_phrases(fast, 1), Path("/nonexistent"), fallback=True)
     assert [s.first_step for s in composed.sections] == [0, 21]  # at the latest one step before the next onset (22)
 
 

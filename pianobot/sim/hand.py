@@ -183,6 +183,8 @@ def lowest_point_in_finger_plane(geometry: FingerGeometry, flexion: np.ndarray) 
 
 PREFERRED_TILT = 1.1
 """The distal link's preferred angle below the horizontal (rad) when a fingertip meets a key."""
+TILT_RANGE = (0.6, 1.57)
+"""Tilts the IK considers: between them the fingertip, not a knuckle, is the finger's lowest point."""
 
 
 def finger_ik(geometry: FingerGeometry, reach: float, drop: float, tilt: float = PREFERRED_TILT) -> np.ndarray | None:
@@ -196,7 +198,7 @@ def finger_ik(geometry: FingerGeometry, reach: float, drop: float, tilt: float =
     limits = geometry.flexion_limits
     for offset in np.concatenate([[0.0], np.repeat(np.arange(1, 50) * 0.02, 2) * np.tile([1, -1], 49)]):
         phi = tilt + offset
-        if not 0.6 <= phi <= 1.57:
+        if not TILT_RANGE[0] <= phi <= TILT_RANGE[1]:
             continue
         centre_x, centre_z = reach, drop - geometry.tip_radius
         l3 = geometry.distal - geometry.tip_radius
