@@ -24,7 +24,7 @@ from pathlib import Path
 import torch
 
 from pianobot import store
-from pianobot.agent.sac import SACConfig, split_observation
+from pianobot.agent.sac import SACConfig
 from pianobot.compose import CompositionalController
 from pianobot.env import EnvConfig
 from pianobot.metrics import compare
@@ -46,7 +46,7 @@ class EndToEnd:
         pass
 
     def act(self, observation: dict):
-        return self.agent.act(*split_observation(observation), deterministic=True)
+        return self.agent.act(*self.agent.split(observation), deterministic=True)
 
 
 def play(piece, factory, config: EnvConfig) -> tuple[list[float], list[float], float]:

@@ -20,7 +20,7 @@ import numpy as np
 import torch
 
 from pianobot.agent.buffer import ReplayBuffer
-from pianobot.agent.sac import SAC, SACConfig, score_size, split_observation, vector_size
+from pianobot.agent.sac import SAC, SACConfig, score_size, vector_size
 from pianobot.env import EnvConfig, PianoEnv
 from pianobot.music.load import load_piece
 
@@ -45,17 +45,18 @@ def ours(tactile: bool, updates: int, repeats: int, compiled: bool = False) -> l
     env = make_env(tactile)
     space = env.observation_space
     shape = space["tactile"].shape if tactile else None
-    agent = SAC(vector_size(space), score_size(space), shape, 13, SACConfig())
+    config = SACConfig()
+    agent = SAC(vector_size(space, config.score_input), score_size(space, config.score_input), shape, 13, config)
     if compiled:
         agent = compile_agent(agent)
-    buffer = ReplayBuffer(FILL, vector_size(space), shape, 13)
+    buffer = ReplayBuffer(FILL, vector_size(space, config.score_input), shape, 13)
     rng = np.random.default_rng(0)
     observation, _ = env.reset(seed=0)
     for _ in range(FILL):
         action = rng.uniform(-1, 1, 13).astype(np.float32)
-        vector, images = split_observation(observation)
+        vector, images = agent.split(observation)
         observation, reward, terminated, truncated, _ = env.step(action)
-        buffer.add(vector, images, action, reward, terminated, *split_observation(observation))
+        buffer.add(vector, images, action, reward, terminated, *agent.split(observation))
         if truncated:
             observation, _ = env.reset()
     for _ in range(5):

@@ -134,8 +134,6 @@ class CompositionalController:
         return active
 
     def act(self, observation: dict) -> np.ndarray:
-        from pianobot.agent.sac import split_observation
-
         section = self.section_at(self.step)
         window = section.score[self.step : self.step + self.lookahead + 1]
         observation = {**observation, "score": window}
@@ -144,4 +142,4 @@ class CompositionalController:
         self.step += 1
         if isinstance(section.controller, ScriptedPianist):
             return section.controller.act(observation)[self.actuated]  # the joints the policies move
-        return section.controller.act(*split_observation(observation), deterministic=True)
+        return section.controller.act(*section.controller.split(observation), deterministic=True)

@@ -26,7 +26,7 @@ import torch
 
 from pianobot import store
 from pianobot.agent.buffer import ReplayBuffer
-from pianobot.agent.sac import SAC, SACConfig, score_size, split_observation, vector_size
+from pianobot.agent.sac import SAC, SACConfig, score_size, vector_size
 from pianobot.env import JOINT_KINDS, EnvConfig, PianoEnv
 from pianobot.errors import PianobotError
 from pianobot.explore import Explorer
@@ -85,7 +85,8 @@ def agent_env_config(config: TrainConfig) -> EnvConfig:
 def make_agent(env: PianoEnv, config: TrainConfig) -> SAC:
     space = env.observation_space
     tactile = space["tactile"].shape if "tactile" in space.spaces else None
-    return SAC(vector_size(space), score_size(space), tactile, env.action_space.shape[0], config.sac)
+    score = config.sac.score_input
+    return SAC(vector_size(space, score), score_size(space, score), tactile, env.action_space.shape[0], config.sac)
 
 
 def make_env(target: Piece | str, env_config: EnvConfig) -> PianoEnv:
@@ -101,7 +102,7 @@ def evaluate(agent: SAC, target: Piece | str, env_config: EnvConfig, episodes: i
         observation, info = env.reset(seed=first_seed + i)
         recorder, total = NoteRecorder(), 0.0
         while True:
-            observation, reward, terminated, truncated, step_info = env.step(agent.act(*split_observation(observation), deterministic=True))
+            observation, reward, terminated, truncated, step_info = env.step(agent.act(*agent.split(observation), deterministic=True))
             recorder.add(step_info["events"], step_info["fingers"])
             total += reward
             if terminated or truncated:
@@ -149,7 +150,7 @@ def train_policy(
     agent = make_agent(env, config)
     space = env.observation_space
     tactile_shape = space["tactile"].shape if "tactile" in space.spaces else None
-    buffer = ReplayBuffer(min(config.sac.buffer_size, config.steps), vector_size(space), tactile_shape, env.action_space.shape[0])
+    buffer = ReplayBuffer(min(config.sac.buffer_size, config.steps), vector_size(space, config.sac.score_input), tactile_shape, env.action_space.shape[0])
     rng = np.random.default_rng(config.seed)
     explorer = Explorer(config.explore, env.action_space.shape[0], env_config, rng, select=env.actuated)
     step, episode, update_debt, evaluations = 0, 0, 0.0, []
@@ -181,14 +182,14 @@ def train_policy(
     started = time.perf_counter()
 
     while step < config.steps:
-        vector, tactile = split_observation(observation)
+        vector, tactile = agent.split(observation)
         taught = explorer.teach(observation)  # the scripted pianist's action here, or None
         if step < config.sac.exploration_steps:
             action = explorer.act(observation, taught)
         else:
             action = agent.act(vector, tactile)
         observation, reward, terminated, truncated, _ = env.step(action)
-        next_vector, next_tactile = split_observation(observation)
+        next_vector, next_tactile = agent.split(observation)
         buffer.add(vector, tactile, action, reward, terminated, next_vector, next_tactile, expert=taught)
         episode_return += reward
         step += 1

@@ -43,10 +43,9 @@ def test_saved_policy_loads_and_acts_the_same(tmp_path):
     train_policy(PHRASE, config, tmp_path / "m")
     env = make_env(PHRASE, replace(config.env, tactile_pool=config.sac.tactile_resolution))
     observation, _ = env.reset(seed=0)
-    from pianobot.agent.sac import split_observation
-
-    first = load_policy(tmp_path / "m", config, env).act(*split_observation(observation), deterministic=True)
-    second = load_policy(tmp_path / "m", config, env).act(*split_observation(observation), deterministic=True)
+    first_agent, second_agent = load_policy(tmp_path / "m", config, env), load_policy(tmp_path / "m", config, env)
+    first = first_agent.act(*first_agent.split(observation), deterministic=True)
+    second = second_agent.act(*second_agent.split(observation), deterministic=True)
     assert first.shape == (13,) and np.array_equal(first, second)
     tensors = store.load_tensors(tmp_path / "m" / store.POLICY_FILE)
     assert not any(k.startswith(("critic.", "target.", "optim.")) for k in tensors)  # only what acting needs
@@ -132,6 +131,28 @@ def test_exploration_strategies(kind):
         assert 0.7 < repeats < 0.9 and wrist_moves < 0.2
 
 
+def test_an_agent_that_does_not_read_the_score_window_does_not_store_it(tmp_path):
+    """The window is 1320 floats of a 1400-float vector: without score input, neither the agent
+    nor its replay buffer carries it."""
+    from pianobot.agent.sac import score_size, vector_size
+
+    env = make_env(PHRASE, EnvConfig(tactile=False))
+    space = env.observation_space
+    observation, _ = env.reset(seed=0)
+    for reads in (False, True):
+        config = replace(small(env=EnvConfig(tactile=False)), sac=replace(small().sac, score_input=reads))
+        from pianobot.train import make_agent
+
+        agent = make_agent(env, config)
+        vector, _ = agent.split(observation)
+        assert vector.size == vector_size(space, reads) == vector_size(space) - (0 if reads else score_size(space))
+        assert agent.act(vector, None).shape == (13,)
+    manifest = train_policy(PHRASE, small(env=EnvConfig(tactile=False), steps=80, checkpoint_every=40), tmp_path / "m", stop_after=45)
+    assert "interrupted_at" in manifest  # (at the first episode end after 45 steps)
+    stored = np.load(next((tmp_path / "m" / store.CHECKPOINT_DIR).rglob("*vector*.npy")), mmap_mode="r")
+    assert stored.shape[-1] == vector_size(space, False)
+
+
 def test_scripted_exploration_mixes_quiet_episodes_that_play_with_noisy_ones():
     """A strike fails with noise much above 0.02: the noise scale is drawn per episode, so the
     buffer gets episodes that play the note (a fixed 0.2 played none) and ones that go astray."""
@@ -165,9 +186,10 @@ def _agent_and_batch(demo_weight: float, demo: float):
     config = SACConfig(batch_size=64, hidden=32, score_features=16, demo_weight=demo_weight)
     from pianobot.agent.sac import score_size, vector_size
 
-    agent = SAC(vector_size(env.observation_space), score_size(env.observation_space), None, env.action_space.shape[0], config)
+    space, score = env.observation_space, config.score_input
+    agent = SAC(vector_size(space, score), score_size(space, score), None, env.action_space.shape[0], config)
     rng = np.random.default_rng(0)
-    n, dim = 64, vector_size(env.observation_space)
+    n, dim = 64, vector_size(space, score)
     target = np.tile(np.linspace(-0.6, 0.6, env.action_space.shape[0], dtype=np.float32), (n, 1))
     batch = {
         "vector": torch.from_numpy(rng.normal(size=(n, dim)).astype(np.float32)),

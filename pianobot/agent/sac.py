@@ -77,18 +77,24 @@ class SACConfig:
 VECTOR_KEYS = ("score", "wrist", "joints", "joint_velocities", "targets", "keys", "key_velocities")
 
 
-def vector_size(observation_space) -> int:
-    return sum(int(np.prod(observation_space[k].shape)) for k in VECTOR_KEYS if k in observation_space.spaces)
+def _keys(score: bool) -> tuple[str, ...]:
+    return VECTOR_KEYS if score else VECTOR_KEYS[1:]
 
 
-def score_size(observation_space) -> int:
-    """Length of the score window at the start of the flat vector."""
-    return int(np.prod(observation_space["score"].shape))
+def vector_size(observation_space, score: bool = True) -> int:
+    """Length of the flat vector (with or without the score window, which comes first)."""
+    return sum(int(np.prod(observation_space[k].shape)) for k in _keys(score) if k in observation_space.spaces)
 
 
-def split_observation(observation: dict) -> tuple[np.ndarray, np.ndarray | None]:
-    """A dict observation as (flat float32 vector, uint8 tactile images or None)."""
-    vector = np.concatenate([np.asarray(observation[k], np.float32).ravel() for k in VECTOR_KEYS if k in observation])
+def score_size(observation_space, score: bool = True) -> int:
+    """Length of the score window at the start of the flat vector (0 without it)."""
+    return int(np.prod(observation_space["score"].shape)) if score else 0
+
+
+def split_observation(observation: dict, score: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
+    """A dict observation as (flat float32 vector, uint8 tactile images or None); ``score``: with
+    the score window (an agent that does not read it need not store it)."""
+    vector = np.concatenate([np.asarray(observation[k], np.float32).ravel() for k in _keys(score) if k in observation])
     return vector, observation.get("tactile")
 
 
@@ -216,6 +222,10 @@ class SAC:
     @property
     def alpha(self) -> torch.Tensor:
         return self.log_alpha.exp()
+
+    def split(self, observation: dict) -> tuple[np.ndarray, np.ndarray | None]:
+        """:func:`split_observation` as this agent reads observations (with or without the score window)."""
+        return split_observation(observation, self.config.score_input)
 
     @torch.no_grad()
     def act(self, vector: np.ndarray, tactile: np.ndarray | None, deterministic: bool = False) -> np.ndarray:
