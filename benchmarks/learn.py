@@ -2,6 +2,7 @@
 
     python benchmarks/learn.py --tasks one-note three-note --seeds 0 1 2 --steps 100000 \
         [--explore prior] [--no-tactile] [--workers 2] [--plot docs/learning.png] [--store /tmp/learn]
+    python benchmarks/learn.py ... --report    # no training: the runs so far, finished or not
 
 Trains with `pianobot.train.train_policy` (checkpointed: rerunning the same command resumes),
 evaluating every ``--eval-every`` steps on ``--eval-episodes`` fixed instances (hand starts
@@ -35,22 +36,31 @@ from pianobot.train import (
 
 CHECK_SEED = 20_000
 """Seeds of the held-out check's instances (the training evaluations use 10000, 10001, ...)."""
+CHECK_FILE = "check.json"
+"""The held-out check's figures, written beside the policy."""
+
+
+def run_folder(task: str, seed: int, args) -> tuple[TrainConfig, Path]:
+    """The run's configuration and the folder its checkpoint and policy go to."""
+    config = TrainConfig(
+        steps=args.steps, seed=seed, explore=args.explore, eval_every=args.eval_every, eval_episodes=args.eval_episodes,
+        checkpoint_every=args.eval_every, until_f1=args.until_f1, sac=SACConfig(exploration_steps=args.exploration_steps),
+        env=EnvConfig(tactile=args.tactile, actuated=tuple(args.joints.split(","))),
+    )
+    return config, store.model_dir(Path(args.store), f"task-{task}-seed{seed}", config)
 
 
 def run(task: str, seed: int, args) -> tuple[str, int, dict]:
     import torch
 
     torch.set_num_threads(1)
-    config = TrainConfig(
-        steps=args.steps, seed=seed, explore=args.explore, eval_every=args.eval_every, eval_episodes=args.eval_episodes,
-        checkpoint_every=args.eval_every, until_f1=args.until_f1, sac=SACConfig(exploration_steps=args.exploration_steps),
-        env=EnvConfig(tactile=args.tactile, actuated=tuple(args.joints.split(","))),
-    )
-    folder = store.model_dir(Path(args.store), f"task-{task}-seed{seed}", config)
+    config, folder = run_folder(task, seed, args)
     manifest = store.read_manifest(folder) if store.is_trained(folder) else train_policy(
         task, config, folder, about={"key": f"task-{task}", "piece": f"task {task}"}
     )
-    return task, seed, {**manifest, "check": check(task, folder, manifest, args.check_episodes)}
+    held = check(task, folder, manifest, args.check_episodes)
+    (folder / CHECK_FILE).write_text(json.dumps(held) + "\n")
+    return task, seed, {**manifest, "check": held}
 
 
 def check(task: str, folder: Path, manifest: dict, episodes: int) -> dict:
@@ -59,6 +69,19 @@ def check(task: str, folder: Path, manifest: dict, episodes: int) -> dict:
     env_config = agent_env_config(config)
     agent = load_policy(folder, config, make_env(task, env_config))
     return {"episodes": episodes, **evaluate(agent, task, env_config, episodes, first_seed=CHECK_SEED)}
+
+
+def progress(task: str, seed: int, args) -> dict | None:
+    """What a run has so far, without training: its manifest once finished (with the check when
+    the full command wrote it), else its last checkpoint's evaluations; None if not started."""
+    _, folder = run_folder(task, seed, args)
+    if store.is_trained(folder):
+        held = folder / CHECK_FILE
+        return {**store.read_manifest(folder), "finished": True, **({"check": json.loads(held.read_text())} if held.exists() else {})}
+    state = folder / store.CHECKPOINT_DIR / "state.json"
+    if state.exists():
+        return {**json.loads(state.read_text()), "finished": False}
+    return None
 
 
 def main() -> None:
@@ -77,9 +100,13 @@ def main() -> None:
     parser.add_argument("--workers", type=int, default=1)
     parser.add_argument("--store", default="/tmp/pianobot-learn")
     parser.add_argument("--plot", default=None)
+    parser.add_argument("--report", action="store_true", help="train nothing: print and plot what the runs have so far")
     args = parser.parse_args()
 
     jobs = [(task, seed) for task in args.tasks for seed in args.seeds]
+    if args.report:
+        report(args, jobs)
+        return
     with ProcessPoolExecutor(max_workers=args.workers) as pool:
         results = list(pool.map(run, *zip(*jobs), [args] * len(jobs)))
 
@@ -92,28 +119,55 @@ def main() -> None:
         print(f"| {task} | {seed} | {last['f1']:.3f} | {kept['f1']:.3f} ({kept['step']}) | {held['f1']:.3f} | {mae} | {manifest['seconds'] / 60:.1f} |")
 
     if args.plot:
-        import matplotlib
-
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-
-        fig, ax = plt.subplots(figsize=(7, 4))
-        colours = dict(zip(args.tasks, plt.rcParams["axes.prop_cycle"].by_key()["color"]))
-        for task, seed, manifest in results:
-            points = manifest["evaluations"]
-            ax.plot([p["step"] for p in points], [p["f1"] for p in points], color=colours[task], alpha=0.8,
-                    label=task if seed == args.seeds[0] else None)
-        ax.axhline(0.9, color="grey", linestyle=":", linewidth=1)
-        ax.set_xlabel("environment steps")
-        ax.set_ylabel("evaluation note F1")
-        ax.set_ylim(-0.02, 1.02)
-        ax.legend()
-        ax.set_title(f"SAC, exploration '{args.explore}', tactile {'on' if args.tactile else 'off'}")
-        fig.tight_layout()
-        fig.savefig(args.plot, dpi=100)
-        print(f"\nplot: {args.plot}")
+        plot(args, results)
     Path(args.store).mkdir(parents=True, exist_ok=True)
     (Path(args.store) / "results.json").write_text(json.dumps([{"task": t, "seed": s, **m} for t, s, m in results], default=str))
+
+
+def report(args, jobs: list[tuple[str, int]]) -> None:
+    """The runs' evaluations so far, finished or not (``--report``)."""
+    results = []
+    print("| task | seed | state | evaluation note F1 at each evaluation | best (step) | on new instances | minutes |")
+    print("| --- | ---: | --- | --- | --- | ---: | ---: |")
+    for task, seed in jobs:
+        found = progress(task, seed, args)
+        if found is None:
+            print(f"| {task} | {seed} | not started | | | | |")
+            continue
+        results.append((task, seed, found))
+        curve = " / ".join(f"{e['f1']:.2f}" for e in found["evaluations"])
+        best = max(found["evaluations"], key=lambda e: e["f1"], default=None)
+        kept = "" if best is None else f"{best['f1']:.2f} ({best['step'] // 1000}k)"
+        held = f"{found['check']['f1']:.2f}" if "check" in found else ""
+        state = "finished" if found["finished"] else f"at {found['step'] // 1000}k steps"
+        print(f"| {task} | {seed} | {state} | {curve} | {kept} | {held} | {found['seconds'] / 60:.1f} |")
+    if args.plot and results:
+        plot(args, results)
+
+
+def plot(args, results: list[tuple[str, int, dict]]) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(7, 4))
+    colours = dict(zip(args.tasks, plt.rcParams["axes.prop_cycle"].by_key()["color"]))
+    labelled = set()
+    for task, seed, manifest in results:
+        points = manifest["evaluations"]
+        ax.plot([p["step"] for p in points], [p["f1"] for p in points], color=colours[task], alpha=0.8, marker=".",
+                label=None if task in labelled else task)
+        labelled.add(task)
+    ax.axhline(0.9, color="grey", linestyle=":", linewidth=1)
+    ax.set_xlabel("environment steps")
+    ax.set_ylabel(f"evaluation note F1 ({args.eval_episodes} instances)")
+    ax.set_ylim(-0.02, 1.02)
+    ax.legend()
+    ax.set_title(f"SAC, exploration '{args.explore}', tactile {'on' if args.tactile else 'off'}, seeds {', '.join(map(str, args.seeds))}")
+    fig.tight_layout()
+    fig.savefig(args.plot, dpi=100)
+    print(f"\nplot: {args.plot}")
 
 
 if __name__ == "__main__":
