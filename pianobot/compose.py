@@ -138,7 +138,7 @@ class CompositionalController:
         window = section.score[self.step : self.step + self.lookahead + 1]
         observation = {**observation, "score": window}
         if "targets" in observation:  # what the phrase's own window asks of each finger
-            observation["targets"] = self.env.targets(window)
+            observation["targets"] = self.env.targets(window, section.score)
         self.step += 1
         if isinstance(section.controller, ScriptedPianist):
             return section.controller.act(observation)[self.actuated]  # the joints the policies move

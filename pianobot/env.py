@@ -60,20 +60,41 @@ TARGET_SCALE = 0.1
 
 
 def finger_targets(
-    window: np.ndarray, tips: dict[int, np.ndarray], points: np.ndarray, fingers: tuple[int, ...], velocity: bool = True
+    window: np.ndarray,
+    tips: dict[int, np.ndarray],
+    points: np.ndarray,
+    fingers: tuple[int, ...],
+    velocity: bool = True,
+    previous: np.ndarray | None = None,
 ) -> np.ndarray:
     """For each finger, the next key it plays in the score ``window`` (steps x keys x channels):
     the offset (x, y, z) from its fingertip to that key's strike point in units of
     :data:`TARGET_SCALE`, how soon, 1 for now falling to 0 for "not in the window", and (with
     ``velocity``) how loud, the score's velocity channel (0 when nothing is to be played).
 
+    With ``previous`` (the score row before the window's first; zeros before the piece), "next"
+    means the next note to *start*, and a last column says how much longer the finger is to hold
+    the key it holds now, as a fraction of the window (0 when it holds nothing or strikes now).
+    Without it a held note reads as "strike now" for as long as it lasts: a policy cannot tell
+    the strike from the hold, and a repeated note from the one before it.
+
     The score names keys by index; this says where they are for the hand and how hard to strike
     them, which is what a policy would otherwise have to learn for every key separately.
     """
-    targets = np.zeros((len(fingers), 5 if velocity else 4), np.float32)
+    onsets = previous is not None
+    targets = np.zeros((len(fingers), 4 + velocity + onsets), np.float32)
     steps = len(window)
     for i, finger in enumerate(fingers):
-        rows, keys = np.nonzero(window[:, :, FINGER + i] > 0.5)
+        on = window[:, :, FINGER + i] > 0.5
+        if onsets:
+            # a note starts where its key's finger channel turns on (repeated notes are apart by a step)
+            before = np.vstack([previous[None, :, FINGER + i] > 0.5, on[:-1]])
+            rows, keys = np.nonzero(on & ~before)
+            held = np.flatnonzero(on[0] & before[0])
+            if held.size:
+                targets[i, -1] = np.argmin(np.append(on[:, held[0]], False)) / steps  # rows the hold goes on
+        else:
+            rows, keys = np.nonzero(on)
         if rows.size:
             targets[i, :3] = (points[keys[0]] - tips[finger]) / TARGET_SCALE
             targets[i, 3] = 1.0 - rows[0] / steps
@@ -107,6 +128,10 @@ class EnvConfig:
     target_velocity: bool = True
     """With the target observations, also the velocity that key is to sound at (policies trained
     before 2026-11-22 were trained without it)."""
+    target_onsets: bool = True
+    """With the target observations, point each finger at its next note *onset* and say how much
+    longer it is to hold the key it holds (policies trained before 2026-11-22 saw a held note as
+    one to strike now, and missed repeated notes)."""
     random_start: bool = True
     """Start the wrist at a random position along the keyboard (else at its centre)."""
     actuated: tuple[str, ...] = JOINT_KINDS
@@ -159,7 +184,8 @@ class PianoEnv(gym.Env):
             "joint_velocities": spaces.Box(-SPEED_BOUND, SPEED_BOUND, (self.n_joints,), np.float32),
         }
         if config.target_observations:
-            obs["targets"] = spaces.Box(-SPEED_BOUND, SPEED_BOUND, (self.n_fingers, 5 if config.target_velocity else 4), np.float32)
+            width = 4 + config.target_velocity + config.target_onsets
+            obs["targets"] = spaces.Box(-SPEED_BOUND, SPEED_BOUND, (self.n_fingers, width), np.float32)
         if config.tactile:
             rows, cols = config.tactile_pool or (config.tactile_sensor.rows, config.tactile_sensor.cols)
             obs["tactile"] = spaces.Box(0, 255, (2, self.n_fingers, rows, cols), np.uint8)
@@ -268,9 +294,15 @@ class PianoEnv(gym.Env):
             self._tip_cache = self.world.tip_points()
         return self._tip_cache
 
-    def targets(self, window: np.ndarray) -> np.ndarray:
-        """:func:`finger_targets` for a score window, from the hand's current pose."""
-        return finger_targets(window, self._tips(), self.strike_points, self.spec_score.hand.fingers, self.config.target_velocity)
+    def targets(self, window: np.ndarray, score: np.ndarray | None = None) -> np.ndarray:
+        """:func:`finger_targets` for the score window at the current step, from the hand's current
+        pose; ``score``: the timeline the window was cut from (default: the episode's)."""
+        score = self.score if score is None else score
+        previous = None
+        if self.config.target_onsets:
+            previous = score[self.t - 1] if self.t > 0 else np.zeros_like(score[0])
+        fingers = self.spec_score.hand.fingers
+        return finger_targets(window, self._tips(), self.strike_points, fingers, self.config.target_velocity, previous)
 
     def _tactile_image(self) -> np.ndarray:
         angles, _ = self.world.key_state()

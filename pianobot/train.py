@@ -295,8 +295,10 @@ def config_from_manifest(manifest: dict) -> TrainConfig:
         pool = tuple(e["tactile_pool"]) if e["tactile_pool"] is not None else None
         env = EnvConfig(world=world, reward=RewardConfig(**e["reward"]), tactile_sensor=TactileConfig(**e["tactile_sensor"]),
                         tactile_pool=pool, actuated=tuple(e["actuated"]),
-                        target_velocity=e.get("target_velocity", False),  # manifests from before it existed: without
-                        **{k: v for k, v in e.items() if k not in ("world", "reward", "tactile_sensor", "tactile_pool", "actuated", "target_velocity")})
+                        # manifests from before these existed: without
+                        target_velocity=e.get("target_velocity", False), target_onsets=e.get("target_onsets", False),
+                        **{k: v for k, v in e.items() if k not in ("world", "reward", "tactile_sensor", "tactile_pool", "actuated",
+                                                                   "target_velocity", "target_onsets")})
         s = c["sac"]
         sac = SACConfig(**{**s, "tactile_resolution": tuple(s["tactile_resolution"]) if s["tactile_resolution"] else None,
                            "log_std_bounds": tuple(s["log_std_bounds"]),

@@ -5,8 +5,9 @@ import numpy as np
 import pytest
 from gymnasium.utils.env_checker import check_env
 
-from pianobot.env import EnvConfig, PianoEnv
+from pianobot.env import EnvConfig, PianoEnv, finger_targets
 from pianobot.music.piece import Note, Piece
+from pianobot.music.tensor import FINGER, NOTE, VELOCITY
 from pianobot.rewards import RewardConfig
 
 PHRASE = Piece((Note(0.0, 60, 0.5, 70, 2), Note(0.5, 62, 1.0, 90, 3)), bpm=60)
@@ -151,10 +152,34 @@ def test_frozen_joints_shrink_the_action_and_hold_still():
         PianoEnv(piece=PHRASE, config=EnvConfig(actuated=("elbow",)))
 
 
+def test_finger_targets_tell_a_held_note_from_the_next_strike_of_the_same_key():
+    keys, fingers = 24, (2, 3, 4)
+    tips = {f: np.zeros(3) for f in fingers}
+    points = np.arange(keys * 3, dtype=float).reshape(keys, 3) * 0.001
+    window = np.zeros((11, keys, 5), np.float32)
+    window[0:4, 3, [NOTE, FINGER]] = 1.0  # the index finger holds key 3 for 4 more steps ...
+    window[0:4, 3, VELOCITY] = 0.5
+    window[5:9, 3, [NOTE, FINGER]] = 1.0  # ... then strikes it again, louder
+    window[5:9, 3, VELOCITY] = 0.8
+    previous = window[0].copy()  # the held note started before this window
+    held = finger_targets(window, tips, points, fingers, velocity=True, previous=previous)
+    assert held.shape == (3, 6)
+    assert held[0, 3] == pytest.approx(1 - 5 / 11)  # the next strike, not the held note
+    assert held[0, 4] == pytest.approx(0.8)
+    assert held[0, 5] == pytest.approx(4 / 11)  # how much longer to hold
+    assert np.allclose(held[0, :3], points[3] / 0.1)
+    strike = finger_targets(window[5:], tips, points, fingers, velocity=True, previous=window[4])
+    assert strike[0, 3] == 1.0 and strike[0, 4] == pytest.approx(0.8) and strike[0, 5] == 0.0
+    assert not held[1:].any() and not strike[1:].any()
+    # without onsets (policies before them) the held note reads as one to strike now
+    old = finger_targets(window, tips, points, fingers, velocity=True)
+    assert old.shape == (3, 5) and old[0, 3] == 1.0 and old[0, 4] == pytest.approx(0.5)
+
+
 def test_finger_targets_point_from_each_fingertip_to_its_next_key():
     env = PianoEnv(piece=PHRASE, config=EnvConfig(tactile=False))
     observation, _ = env.reset(seed=3)
-    assert observation["targets"].shape == (3, 5)
+    assert observation["targets"].shape == (3, 6)
     assert not observation["targets"].any()  # nothing in the 0.5 s window yet
     for _ in range(env.lead_steps - 5):
         observation, *_ = env.step(np.zeros(13))
@@ -165,8 +190,25 @@ def test_finger_targets_point_from_each_fingertip_to_its_next_key():
     assert np.allclose(targets[0, :3], expected, atol=1e-5)
     assert targets[0, 3] == pytest.approx(1 - 5 / 11)
     assert targets[0, 4] == pytest.approx(PHRASE.notes[0].velocity / 127)  # how loud
+    assert targets[0, 5] == 0  # holds nothing
     assert not targets[1].any() and not targets[2].any()
-    older = PianoEnv(piece=PHRASE, config=EnvConfig(tactile=False, target_velocity=False))  # as policies before it
+    older = PianoEnv(piece=PHRASE, config=EnvConfig(tactile=False, target_velocity=False, target_onsets=False))  # as policies before them
     assert older.reset(seed=3)[0]["targets"].shape == (3, 4)
     without = PianoEnv(piece=PHRASE, config=EnvConfig(tactile=False, target_observations=False))
     assert "targets" not in without.reset(seed=0)[0]
+
+
+def test_each_strike_of_a_repeated_note_is_announced_once_and_the_hold_between_them_is_not():
+    piece = Piece([Note(0.0, 60, 0.5, 80, 2), Note(0.5, 60, 1.0, 80, 2)])  # C4 twice, index finger
+    env = PianoEnv(piece=piece, config=EnvConfig(tactile=False, random_start=False))
+    observation, _ = env.reset(seed=0)
+    now, holding = [], []
+    while True:
+        now.append(observation["targets"][0, 3] == 1.0)
+        holding.append(observation["targets"][0, 5] > 0)
+        observation, _, terminated, truncated, _ = env.step(np.zeros(env.action_space.shape))
+        if terminated or truncated:
+            break
+    strikes = [env.lead_steps, env.lead_steps + 10]  # 20 Hz: the onsets' steps
+    assert [t for t, flag in enumerate(now) if flag] == strikes
+    assert all(holding[strikes[0] + 1 : strikes[1] - 1]) and not holding[strikes[0]] and not holding[strikes[1] - 1]

@@ -183,7 +183,7 @@ def _agent_and_batch(demo_weight: float, demo: float):
 
     torch.manual_seed(0)
     env = make_env(PHRASE, EnvConfig(tactile=False))
-    config = SACConfig(batch_size=64, hidden=32, score_features=16, demo_weight=demo_weight)
+    config = SACConfig(batch_size=64, hidden=32, score_features=16, demo_weight=demo_weight, learning_rate=1e-3)  # the mechanism, quickly
     from pianobot.agent.sac import score_size, vector_size
 
     space, score = env.observation_space, config.score_input
