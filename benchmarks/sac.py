@@ -4,7 +4,8 @@
     python benchmarks/sac.py --compile      # ours with and without torch.compile instead
 
 Both learn on the same environment (examples/midi/three-note.mid, state only and with tactile
-images of 3 fingertips) with batch size 256, from a replay buffer filled by 1000 random steps.
+images of 3 fingertips; Stable-Baselines3 without the score window when ours does not read it,
+so that both see the same inputs) with batch size 256, from a replay buffer filled by 1000 random steps.
 Each figure is the median of ``--repeats`` timings of ``--updates`` updates. Stable-Baselines3
 is a benchmark-only dependency (`pip install stable-baselines3`).
 """
@@ -70,10 +71,20 @@ def ours(tactile: bool, updates: int, repeats: int, compiled: bool = False) -> l
     return rates
 
 
-def stable_baselines(tactile: bool, updates: int, repeats: int) -> list[float]:
+PAPER_DEPTH = [256, 256, 256, 256]
+"""Stable-Baselines3 hidden layers as deep as our networks: the paper's 2-layer encoder MLP then
+2-layer heads (its default is [256, 256], half the work per network)."""
+
+
+def stable_baselines(tactile: bool, updates: int, repeats: int, net_arch: list[int] | None = None) -> list[float]:
+    from gymnasium.wrappers import FilterObservation
     from stable_baselines3 import SAC as SB3SAC
 
-    model = SB3SAC("MultiInputPolicy", make_env(tactile), batch_size=256, learning_starts=FILL, buffer_size=FILL + 10, device="cpu", seed=0)
+    env = make_env(tactile)
+    if not SACConfig().score_input:  # the same inputs as ours: without the score window when ours skips it
+        env = FilterObservation(env, [k for k in env.observation_space.spaces if k != "score"])
+    kwargs = {} if net_arch is None else {"policy_kwargs": {"net_arch": net_arch}}
+    model = SB3SAC("MultiInputPolicy", env, **kwargs, batch_size=256, learning_starts=FILL, buffer_size=FILL + 10, device="cpu", seed=0)
     model.learn(FILL)  # fills the buffer with random steps
     model.train(gradient_steps=5, batch_size=256)
     rates = []
@@ -96,14 +107,19 @@ def main() -> None:
         compare_compile(args)
         return
     print(f"torch {torch.__version__}, {args.threads} thread(s), batch 256, {args.updates} updates x {args.repeats} repeats\n")
-    print("| configuration | pianobot updates/s | Stable-Baselines3 updates/s | ratio |")
-    print("| --- | ---: | ---: | ---: |")
+    print("| configuration | pianobot updates/s | Stable-Baselines3 updates/s, its default net | ratio | Stable-Baselines3, 4 x 256 like ours | ratio |")
+    print("| --- | ---: | ---: | ---: | ---: | ---: |")
+
+    def cell(rates: list[float]) -> str:
+        return f"{statistics.median(rates):.1f} ({', '.join(f'{x:.1f}' for x in rates)})"
+
     for tactile in (False, True):
         mine = ours(tactile, args.updates, args.repeats)
-        theirs = stable_baselines(tactile, args.updates, args.repeats)
-        a, b = statistics.median(mine), statistics.median(theirs)
+        default = stable_baselines(tactile, args.updates, args.repeats)
+        deep = stable_baselines(tactile, args.updates, args.repeats, PAPER_DEPTH)
+        a = statistics.median(mine)
         label = "tactile (3 fingertips, 15x20)" if tactile else "state only"
-        print(f"| {label} | {a:.1f} ({', '.join(f'{x:.1f}' for x in mine)}) | {b:.1f} ({', '.join(f'{x:.1f}' for x in theirs)}) | {a / b:.2f}x |")
+        print(f"| {label} | {cell(mine)} | {cell(default)} | {a / statistics.median(default):.2f}x | {cell(deep)} | {a / statistics.median(deep):.2f}x |")
 
 
 def compare_compile(args) -> None:
