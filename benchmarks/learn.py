@@ -3,6 +3,7 @@
     python benchmarks/learn.py --tasks one-note three-note --seeds 0 1 2 --steps 100000 \
         [--explore prior] [--no-tactile] [--workers 2] [--plot docs/learning.png] [--store /tmp/learn]
     python benchmarks/learn.py ... --report    # no training: the runs so far, finished or not
+    python benchmarks/learn.py ... --report --check   # and what unfinished runs' best policies play
 
 Trains with `pianobot.train.train_policy` (checkpointed: rerunning the same command resumes),
 evaluating every ``--eval-every`` steps on ``--eval-episodes`` fixed instances (hand starts
@@ -23,6 +24,7 @@ from pianobot import store
 from pianobot.agent.sac import SACConfig
 from pianobot.env import EnvConfig
 from pianobot.train import (
+    BEST_PREFIX,
     TASK_EVAL_EPISODES,
     TRAIN_JOINTS,
     TrainConfig,
@@ -30,6 +32,7 @@ from pianobot.train import (
     config_from_manifest,
     evaluate,
     load_policy,
+    make_agent,
     make_env,
     train_policy,
 )
@@ -71,6 +74,22 @@ def check(task: str, folder: Path, manifest: dict, episodes: int) -> dict:
     return {"episodes": episodes, **evaluate(agent, task, env_config, episodes, first_seed=CHECK_SEED)}
 
 
+def check_so_far(task: str, seed: int, args) -> dict | None:
+    """The best policy an unfinished run has kept so far (in its checkpoint), on the same fresh
+    instances as :func:`check`; None if it has none yet. Reads the checkpoint a running run
+    writes (atomically) and changes nothing."""
+    config, folder = run_folder(task, seed, args)
+    found = store.load_checkpoint(folder)
+    if found is None or found[1].get("best") is None:
+        return None
+    tensors, state, _ = found
+    env_config = agent_env_config(config)
+    agent = make_agent(make_env(task, env_config), config)
+    agent.load_tensors({k[len(BEST_PREFIX) :]: v for k, v in tensors.items() if k.startswith(BEST_PREFIX)}, with_training_state=False)
+    figures = evaluate(agent, task, env_config, args.check_episodes, first_seed=CHECK_SEED)
+    return {"episodes": args.check_episodes, "step": state["best"]["step"], **figures}
+
+
 def progress(task: str, seed: int, args) -> dict | None:
     """What a run has so far, without training: its manifest once finished (with the check when
     the full command wrote it), else its last checkpoint's evaluations; None if not started."""
@@ -101,6 +120,7 @@ def main() -> None:
     parser.add_argument("--store", default="/tmp/pianobot-learn")
     parser.add_argument("--plot", default=None)
     parser.add_argument("--report", action="store_true", help="train nothing: print and plot what the runs have so far")
+    parser.add_argument("--check", action="store_true", help="with --report: unfinished runs' best policies so far play the new instances too")
     args = parser.parse_args()
 
     jobs = [(task, seed) for task in args.tasks for seed in args.seeds]
@@ -139,6 +159,8 @@ def report(args, jobs: list[tuple[str, int]]) -> None:
         best = max(found["evaluations"], key=lambda e: e["f1"], default=None)
         kept = "" if best is None else f"{best['f1']:.2f} ({best['step'] // 1000}k)"
         held = f"{found['check']['f1']:.2f}" if "check" in found else ""
+        if not found["finished"] and args.check and (so_far := check_so_far(task, seed, args)) is not None:
+            held = f"{so_far['f1']:.2f} (best so far, {so_far['step'] // 1000}k)"
         state = "finished" if found["finished"] else f"at {found['step'] // 1000}k steps"
         print(f"| {task} | {seed} | {state} | {curve} | {kept} | {held} | {found['seconds'] / 60:.1f} |")
     if args.plot and results:
