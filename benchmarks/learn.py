@@ -156,7 +156,7 @@ def report(args, jobs: list[tuple[str, int]]) -> None:
             continue
         results.append((task, seed, found))
         curve = " / ".join(f"{e['f1']:.2f}" for e in found["evaluations"])
-        best = max(found["evaluations"], key=lambda e: e["f1"], default=None)
+        best = found.get("evaluation") or found.get("best")  # the kept policy's figures (training's choice, ties broken on return)
         kept = "" if best is None else f"{best['f1']:.2f} ({best['step'] // 1000}k)"
         held = f"{found['check']['f1']:.2f}" if "check" in found else ""
         if not found["finished"] and args.check and (so_far := check_so_far(task, seed, args)) is not None:
