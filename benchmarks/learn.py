@@ -24,11 +24,11 @@ from pianobot import store
 from pianobot.agent.sac import SACConfig
 from pianobot.env import EnvConfig
 from pianobot.train import (
-    BEST_PREFIX,
     TASK_EVAL_EPISODES,
     TRAIN_JOINTS,
     TrainConfig,
     agent_env_config,
+    best_policy_tensors,
     config_from_manifest,
     evaluate,
     load_policy,
@@ -85,7 +85,7 @@ def check_so_far(task: str, seed: int, args) -> dict | None:
     tensors, state, _ = found
     env_config = agent_env_config(config)
     agent = make_agent(make_env(task, env_config), config)
-    agent.load_tensors({k[len(BEST_PREFIX) :]: v for k, v in tensors.items() if k.startswith(BEST_PREFIX)}, with_training_state=False)
+    agent.load_tensors(best_policy_tensors(tensors), with_training_state=False)
     figures = evaluate(agent, task, env_config, args.check_episodes, first_seed=CHECK_SEED)
     return {"episodes": args.check_episodes, "step": state["best"]["step"], **figures}
 

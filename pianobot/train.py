@@ -124,6 +124,11 @@ BEST_PREFIX = "best."
 """Checkpoint tensors of the best policy evaluated so far are stored under this prefix."""
 
 
+def best_policy_tensors(checkpoint_tensors: dict[str, torch.Tensor]) -> dict[str, torch.Tensor]:
+    """The best evaluated policy's tensors in a checkpoint, under their own names."""
+    return {k[len(BEST_PREFIX) :]: v for k, v in checkpoint_tensors.items() if k.startswith(BEST_PREFIX)}
+
+
 def better(figures: dict, than: dict | None) -> bool:
     """Whether an evaluation beats another: higher note F1 first, then higher return."""
     if than is None:
@@ -163,7 +168,7 @@ def train_policy(
         agent.load_tensors({k: v for k, v in tensors.items() if not k.startswith(BEST_PREFIX)})
         if state.get("best") is not None:
             best = state["best"]
-            best_tensors = {k[len(BEST_PREFIX) :]: v for k, v in tensors.items() if k.startswith(BEST_PREFIX)}
+            best_tensors = best_policy_tensors(tensors)
         torch.set_rng_state(tensors["torch_rng"])
         buffer.load(buffer_folder, state["buffer_size"], state["buffer_cursor"])
         rng.bit_generator.state = state["rng"]
