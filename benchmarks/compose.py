@@ -23,15 +23,15 @@ from pathlib import Path
 
 import torch
 
-from pianobot import store
+from pianobot.agent import store
 from pianobot.agent.sac import SACConfig
-from pianobot.compose import CompositionalController
-from pianobot.env import EnvConfig
-from pianobot.metrics import compare
+from pianobot.perform.compose import CompositionalController
+from pianobot.env.piano import EnvConfig
+from pianobot.music.metrics import compare
 from pianobot.music.load import load_piece
 from pianobot.music.phrases import split_phrases
-from pianobot.perform import perform
-from pianobot.train import TRAIN_JOINTS, TrainConfig, load_policy, plan_jobs, run_jobs, train_policy
+from pianobot.perform.perform import perform
+from pianobot.learn.train import TRAIN_JOINTS, TrainConfig, load_policy, plan_jobs, run_jobs, train_policy
 
 PLAY_SEEDS = (0, 1, 2)
 

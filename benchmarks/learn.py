@@ -5,7 +5,7 @@
     python benchmarks/learn.py ... --report    # no training: the runs so far, finished or not
     python benchmarks/learn.py ... --report --check   # and what unfinished runs' best policies play
 
-Trains with `pianobot.train.train_policy` (checkpointed: rerunning the same command resumes),
+Trains with `pianobot.learn.train.train_policy` (checkpointed: rerunning the same command resumes),
 evaluating every ``--eval-every`` steps on ``--eval-episodes`` fixed instances (hand starts
 and notes). A run stopped by ``--until-f1`` stopped on the first evaluation that reached it, a
 figure that flatters; so the kept policy then plays ``--check-episodes`` instances it was never
@@ -20,10 +20,10 @@ import json
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
-from pianobot import store
+from pianobot.agent import store
 from pianobot.agent.sac import SACConfig
-from pianobot.env import EnvConfig
-from pianobot.train import (
+from pianobot.env.piano import EnvConfig
+from pianobot.learn.train import (
     TASK_EVAL_EPISODES,
     TRAIN_JOINTS,
     TrainConfig,

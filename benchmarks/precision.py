@@ -16,13 +16,13 @@ from pathlib import Path
 
 import numpy as np
 
-from pianobot.controllers import ScriptedPianist
-from pianobot.metrics import compare
+from pianobot.pianist.scripted import ScriptedPianist
+from pianobot.music.metrics import compare
 from pianobot.music.instrument import HandSpec
 from pianobot.music.load import LoadOptions, load_part
 from pianobot.music.phrases import split_phrases
 from pianobot.sim.recorder import NoteRecorder
-from pianobot.train import EVAL_SEED, TrainConfig, agent_env_config, make_env, phrase_target
+from pianobot.learn.train import EVAL_SEED, TrainConfig, agent_env_config, make_env, phrase_target
 
 PARTS = ("all", "fingers", "wrist")
 

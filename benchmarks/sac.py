@@ -22,7 +22,7 @@ import torch
 
 from pianobot.agent.buffer import ReplayBuffer
 from pianobot.agent.sac import SAC, SACConfig, score_size, vector_size
-from pianobot.env import EnvConfig, PianoEnv
+from pianobot.env.piano import EnvConfig, PianoEnv
 from pianobot.music.load import load_piece
 
 ROOT = Path(__file__).resolve().parent.parent

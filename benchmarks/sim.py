@@ -22,8 +22,8 @@ import time
 from pathlib import Path
 
 
-from pianobot.controllers import ScriptedPianist
-from pianobot.env import EnvConfig, PianoEnv
+from pianobot.pianist.scripted import ScriptedPianist
+from pianobot.env.piano import EnvConfig, PianoEnv
 from pianobot.music.load import load_piece
 from pianobot.sim.tactile import TactileConfig, TactileRenderer
 

@@ -7,7 +7,7 @@ velocities; the table shows what the simulated keyboard sounded.
 from __future__ import annotations
 
 from pianobot.music.piece import Note, Piece, pitch_name
-from pianobot.perform import perform
+from pianobot.perform.perform import perform
 
 TARGETS = (10, 30, 50, 70, 90, 110, 127)
 

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
-from pianobot.cli import app
+from pianobot.cli.app import app
 from pianobot.music.midi_io import write_midi
 from pianobot.music.piece import Note, Piece
 from pianobot.music.pig import sidecar_for, write_pig
@@ -245,7 +245,7 @@ def test_train_then_skip(tmp_path):
 
 def test_train_a_task_family_evaluates_on_many_instances(tmp_path):
     """A task's instances all differ: its evaluation plays TASK_EVAL_EPISODES of them, not a phrase's 3."""
-    from pianobot.train import TASK_EVAL_EPISODES
+    from pianobot.learn.train import TASK_EVAL_EPISODES
 
     result = run("train", "--task", "one-note", "--steps", "60", "--exploration-steps", "30", "--no-tactile", "--models", tmp_path)
     assert result.exit_code == 0, result.output
@@ -285,11 +285,11 @@ def test_play_composes_policies_with_different_agent_settings(tmp_path):
     score window (as policies stored before 2026-11-22 do) beside one that does not."""
     from dataclasses import replace
 
-    from pianobot import store
+    from pianobot.agent import store
     from pianobot.agent.sac import SACConfig
-    from pianobot.env import EnvConfig
+    from pianobot.env.piano import EnvConfig
     from pianobot.music.phrases import split_phrases
-    from pianobot.train import TrainConfig, phrase_target, train_policy
+    from pianobot.learn.train import TrainConfig, phrase_target, train_policy
 
     piece = Piece((Note(0.0, 64, 1.0, 80, 3), Note(3.0, 67, 4.0, 70, 4)), bpm=60)
     song = write_midi(piece, tmp_path / "song.mid")
@@ -310,8 +310,8 @@ def read_played(path):
 
 
 def test_sections_hand_over_after_the_last_strike():
-    from pianobot.compose import CompositionalController
-    from pianobot.env import EnvConfig, PianoEnv
+    from pianobot.perform.compose import CompositionalController
+    from pianobot.env.piano import EnvConfig, PianoEnv
     from pianobot.music.phrases import split_phrases
 
     piece = Piece((Note(0.0, 60, 0.5, 80, 2), Note(0.5, 62, 1.0, 80, 3), Note(1.0, 64, 1.5, 80, 4)), bpm=60)
@@ -364,7 +364,7 @@ MODELS = Path(__file__).parent.parent / "models"
 
 def _committed_examples() -> list[Path]:
     """Examples whose every phrase has a policy committed in models/."""
-    from pianobot.compose import missing_phrases, trained_split
+    from pianobot.perform.compose import missing_phrases, trained_split
     from pianobot.music.load import load_piece
 
     return [p for p in sorted(EXAMPLES.glob("*.mid")) if "performed" not in p.stem

@@ -6,15 +6,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from pianobot.controllers import RandomController, ScriptedPianist
-from pianobot.env import EnvConfig
-from pianobot.metrics import compare
+from pianobot.pianist.scripted import RandomController, ScriptedPianist
+from pianobot.env.piano import EnvConfig
+from pianobot.music.metrics import compare
 from pianobot.errors import PianobotWarning
-from pianobot.fingering import ensure_fingering
+from pianobot.pianist.fingering import ensure_fingering
 from pianobot.music.instrument import HandSpec, KeyboardSpec
 from pianobot.music.load import LoadOptions, load_part, load_piece
 from pianobot.music.tasks import TASKS, make_task
-from pianobot.perform import perform
+from pianobot.perform.perform import perform
 from pianobot.sim.world import WorldConfig
 
 EXAMPLES = sorted((Path(__file__).parent.parent / "examples" / "midi").glob("*.mid"))
@@ -69,7 +69,7 @@ def test_scripted_pianist_plays_a_phrase_from_every_hand_start():
     left a fingertip hovering for ever a hair under the height for crossing out of the black keys' band."""
     from pianobot.music.phrases import split_phrases
     from pianobot.sim.recorder import NoteRecorder
-    from pianobot.train import EVAL_SEED, make_env, phrase_target
+    from pianobot.learn.train import EVAL_SEED, make_env, phrase_target
 
     phrase = split_phrases(load_piece(Path(__file__).parent.parent / "examples" / "midi" / "three-note.mid"))[0]
     config = EnvConfig(tactile=False)
@@ -92,7 +92,7 @@ def test_scripted_pianist_strikes_in_the_step_of_each_onset():
     its row: a key played on time must sound in the step of its onset's row, not the one before
     (before the steps were centred, the on-time strike fell in the row before and was penalised)."""
     from pianobot.music.phrases import split_phrases
-    from pianobot.train import EVAL_SEED, make_env, phrase_target
+    from pianobot.learn.train import EVAL_SEED, make_env, phrase_target
 
     phrase = split_phrases(load_piece(Path(__file__).parent.parent / "examples" / "midi" / "rhythmic.mid"))[0]
     config = EnvConfig(tactile=False)

@@ -5,10 +5,10 @@ import numpy as np
 import pytest
 from gymnasium.utils.env_checker import check_env
 
-from pianobot.env import EnvConfig, PianoEnv, finger_targets
+from pianobot.env.piano import EnvConfig, PianoEnv, finger_targets
 from pianobot.music.piece import Note, Piece
 from pianobot.music.tensor import FINGER, NOTE, VELOCITY
-from pianobot.rewards import RewardConfig
+from pianobot.env.rewards import RewardConfig
 
 PHRASE = Piece((Note(0.0, 60, 0.5, 70, 2), Note(0.5, 62, 1.0, 90, 3)), bpm=60)
 

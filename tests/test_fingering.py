@@ -7,15 +7,15 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
-from pianobot.cli import app
+from pianobot.cli.app import app
 from pianobot.errors import PianobotError
-from pianobot.fingering import Planner, ensure_fingering, plan_fingering
-from pianobot.metrics import compare
+from pianobot.pianist.fingering import Planner, ensure_fingering, plan_fingering
+from pianobot.music.metrics import compare
 from pianobot.music.instrument import HandSpec, KeyboardSpec
 from pianobot.music.load import LoadOptions, load_part, load_piece, thin_chords
 from pianobot.music.midi_io import read_midi, write_midi
 from pianobot.music.piece import Note, Piece, parse_pitch
-from pianobot.perform import perform
+from pianobot.perform.perform import perform
 from pianobot.sim.hand import FINGER_BASE_X
 
 from conftest import midi_file

@@ -50,7 +50,7 @@ def test_key_sensor_sends_note_on_with_velocity_and_note_off_with_hysteresis():
 def test_slow_press_is_soft_and_fast_press_is_loud():
     """A finger pressing a key through the physics: the key's speed sets the velocity."""
     from pianobot.sim.world import PianoWorld, WorldConfig
-    from pianobot.env import idle_pose
+    from pianobot.env.piano import idle_pose
 
     world = PianoWorld(WorldConfig())
     velocities = []
@@ -76,7 +76,7 @@ def test_slow_press_is_soft_and_fast_press_is_loud():
 def test_finger_joints_stay_within_their_limits_at_full_command(control):
     """(Under torque control, fingers jammed into the keys at full torque still overshoot by up to
     0.6 rad: see docs/simulator.md.)"""
-    from pianobot.env import idle_pose
+    from pianobot.env.piano import idle_pose
     from pianobot.sim.world import PianoWorld, WorldConfig
 
     world = PianoWorld(WorldConfig(control=control))

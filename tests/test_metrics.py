@@ -4,7 +4,7 @@ import mir_eval
 import numpy as np
 import pytest
 
-from pianobot.metrics import compare, key_press_f1
+from pianobot.music.metrics import compare, key_press_f1
 from pianobot.music.piece import Note, Piece
 
 

@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 
-from pianobot.rewards import RewardConfig, gate, linear_distance, reward_terms, squared_distance, wasserstein_distance
+from pianobot.env.rewards import RewardConfig, gate, linear_distance, reward_terms, squared_distance, wasserstein_distance
 
 L = 6
 
@@ -86,7 +86,7 @@ def test_unknown_reward_is_refused():
 
 
 def test_closeness_bonus_rewards_fingertips_near_their_keys():
-    from pianobot.rewards import closeness
+    from pianobot.env.rewards import closeness
 
     assert closeness(np.array([0.0, 0.0]), 0.02) == 1.0
     assert closeness(np.array([0.02]), 0.02) == pytest.approx(np.exp(-1))
@@ -99,8 +99,8 @@ def test_closeness_bonus_rewards_fingertips_near_their_keys():
 
 
 def test_the_scripted_pianist_earns_more_than_an_idle_hand():
-    from pianobot.controllers import ScriptedPianist
-    from pianobot.env import EnvConfig, PianoEnv
+    from pianobot.pianist.scripted import ScriptedPianist
+    from pianobot.env.piano import EnvConfig, PianoEnv
     from pianobot.music.piece import Note, Piece
 
     config = EnvConfig(tactile=False)

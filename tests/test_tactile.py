@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from pianobot.controllers import ScriptedPianist
-from pianobot.env import EnvConfig, PianoEnv
+from pianobot.pianist.scripted import ScriptedPianist
+from pianobot.env.piano import EnvConfig, PianoEnv
 from pianobot.music.piece import Note, Piece
 from pianobot.sim.bullet import p
 from pianobot.sim.tactile import TactileConfig, TactileRenderer, pool, to_uint8

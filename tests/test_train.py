@@ -7,14 +7,14 @@ import numpy as np
 import pytest
 import torch
 
-from pianobot import store
+from pianobot.agent import store
 from pianobot.agent.sac import SACConfig
-from pianobot.env import EnvConfig
+from pianobot.env.piano import EnvConfig
 from pianobot.errors import PianobotError
-from pianobot.explore import Explorer
+from pianobot.learn.explore import Explorer
 from pianobot.music.phrases import split_phrases
 from pianobot.music.piece import Note, Piece
-from pianobot.train import Progress, TrainConfig, load_policy, make_env, plan_jobs, train_policy
+from pianobot.learn.train import Progress, TrainConfig, load_policy, make_env, plan_jobs, train_policy
 
 PHRASE = Piece((Note(0.0, 64, 0.5, 80, 3),), bpm=60)  # a one-note phrase: 35 steps an episode
 
@@ -141,7 +141,7 @@ def test_an_agent_that_does_not_read_the_score_window_does_not_store_it(tmp_path
     observation, _ = env.reset(seed=0)
     for reads in (False, True):
         config = replace(small(env=EnvConfig(tactile=False)), sac=replace(small().sac, score_input=reads))
-        from pianobot.train import make_agent
+        from pianobot.learn.train import make_agent
 
         agent = make_agent(env, config)
         vector, _ = agent.split(observation)
@@ -156,7 +156,7 @@ def test_an_agent_that_does_not_read_the_score_window_does_not_store_it(tmp_path
 def test_scripted_exploration_mixes_quiet_episodes_that_play_with_noisy_ones():
     """A strike fails with noise much above 0.02: the noise scale is drawn per episode, so the
     buffer gets episodes that play the note (a fixed 0.2 played none) and ones that go astray."""
-    from pianobot.metrics import compare
+    from pianobot.music.metrics import compare
     from pianobot.sim.recorder import NoteRecorder
 
     env = make_env(PHRASE, EnvConfig(tactile=False))
@@ -217,7 +217,7 @@ def test_behaviour_cloning_pulls_the_actor_towards_demonstrations():
 
 
 def test_until_f1_stops_at_the_first_good_evaluation(tmp_path, monkeypatch):
-    import pianobot.train as train
+    import pianobot.learn.train as train
 
     calls = []
 
@@ -235,7 +235,7 @@ def test_until_f1_stops_at_the_first_good_evaluation(tmp_path, monkeypatch):
 
 
 def test_the_best_evaluated_policy_is_kept_across_an_interruption(tmp_path, monkeypatch):
-    import pianobot.train as train
+    import pianobot.learn.train as train
 
     def scripted(record):
         scores = iter([0.2, 0.9, 0.4, 0.3])  # the second evaluation is the best; the last (final) is worse
@@ -282,7 +282,7 @@ def test_training_workers_end_when_their_parent_is_killed(tmp_path):
     script.write_text(
         "import multiprocessing, os, time\n"
         "from concurrent.futures import ProcessPoolExecutor\n"
-        "from pianobot.train import _exit_with_parent\n"
+        "from pianobot.learn.train import _exit_with_parent\n"
         "def nap():\n"
         "    print(os.getpid(), flush=True)\n"
         "    time.sleep(60)\n"

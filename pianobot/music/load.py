@@ -33,7 +33,7 @@ class LoadOptions:
     quantize: str | None = None
     """Move onsets and offsets to this grid, e.g. '1/16' (for recordings of human players)."""
     refinger: bool = False
-    """Replace the file's fingering with the planner's (see pianobot.fingering)."""
+    """Replace the file's fingering with the planner's (see pianobot.pianist.fingering)."""
 
 
 HANDS = ("right", "left")

@@ -5,7 +5,7 @@ from __future__ import annotations
 from rich.console import Console
 from rich.table import Table
 
-from pianobot.metrics import Report
+from pianobot.music.metrics import Report
 from pianobot.music.midi_io import TrackInfo
 from pianobot.music.phrases import Phrase
 from pianobot.music.piece import FINGER_NAMES, Piece, pitch_name

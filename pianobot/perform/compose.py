@@ -18,15 +18,15 @@ from pathlib import Path
 
 import numpy as np
 
-from pianobot import store
-from pianobot.controllers import ScriptedPianist
-from pianobot.env import PianoEnv
+from pianobot.agent import store
+from pianobot.pianist.scripted import ScriptedPianist
+from pianobot.env.piano import PianoEnv
 from pianobot.errors import PianobotError
-from pianobot.metrics import DEFAULT_ONSET_TOLERANCE
+from pianobot.music.metrics import DEFAULT_ONSET_TOLERANCE
 from pianobot.music.phrases import DEFAULT_MAX_NOTES, Phrase, split_phrases
 from pianobot.music.piece import Piece
 from pianobot.music.tensor import score_tensor
-from pianobot.train import TrainConfig, config_from_manifest, load_policy, phrase_target
+from pianobot.learn.train import TrainConfig, config_from_manifest, load_policy, phrase_target
 
 
 @dataclass

@@ -25,7 +25,7 @@ from pianobot.music.instrument import check_playable
 from pianobot.music.piece import Piece
 from pianobot.music.tasks import TASKS, make_task
 from pianobot.music.tensor import FINGER, NOTE, VELOCITY, ScoreSpec, score_tensor, steps_for
-from pianobot.rewards import RewardConfig, reward_terms
+from pianobot.env.rewards import RewardConfig, reward_terms
 from pianobot.sim.hand import finger_ik, joint_names
 from pianobot.sim.tactile import TactileConfig, TactileRenderer, pool, to_uint8
 from pianobot.sim.keyboard import strike_points
@@ -137,7 +137,7 @@ class EnvConfig:
     actuated: tuple[str, ...] = JOINT_KINDS
     """Finger joints the policy moves; the others hold their starting angle (the paper froze the
     joints not crucial to a task). E.g. ("mcp", "pip") leaves 2 per finger plus the wrist, the
-    training default (:data:`pianobot.train.TRAIN_JOINTS`)."""
+    training default (:data:`pianobot.learn.train.TRAIN_JOINTS`)."""
 
     @property
     def score_spec(self) -> ScoreSpec:
@@ -348,10 +348,10 @@ def register_envs() -> None:
     """Register ``pianobot/Piano-v0`` (give piece=) and one id per task family, e.g. ``pianobot/OneNote-v0``."""
     if "pianobot/Piano-v0" in gym.registry:
         return
-    gym.register(id="pianobot/Piano-v0", entry_point="pianobot.env:PianoEnv")
+    gym.register(id="pianobot/Piano-v0", entry_point="pianobot.env.piano:PianoEnv")
     for task in TASKS:
         name = "".join(part.capitalize() for part in task.split("-"))
-        gym.register(id=f"pianobot/{name}-v0", entry_point="pianobot.env:PianoEnv", kwargs={"task": task})
+        gym.register(id=f"pianobot/{name}-v0", entry_point="pianobot.env.piano:PianoEnv", kwargs={"task": task})
 
 
 register_envs()

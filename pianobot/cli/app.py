@@ -18,26 +18,27 @@ import typer
 from rich.console import Console
 from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 
-from pianobot import __version__, display
+from pianobot import __version__
+from pianobot.cli import display
 from pianobot.errors import PianobotError, PianobotWarning
 from pianobot.files import atomic_write, check_writable
-from pianobot.metrics import DEFAULT_ONSET_TOLERANCE, compare, plot_report
+from pianobot.music.metrics import DEFAULT_ONSET_TOLERANCE, compare, plot_report
 from pianobot.music import midi_io
 from pianobot.music.instrument import HandSpec, KeyboardSpec, check_playable
-from pianobot import store
+from pianobot.agent import store
 from pianobot.agent.sac import SACConfig
-from pianobot.env import JOINT_KINDS, EnvConfig
-from pianobot.explore import EXPLORATIONS
+from pianobot.env.piano import JOINT_KINDS, EnvConfig
+from pianobot.learn.explore import EXPLORATIONS
 from pianobot.music.tasks import TASKS
-from pianobot.rewards import REWARDS, RewardConfig
+from pianobot.env.rewards import REWARDS, RewardConfig
 from pianobot.sim.world import CONTROL_MODES
-from pianobot.train import TASK_EVAL_EPISODES, TRAIN_JOINTS, PhraseJob, TrainConfig, plan_jobs, run_jobs
-from pianobot.fingering import ensure_fingering
+from pianobot.learn.train import TASK_EVAL_EPISODES, TRAIN_JOINTS, PhraseJob, TrainConfig, plan_jobs, run_jobs
+from pianobot.pianist.fingering import ensure_fingering
 from pianobot.music.load import HANDS, LoadOptions, hand_tracks, load_part, load_piece
 from pianobot.music.midi_io import write_midi
-from pianobot.audio import write_wav
-from pianobot.compose import CompositionalController, missing_phrases, trained_split, training_config
-from pianobot.perform import CONTROLLERS, perform, write_video
+from pianobot.perform.audio import write_wav
+from pianobot.perform.compose import CompositionalController, missing_phrases, trained_split, training_config
+from pianobot.perform.perform import CONTROLLERS, perform, write_video
 from pianobot.sim.hand import HandConfig
 from pianobot.sim.keyboard import KeyboardConfig
 from pianobot.sim.world import WorldConfig

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pianobot.env import EnvConfig
+from pianobot.env.piano import EnvConfig
 from pianobot.music.tensor import FINGER, NOTE, VELOCITY
 from pianobot.sim.hand import FINGER_BASE_X, PREFERRED_TILT, TILT_RANGE, finger_ik, lowest_point_in_finger_plane
 from pianobot.sim.keyboard import BLACK_STRIKE_FROM_FRONT, WHITE_STRIKE_FROM_FRONT, key_boxes

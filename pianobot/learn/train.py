@@ -24,13 +24,13 @@ from typing import Callable
 import numpy as np
 import torch
 
-from pianobot import store
+from pianobot.agent import store
 from pianobot.agent.buffer import ReplayBuffer
 from pianobot.agent.sac import SAC, SACConfig, score_size, vector_size
-from pianobot.env import JOINT_KINDS, EnvConfig, PianoEnv
+from pianobot.env.piano import JOINT_KINDS, EnvConfig, PianoEnv
 from pianobot.errors import PianobotError
-from pianobot.explore import Explorer
-from pianobot.metrics import compare
+from pianobot.learn.explore import Explorer
+from pianobot.music.metrics import compare
 from pianobot.music.phrases import Phrase
 from pianobot.music.piece import Piece
 from pianobot.sim.recorder import NoteRecorder
@@ -279,7 +279,7 @@ def load_policy(folder: Path, config: TrainConfig, env: PianoEnv) -> SAC:
 def config_from_manifest(manifest: dict) -> TrainConfig:
     """Rebuild the TrainConfig a stored policy was trained with."""
     from pianobot.music.instrument import HandSpec, KeyboardSpec
-    from pianobot.rewards import RewardConfig
+    from pianobot.env.rewards import RewardConfig
     from pianobot.sim.hand import FingerGeometry, HandConfig
     from pianobot.sim.keyboard import KeyboardConfig, KeyGeometry, VelocityCurve
     from pianobot.sim.tactile import TactileConfig

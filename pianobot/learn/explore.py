@@ -15,8 +15,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from pianobot.controllers import ScriptedPianist
-from pianobot.env import EnvConfig
+from pianobot.pianist.scripted import ScriptedPianist
+from pianobot.env.piano import EnvConfig
 
 EXPLORATIONS = ("uniform", "repeat", "prior", "scripted")
 REPEAT_PROBABILITY = 0.8

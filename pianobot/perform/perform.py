@@ -14,8 +14,8 @@ from typing import Callable, Protocol
 
 import numpy as np
 
-from pianobot.controllers import RandomController, ScriptedPianist
-from pianobot.env import JOINT_KINDS, EnvConfig, PianoEnv
+from pianobot.pianist.scripted import RandomController, ScriptedPianist
+from pianobot.env.piano import JOINT_KINDS, EnvConfig, PianoEnv
 from pianobot.errors import PianobotError
 from pianobot.files import check_writable, move_into_place, temporary_beside
 from pianobot.music.piece import Piece
@@ -40,7 +40,7 @@ class Performance:
 
 
 def make_controller(name: str, env: PianoEnv, seed: int | None = None) -> Controller:
-    """The scripted or random controller (``sac`` needs the model store: see pianobot.compose)."""
+    """The scripted or random controller (``sac`` needs the model store: see pianobot.perform.compose)."""
     if name == "scripted":
         return ScriptedPianist(env.config)
     if name == "random":
