@@ -24,29 +24,18 @@ from pathlib import Path
 import torch
 
 from pianobot.agent import store
-from pianobot.agent.sac import SACConfig
-from pianobot.perform.compose import CompositionalController
+from pianobot.agent.config import SACConfig
+from pianobot.agent.policy import load_policy
 from pianobot.env.piano import EnvConfig
-from pianobot.music.metrics import compare
+from pianobot.learn.config import TrainConfig
+from pianobot.learn.jobs import phrase_jobs, plan_jobs, run_jobs
+from pianobot.learn.train import train_policy
 from pianobot.music.load import load_piece
 from pianobot.music.phrases import split_phrases
+from pianobot.perform.compose import CompositionalController
 from pianobot.perform.perform import perform
-from pianobot.learn.train import TRAIN_JOINTS, TrainConfig, load_policy, plan_jobs, run_jobs, train_policy
 
 PLAY_SEEDS = (0, 1, 2)
-
-
-class EndToEnd:
-    """One policy that sees the whole piece's score window (as it was trained)."""
-
-    def __init__(self, agent):
-        self.agent = agent
-
-    def reset(self) -> None:
-        pass
-
-    def act(self, observation: dict):
-        return self.agent.act(*self.agent.split(observation), deterministic=True)
 
 
 def play(piece, factory, config: EnvConfig) -> tuple[list[float], list[float], float]:
@@ -56,7 +45,7 @@ def play(piece, factory, config: EnvConfig) -> tuple[list[float], list[float], f
         started = time.perf_counter()
         result = perform(piece, factory, config, seed=seed)
         factors.append(result.steps / config.world.control_hz / (time.perf_counter() - started))
-        report = compare(piece, result.played)
+        report = result.report()
         f1s.append(report.f1)
         maes.append(report.velocity_mae if report.velocity_mae is not None else float("nan"))
     return f1s, maes, statistics.median(factors)
@@ -82,11 +71,11 @@ def main() -> None:
     print(f"{args.piece}: {len(piece)} notes in {len(phrases)} phrases; {args.steps} steps per phrase, {total} end-to-end\n")
     rows = []
     for seed in args.seeds:
-        env = EnvConfig(tactile=args.tactile, actuated=TRAIN_JOINTS)
+        env = EnvConfig(tactile=args.tactile)
         config = TrainConfig(steps=args.steps, seed=seed, sac=SACConfig(exploration_steps=args.exploration_steps), env=env)
         root = Path(args.store) / f"seed{seed}"
         models = Path(args.models) if args.models else root / "phrases"
-        todo, _ = plan_jobs(phrases, config, models, force=False, piece=Path(args.piece).name)
+        todo, _ = plan_jobs(phrase_jobs(phrases, config, models, piece=Path(args.piece).name), force=False)
         started = time.perf_counter()
         run_jobs(todo, config, args.workers, lambda key, progress: None)
         compositional_minutes = (time.perf_counter() - started) / 60
@@ -98,10 +87,9 @@ def main() -> None:
             train_policy(piece.shift(-piece.notes[0].onset), whole, folder, about={"key": "whole-piece", "piece": args.piece})
         end_to_end_minutes = (time.perf_counter() - started) / 60
 
-        play_config = replace(env, tactile_pool=config.sac.tactile_resolution)
-        composed = play(piece, lambda e: CompositionalController(e, phrases, models, fallback=False), play_config)
-        single = play(piece, lambda e: EndToEnd(load_policy(folder, whole, e)), play_config)
-        scripted = play(piece, "scripted", replace(play_config, actuated=("abd", "mcp", "pip", "dip")))
+        composed = play(piece, lambda e: CompositionalController(e, phrases, models, fallback=False), env)
+        single = play(piece, lambda e: load_policy(folder, e), env)  # sees the whole piece's score window, as trained
+        scripted = play(piece, "scripted", env)
         for name, (f1s, maes, factor), minutes in (
             ("compositional", composed, compositional_minutes),
             ("end-to-end", single, end_to_end_minutes),

@@ -21,21 +21,11 @@ from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 from pianobot.agent import store
-from pianobot.agent.sac import SACConfig
+from pianobot.agent.config import SACConfig
+from pianobot.agent.policy import load_policy, make_agent
 from pianobot.env.piano import EnvConfig
-from pianobot.learn.train import (
-    TASK_EVAL_EPISODES,
-    TRAIN_JOINTS,
-    TrainConfig,
-    agent_env_config,
-    best_policy_tensors,
-    config_from_manifest,
-    evaluate,
-    load_policy,
-    make_agent,
-    make_env,
-    train_policy,
-)
+from pianobot.learn.config import TrainConfig, config_from_manifest
+from pianobot.learn.train import TASK_EVAL_EPISODES, best_policy_tensors, evaluate, make_env, train_policy
 
 CHECK_SEED = 20_000
 """Seeds of the held-out check's instances (the training evaluations use 10000, 10001, ...)."""
@@ -68,9 +58,8 @@ def run(task: str, seed: int, args) -> tuple[str, int, dict]:
 
 def check(task: str, folder: Path, manifest: dict, episodes: int) -> dict:
     """The kept policy on ``episodes`` fresh instances of the task."""
-    config = config_from_manifest(manifest)
-    env_config = agent_env_config(config)
-    agent = load_policy(folder, config, make_env(task, env_config))
+    env_config = config_from_manifest(manifest).env
+    agent = load_policy(folder, make_env(task, env_config))
     return {"episodes": episodes, **evaluate(agent, task, env_config, episodes, first_seed=CHECK_SEED)}
 
 
@@ -83,8 +72,8 @@ def check_so_far(task: str, seed: int, args) -> dict | None:
     if found is None or found[1].get("best") is None:
         return None
     tensors, state, _ = found
-    env_config = agent_env_config(config)
-    agent = make_agent(make_env(task, env_config), config)
+    env_config = config.env
+    agent = make_agent(make_env(task, env_config), config.sac)
     agent.load_tensors(best_policy_tensors(tensors), with_training_state=False)
     figures = evaluate(agent, task, env_config, args.check_episodes, first_seed=CHECK_SEED)
     return {"episodes": args.check_episodes, "step": state["best"]["step"], **figures}
@@ -115,7 +104,7 @@ def main() -> None:
     parser.add_argument("--check-episodes", type=int, default=30, help="fresh instances the kept policy plays at the end")
     parser.add_argument("--until-f1", type=float, default=None, help="stop a run once an evaluation reaches this F1")
     parser.add_argument("--tactile", action=argparse.BooleanOptionalAction, default=True)
-    parser.add_argument("--joints", default=",".join(TRAIN_JOINTS), help="finger joints the policy moves")
+    parser.add_argument("--joints", default=",".join(EnvConfig.actuated), help="finger joints the policy moves")
     parser.add_argument("--workers", type=int, default=1)
     parser.add_argument("--store", default="/tmp/pianobot-learn")
     parser.add_argument("--plot", default=None)

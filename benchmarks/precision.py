@@ -16,35 +16,40 @@ from pathlib import Path
 
 import numpy as np
 
-from pianobot.pianist.scripted import ScriptedPianist
-from pianobot.music.metrics import compare
+from pianobot.learn.config import TrainConfig
+from pianobot.learn.train import EVAL_SEED, make_env
 from pianobot.music.instrument import HandSpec
 from pianobot.music.load import LoadOptions, load_part
 from pianobot.music.phrases import split_phrases
-from pianobot.sim.recorder import NoteRecorder
-from pianobot.learn.train import EVAL_SEED, TrainConfig, agent_env_config, make_env, phrase_target
+from pianobot.perform.rollout import rollout
+from pianobot.pianist.scripted import ScriptedPianist
 
 PARTS = ("all", "fingers", "wrist")
 
 
+class NoisyPianist:
+    """The scripted pianist's actions plus N(0, sigma) on every joint, the fingers' or the wrist's."""
+
+    def __init__(self, pianist: ScriptedPianist, sigma: float, part: str, seed: int):
+        self.pianist, self.sigma, self.part = pianist, sigma, part
+        self.rng = np.random.default_rng(seed)
+
+    def reset(self) -> None:
+        self.pianist.reset()
+
+    def act(self, observation: dict) -> np.ndarray:
+        action = self.pianist.act(observation)
+        noise = self.sigma * self.rng.standard_normal(action.shape)
+        if self.part == "fingers":
+            noise[-1] = 0.0  # the last action is the wrist's
+        elif self.part == "wrist":
+            noise[:-1] = 0.0
+        return np.clip(action + noise, -1.0, 1.0)
+
+
 def play(env, pianist: ScriptedPianist, sigma: float, part: str, start: int) -> tuple[float, float, float | None]:
     """One noisy performance: (note F1, step F1, mean onset error of the matched notes, or None)."""
-    rng = np.random.default_rng(start)
-    observation, info = env.reset(seed=EVAL_SEED + start)
-    pianist.reset()
-    recorder = NoteRecorder()
-    while True:
-        action = pianist.act(observation)
-        noise = sigma * rng.standard_normal(action.shape)
-        if part == "fingers":
-            noise[-1] = 0.0  # the last action is the wrist's
-        elif part == "wrist":
-            noise[:-1] = 0.0
-        observation, _, terminated, truncated, step = env.step(np.clip(action + noise, -1.0, 1.0))
-        recorder.add(step["events"], step["fingers"])
-        if terminated or truncated:
-            break
-    report = compare(info["piece"], recorder.piece(end=env.world.time, start=env.score_start))
+    report = rollout(env, NoisyPianist(pianist, sigma, part, seed=start), seed=EVAL_SEED + start).report()
     return report.f1, report.step_f1, report.onset_error_mean
 
 
@@ -55,9 +60,9 @@ def main() -> None:
     parser.add_argument("--starts", type=int, default=4, help="hand starts per setting")
     args = parser.parse_args()
 
-    env_config = agent_env_config(TrainConfig())
+    env_config = TrainConfig().env
     piece = load_part(Path(args.song), LoadOptions(), HandSpec())
-    env = make_env(phrase_target(split_phrases(piece)[0]), env_config)
+    env = make_env(split_phrases(piece)[0].piece(), env_config)
     pianist = ScriptedPianist(env_config)
     print(f"{Path(args.song).name}, first phrase, {args.starts} hand starts; action noise N(0, sigma) on [-1, 1] actions\n")
     print("| noise on | sigma | note F1 (mean) | note F1 per start | step F1 | mean onset error of matched notes (ms) |")

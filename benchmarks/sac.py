@@ -21,7 +21,8 @@ import numpy as np
 import torch
 
 from pianobot.agent.buffer import ReplayBuffer
-from pianobot.agent.sac import SAC, SACConfig, score_size, vector_size
+from pianobot.agent.config import SACConfig
+from pianobot.agent.sac import SAC, score_size, vector_size
 from pianobot.env.piano import EnvConfig, PianoEnv
 from pianobot.music.load import load_piece
 

@@ -218,12 +218,12 @@ def test_train_bad_requests_answer_with_one_line(tmp_path):
     assert_one_line_error(run("train"), "--task")
     assert_one_line_error(run("train", song, "--task", "one-note"), "not both")
     assert_one_line_error(run("train", "--task", "sonata"), "--task sonata")
-    assert_one_line_error(run("train", song, "--steps", "100"), "--steps 100 must exceed --exploration-steps")
-    assert_one_line_error(run("train", song, "--control", "position"), "--control position")
-    assert_one_line_error(run("train", song, "--reward", "cubic"), "--reward cubic")
-    assert_one_line_error(run("train", song, "--explore", "wild"), "--explore wild")
-    assert_one_line_error(run("train", song, "--explore", "scripted", "--control", "torque"), "velocity")
-    assert_one_line_error(run("train", song, "--until-f1", "1.5"), "--until-f1 1.5")
+    assert_one_line_error(run("train", song, "--steps", "100"), "100 steps must exceed the 15000 exploration steps")
+    assert_one_line_error(run("train", song, "--control", "position"), "--control position", "velocity, torque")
+    assert_one_line_error(run("train", song, "--reward", "cubic"), "--reward cubic", "linear, squared, wasserstein")
+    assert_one_line_error(run("train", song, "--explore", "wild"), "exploration must be one of", "'wild'")
+    assert_one_line_error(run("train", song, "--explore", "scripted", "--control", "torque"), "needs velocity control")
+    assert_one_line_error(run("train", song, "--until-f1", "1.5"), "note F1 to stop at", "1.5")
     (tmp_path / "file").write_text("x")
     assert_one_line_error(run("train", song, "--models", tmp_path / "file"), "is a file")
 
@@ -282,21 +282,22 @@ def test_play_sac_composes_trained_and_fallback_phrases(tmp_path):
 
 def test_play_composes_policies_with_different_agent_settings(tmp_path):
     """Each phrase's policy is loaded with its own manifest's agent settings: one that reads the
-    score window (as policies stored before 2026-11-22 do) beside one that does not."""
+    score window (as older policies do) beside one that does not."""
     from dataclasses import replace
 
     from pianobot.agent import store
-    from pianobot.agent.sac import SACConfig
+    from pianobot.agent.config import SACConfig
     from pianobot.env.piano import EnvConfig
     from pianobot.music.phrases import split_phrases
-    from pianobot.learn.train import TrainConfig, phrase_target, train_policy
+    from pianobot.learn.config import TrainConfig
+    from pianobot.learn.train import train_policy
 
     piece = Piece((Note(0.0, 64, 1.0, 80, 3), Note(3.0, 67, 4.0, 70, 4)), bpm=60)
     song = write_midi(piece, tmp_path / "song.mid")
     base = TrainConfig(steps=40, eval_episodes=1, sac=SACConfig(exploration_steps=20, batch_size=16, hidden=16), env=EnvConfig(tactile=False))
     for phrase, reads_score in zip(split_phrases(piece, 1), (True, False)):
         config = replace(base, sac=replace(base.sac, score_input=reads_score))
-        train_policy(phrase_target(phrase), config, store.model_dir(tmp_path / "models", phrase.hash, config))
+        train_policy(phrase.piece(), config, store.model_dir(tmp_path / "models", phrase.hash, config))
     result = run("play", song, "-o", tmp_path / "out.mid", "--models", tmp_path / "models", "--phrase-notes", "1")
     assert result.exit_code == 0, result.output
     report = json.loads((tmp_path / "out.report.json").read_text())
@@ -334,7 +335,7 @@ def test_sections_hand_over_after_the_last_strike():
 
 def test_train_options_reach_the_stored_configuration(tmp_path):
     result = run("train", EXAMPLES / "one-note.mid", "--steps", "50", "--exploration-steps", "25", "--no-tactile",
-                 "--control", "torque", "--reward", "wasserstein", "--no-fingering", "--joints", "mcp,pip",
+                 "--control", "torque", "--reward", "wasserstein", "--no-fingering-gate", "--joints", "mcp,pip",
                  "--explore", "uniform", "--seed", "3", "--models", tmp_path)
     assert result.exit_code == 0, result.output
     config = json.loads(next(tmp_path.glob("*/manifest.json")).read_text())["config"]
@@ -342,6 +343,22 @@ def test_train_options_reach_the_stored_configuration(tmp_path):
     assert config["env"]["world"]["control"] == "torque" and config["env"]["actuated"] == ["mcp", "pip"]
     assert config["env"]["reward"]["kind"] == "wasserstein" and config["env"]["reward"]["fingering_gate"] is False
     assert_one_line_error(run("train", EXAMPLES / "one-note.mid", "--joints", "elbow"), "--joints elbow")
+
+
+def test_train_fingering_options_are_distinct(tmp_path):
+    """--fingering names a PIG file (as for every reading command); the reward's gate is --fingering-gate."""
+    from pianobot.music.pig import write_pig
+
+    piece = Piece((Note(0.0, 64, 1.0, 80, None),), bpm=60)
+    song = write_midi(piece, tmp_path / "song.mid")
+    pig = write_pig(Piece((Note(0.0, 64, 1.0, 80, 4),), bpm=60), tmp_path / "fingers.txt")
+    result = run("train", song, "--fingering", pig, "--no-fingering-gate", "--steps", "40", "--exploration-steps", "20",
+                 "--no-tactile", "--models", tmp_path / "m")
+    assert result.exit_code == 0, result.output
+    manifest = json.loads(next((tmp_path / "m").glob("*/manifest.json")).read_text())
+    assert [n["finger"] for n in manifest["target"]] == [4] and manifest["config"]["env"]["reward"]["fingering_gate"] is False
+    help_text = run("train", "--help").output
+    assert help_text.count("--fingering ") == 1 and "--fingering-gate" in help_text
 
 
 def test_train_workers_train_phrases_in_parallel(tmp_path):

@@ -8,13 +8,17 @@ import pytest
 import torch
 
 from pianobot.agent import store
-from pianobot.agent.sac import SACConfig
+from pianobot.agent.config import SACConfig
 from pianobot.env.piano import EnvConfig
 from pianobot.errors import PianobotError
 from pianobot.learn.explore import Explorer
 from pianobot.music.phrases import split_phrases
 from pianobot.music.piece import Note, Piece
-from pianobot.learn.train import Progress, TrainConfig, load_policy, make_env, plan_jobs, train_policy
+from pianobot.agent.policy import load_policy, make_agent
+from pianobot.learn.config import TrainConfig
+from pianobot.learn.jobs import phrase_jobs, plan_jobs
+from pianobot.learn.train import Progress, make_env, train_policy
+from pianobot.perform.rollout import rollout
 
 PHRASE = Piece((Note(0.0, 64, 0.5, 80, 3),), bpm=60)  # a one-note phrase: 35 steps an episode
 
@@ -41,14 +45,14 @@ def test_training_runs_real_updates_with_finite_losses(tmp_path):
 def test_saved_policy_loads_and_acts_the_same(tmp_path):
     config = small()
     train_policy(PHRASE, config, tmp_path / "m")
-    env = make_env(PHRASE, replace(config.env, tactile_pool=config.sac.tactile_resolution))
+    env = make_env(PHRASE, config.env)
     observation, _ = env.reset(seed=0)
-    first_agent, second_agent = load_policy(tmp_path / "m", config, env), load_policy(tmp_path / "m", config, env)
-    first = first_agent.act(*first_agent.split(observation), deterministic=True)
-    second = second_agent.act(*second_agent.split(observation), deterministic=True)
+    first_agent, second_agent = load_policy(tmp_path / "m", env), load_policy(tmp_path / "m", env)
+    first, second = first_agent.act(observation), second_agent.act(observation)
     assert first.shape == (13,) and np.array_equal(first, second)
     tensors = store.load_tensors(tmp_path / "m" / store.POLICY_FILE)
     assert not any(k.startswith(("critic.", "target.", "optim.")) for k in tensors)  # only what acting needs
+    assert not any(".conv." in k for k in tensors)  # the tactile convolutions once, under encoder.tactile.0
 
 
 def test_interrupted_training_resumes_to_the_same_state(tmp_path):
@@ -70,15 +74,30 @@ def test_skip_if_trained_and_identical_phrases_share_a_policy(tmp_path):
     config = small()
     repeated = Piece(PHRASE.notes + PHRASE.shift(2.0).notes + (Note(4.0, 67, 4.5, 90, 4),), bpm=60)
     phrases = split_phrases(repeated, 1)
-    todo, done = plan_jobs(phrases, config, tmp_path, force=False)
+    todo, done = plan_jobs(phrase_jobs(phrases, config, tmp_path), force=False)
     assert [j.phrases for j in todo] == [[0, 1], [2]] and done == []
     train_policy(todo[0].target, config, todo[0].folder)
-    todo, done = plan_jobs(phrases, config, tmp_path, force=False)
+    todo, done = plan_jobs(phrase_jobs(phrases, config, tmp_path), force=False)
     assert [j.phrases for j in done] == [[0, 1]] and [j.phrases for j in todo] == [[2]]
-    todo, done = plan_jobs(phrases, config, tmp_path, force=True)
+    todo, done = plan_jobs(phrase_jobs(phrases, config, tmp_path), force=True)
     assert len(todo) == 2 and done == []
-    other = plan_jobs(phrases, replace(config, seed=1), tmp_path, force=False)[0]
+    other = plan_jobs(phrase_jobs(phrases, replace(config, seed=1), tmp_path), force=False)[0]
     assert len(other) == 2  # another configuration is another model
+
+
+def test_a_forced_task_run_removes_the_old_policy_first(tmp_path):
+    """Otherwise an interrupted forced run leaves the old policy, and the next plain run skips
+    the task and leaves the new run's checkpoint unused."""
+    from pianobot.learn.jobs import task_job
+
+    config = small(steps=80, checkpoint_every=40)
+    job = task_job("one-note", config, tmp_path)
+    train_policy(job.target, config, job.folder)
+    assert plan_jobs([job], force=False) == ([], [job])
+    todo, _ = plan_jobs([job], force=True)
+    assert todo == [job] and not store.is_trained(job.folder)
+    train_policy(job.target, config, job.folder, stop_after=40)  # the forced run is interrupted
+    assert plan_jobs([job], force=False) == ([job], [])  # the next plain run resumes it
 
 
 def test_corrupt_and_foreign_model_files_are_clear_errors(tmp_path):
@@ -100,10 +119,42 @@ def test_corrupt_and_foreign_model_files_are_clear_errors(tmp_path):
 def test_policy_of_another_shape_is_refused(tmp_path):
     config = small()
     train_policy(PHRASE, config, tmp_path / "m")
-    bigger = replace(config, sac=replace(config.sac, hidden=64))
-    env = make_env(PHRASE, replace(config.env, tactile_pool=config.sac.tactile_resolution))
-    with pytest.raises(PianobotError, match="does not fit this configuration"):
-        load_policy(tmp_path / "m", bigger, env)
+    manifest = json.loads((tmp_path / "m" / store.MANIFEST_FILE).read_text())
+    manifest["config"]["sac"]["hidden"] = 64
+    (tmp_path / "m" / store.MANIFEST_FILE).write_text(json.dumps(manifest))
+    env = make_env(PHRASE, config.env)
+    with pytest.raises(PianobotError, match=r"tensor actor\.net\.0\.bias has shape \(32,\), this agent's is \(64,\)"):
+        load_policy(tmp_path / "m", env)
+
+
+def test_policy_with_bad_values_is_refused(tmp_path):
+    config = small(env=EnvConfig(tactile=False))
+    train_policy(PHRASE, config, tmp_path / "m")
+    env = make_env(PHRASE, config.env)
+    tensors = store.load_tensors(tmp_path / "m" / store.POLICY_FILE)
+    name = "actor.net.2.bias"
+    for bad, message in ((tensors[name].fill_(float("nan")), "NaN"), (tensors[name].to(torch.int64), "torch.int64")):
+        store.save_tensors({**tensors, name: bad}, tmp_path / "m" / store.POLICY_FILE)
+        with pytest.raises(PianobotError, match=f"tensor {name}.*{message}"):
+            load_policy(tmp_path / "m", env)
+
+
+@pytest.mark.parametrize("field, value, message", [
+    ("hidden", "256", "expected a whole number, got str '256'"),
+    ("hidden", 2_000_000, "hidden 2000000 must be between 1 and 4096"),
+    ("hidden", -5, "hidden -5 must be between 1 and 4096"),
+    ("discount", float("nan"), "expected a finite number"),
+    ("colour", 1, "not a field of SACConfig"),
+])
+def test_manifest_values_that_do_not_fit_are_one_line_errors(tmp_path, field, value, message):
+    config = small(env=EnvConfig(tactile=False))
+    train_policy(PHRASE, config, tmp_path / "m")
+    manifest = json.loads((tmp_path / "m" / store.MANIFEST_FILE).read_text())
+    manifest["config"]["sac"][field] = value
+    (tmp_path / "m" / store.MANIFEST_FILE).write_text(json.dumps(manifest))
+    with pytest.raises(PianobotError, match=f"config\\.sac.*{message}") as error:
+        load_policy(tmp_path / "m", make_env(PHRASE, config.env))
+    assert "\n" not in str(error.value)
 
 
 @pytest.mark.parametrize("kind", ["uniform", "repeat", "prior", "scripted"])
@@ -111,16 +162,17 @@ def test_exploration_strategies(kind):
     env = make_env(PHRASE, EnvConfig(tactile=False))
     observation, _ = env.reset(seed=0)
     explorer = Explorer(kind, 13, env.config, np.random.default_rng(0))
-    actions = []
+    actions, teacher = [], []
     for _ in range(300):
-        action = explorer.act(observation)
+        taught = explorer.teach(observation)
+        action = explorer.act(observation, taught)
         actions.append(action)
+        teacher.append(taught if taught is not None else np.zeros(13))
         observation, _, _, truncated, _ = env.step(action)
         if truncated:
             observation, _ = env.reset()
             explorer.reset()
     actions = np.array(actions)
-    assert np.abs(actions).max() <= 1.0
     repeats = np.mean([np.array_equal(a[:-1], b[:-1]) for a, b in zip(actions, actions[1:])])
     wrist_moves = np.mean(actions[:, -1] != 0)
     if kind == "uniform":
@@ -129,6 +181,8 @@ def test_exploration_strategies(kind):
         assert 0.7 < repeats < 0.9
     if kind == "prior":
         assert 0.7 < repeats < 0.9 and wrist_moves < 0.2
+    if kind == "scripted":  # the teacher's action plus a little noise: it follows the teacher
+        assert np.abs(actions - teacher).mean() < 0.2 and repeats == 0
 
 
 def test_an_agent_that_does_not_read_the_score_window_does_not_store_it(tmp_path):
@@ -140,13 +194,10 @@ def test_an_agent_that_does_not_read_the_score_window_does_not_store_it(tmp_path
     space = env.observation_space
     observation, _ = env.reset(seed=0)
     for reads in (False, True):
-        config = replace(small(env=EnvConfig(tactile=False)), sac=replace(small().sac, score_input=reads))
-        from pianobot.learn.train import make_agent
-
-        agent = make_agent(env, config)
+        agent = make_agent(env, replace(small().sac, score_input=reads))
         vector, _ = agent.split(observation)
         assert vector.size == vector_size(space, reads) == vector_size(space) - (0 if reads else score_size(space))
-        assert agent.act(vector, None).shape == (13,)
+        assert agent.sample(vector, None).shape == agent.act(observation).shape == (13,)
     manifest = train_policy(PHRASE, small(env=EnvConfig(tactile=False), steps=80, checkpoint_every=40), tmp_path / "m", stop_after=45)
     assert "interrupted_at" in manifest  # (at the first episode end after 45 steps)
     stored = np.load(next((tmp_path / "m" / store.CHECKPOINT_DIR).rglob("*vector*.npy")), mmap_mode="r")
@@ -156,23 +207,12 @@ def test_an_agent_that_does_not_read_the_score_window_does_not_store_it(tmp_path
 def test_scripted_exploration_mixes_quiet_episodes_that_play_with_noisy_ones():
     """A strike fails with noise much above 0.02: the noise scale is drawn per episode, so the
     buffer gets episodes that play the note (a fixed 0.2 played none) and ones that go astray."""
-    from pianobot.music.metrics import compare
-    from pianobot.sim.recorder import NoteRecorder
-
     env = make_env(PHRASE, EnvConfig(tactile=False))
-    explorer = Explorer("scripted", env.action_space.shape[0], env.config, np.random.default_rng(0), select=env.actuated)
+    explorer = Explorer("scripted", env.action_space.shape[0], env.config, np.random.default_rng(0))
     noises, f1s = [], []
     for episode in range(10):
-        observation, info = env.reset(seed=episode)
-        explorer.reset()
-        recorder = NoteRecorder()
-        while True:
-            observation, _, _, truncated, step = env.step(explorer.act(observation))
-            recorder.add(step["events"], step["fingers"])
-            if truncated:
-                break
+        f1s.append(rollout(env, explorer, seed=episode).report().f1)  # rollout resets the explorer
         noises.append(explorer.noise)
-        f1s.append(compare(info["piece"], recorder.piece(end=env.world.time, start=env.score_start)).f1)
     noises, f1s = np.array(noises), np.array(f1s)
     assert np.all((0.005 <= noises) & (noises <= 0.2)) and noises.min() < 0.02 and noises.max() > 0.05
     assert np.all(f1s[noises < 0.02] == 1.0)
@@ -208,7 +248,7 @@ def test_behaviour_cloning_pulls_the_actor_towards_demonstrations():
         for _ in range(150):
             agent.update(batch)
         with torch.no_grad():
-            mean, _ = agent.actor(agent.critic.encoder(batch["vector"], None), deterministic=True)
+            mean = agent.actor.deterministic(agent.critic.encoder(batch["vector"], None))
         return float((mean.numpy() - target).__abs__().mean())
 
     cloned, unflagged, off = error_after_updates(1.0, 1.0), error_after_updates(1.0, 0.0), error_after_updates(0.0, 1.0)
@@ -282,7 +322,7 @@ def test_training_workers_end_when_their_parent_is_killed(tmp_path):
     script.write_text(
         "import multiprocessing, os, time\n"
         "from concurrent.futures import ProcessPoolExecutor\n"
-        "from pianobot.learn.train import _exit_with_parent\n"
+        "from pianobot.learn.jobs import _exit_with_parent\n"
         "def nap():\n"
         "    print(os.getpid(), flush=True)\n"
         "    time.sleep(60)\n"

@@ -7,71 +7,20 @@ throughout. The critic's two Q heads are one batched network (weights stacked on
 axis, one ``baddbmm`` per layer), so both critics cost one forward and one optimiser step. The encoder belongs to the critic and the actor reads
 its features detached (as in DrQ): one encoder pass per update serves both.
 
-Everything tunable is in :class:`SACConfig`; docs/training.md says where our defaults differ
+Everything tunable is in :class:`~pianobot.agent.config.SACConfig`; docs/training.md says where our defaults differ
 from the paper's and why.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 import torch
 from torch import nn
 from torch.nn import functional as F
 
-
-@dataclass(frozen=True)
-class SACConfig:
-    """Every hyperparameter of the agent, with its default. The single source of defaults."""
-
-    discount: float = 0.9
-    """RoboPianist found 0.8-0.9 better than 0.99 for piano playing (the paper does not say)."""
-    batch_size: int = 256
-    learning_rate: float = 3e-4
-    """Adam, for actor, critic and temperature. The paper's 1e-3 made task-family evaluations
-    swing by 0.3 of F1 from one to the next (docs/benchmarks.md, Learning item 11)."""
-    initial_alpha: float = 0.02
-    """Initial entropy temperature (paper)."""
-    target_entropy_scale: float = 2.5
-    """Target entropy = -scale * action dimensions. A Gaussian's entropy is 1.42 + ln(sigma) per
-    dimension, so 2.5 lets the policy explore with a noise of about 0.02 per action on average:
-    more than that and a strike fails (docs/benchmarks.md, "How precise must a policy be?").
-    The usual 1.0 (sigma near 0.09) failed most of the policy's own training episodes."""
-    tau: float = 0.005
-    """Polyak factor of the target critic."""
-    hidden: int = 256
-    """Width of the MLP layers."""
-    score_input: bool = False
-    """Feed the score window (L keys x 5 channels x lookahead steps, the paper's input) to the
-    networks. Off by default: the finger targets in the observation say, for each finger, where
-    its next key is, how soon and how loud, which is what the window's key-indexed one-hots say
-    in a form that does not depend on the key; with the window a policy learns the keys it has
-    seen one by one (docs/benchmarks.md, Learning item 10). Policies stored before 2026-11-22
-    read it."""
-    score_features: int = 64
-    """Width of the first layer over the (large, sparse) score window, when it is read."""
-    tactile_channels: int = 8
-    """Channels of the tactile convolutions."""
-    tactile_features: int = 32
-    """Features per finger from the tactile encoder."""
-    tactile_resolution: tuple[int, int] | None = (15, 20)
-    """Tactile images are average-pooled to this size before buffer and network (None: full 60 x 80)."""
-    buffer_size: int = 100_000
-    """Replay buffer capacity (transitions)."""
-    update_ratio: float = 1.0
-    """Gradient updates per environment step once learning starts."""
-    exploration_steps: int = 15_000
-    """Environment steps of exploration before learning starts (paper: 15000)."""
-    demo_weight: float = 1.0
-    """Behaviour cloning towards a teacher's actions in the batch (the scripted pianist labels
-    every step when exploring with it, as in DAgger), as in TD3+BC: the actor's loss is
-    ``demo_q_weight * SAC loss / mean |Q| + demo_weight * squared error to the teacher's
-    action``. 0 gives plain SAC. Not in the paper."""
-    demo_q_weight: float = 2.5
-    """TD3+BC's alpha: how much the critic counts against the demonstrations."""
-    log_std_bounds: tuple[float, float] = (-5.0, 2.0)
+from pianobot.agent.config import SACConfig
 
 
 # -- observation layout -----------------------------------------------------------------------
@@ -118,13 +67,12 @@ class Encoder(nn.Module):
         if tactile_shape is not None:
             history, fingers, rows, cols = tactile_shape
             c = config.tactile_channels
-            self.fingers = fingers
-            self.conv = nn.Sequential(
+            conv = nn.Sequential(
                 nn.Conv2d(history, c, 3, stride=2), nn.ReLU(), nn.Conv2d(c, c, 3), nn.ReLU(), nn.Conv2d(c, c, 3), nn.ReLU(), nn.Flatten()
             )
             with torch.no_grad():
-                flat = self.conv(torch.zeros(1, history, rows, cols)).shape[1]
-            self.tactile = nn.Sequential(self.conv, nn.Linear(flat, config.tactile_features), nn.ReLU())
+                flat = conv(torch.zeros(1, history, rows, cols)).shape[1]
+            self.tactile = nn.Sequential(conv, nn.Linear(flat, config.tactile_features), nn.ReLU())
             self.out_dim += fingers * config.tactile_features
 
     def forward(self, vector: torch.Tensor, tactile: torch.Tensor | None) -> torch.Tensor:
@@ -180,15 +128,11 @@ class Actor(nn.Module):
         self.net = nn.Sequential(nn.Linear(feature_dim, h), nn.ReLU(), nn.Linear(h, h), nn.ReLU(), nn.Linear(h, 2 * action_dim))
         self.log_std_bounds = config.log_std_bounds
 
-    def forward(self, features: torch.Tensor, deterministic: bool = False) -> tuple[torch.Tensor, torch.Tensor]:
-        """(action, log-probability); deterministic: (tanh of the mean, zeros). The tanh of the
-        mean of the last call is kept in ``self.mean_action`` (behaviour cloning reads it)."""
+    def forward(self, features: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+        """(sampled action, its log-probability, the deterministic action: tanh of the mean)."""
         mean, log_std = self.net(features).chunk(2, dim=-1)
-        self.mean_action = torch.tanh(mean)
         low, high = self.log_std_bounds
         log_std = low + 0.5 * (high - low) * (torch.tanh(log_std) + 1)
-        if deterministic:
-            return self.mean_action, torch.zeros(mean.shape[0])
         std = log_std.exp()
         noise = torch.randn_like(mean)
         raw = mean + std * noise
@@ -196,7 +140,31 @@ class Actor(nn.Module):
         # log-probability of the squashed sample (change of variables, numerically stable form)
         log_prob = (-0.5 * noise.pow(2) - log_std - 0.5 * math.log(2 * math.pi)).sum(-1)
         log_prob = log_prob - (2 * (math.log(2) - raw - F.softplus(-2 * raw))).sum(-1)
-        return action, log_prob
+        return action, log_prob, torch.tanh(mean)
+
+    def deterministic(self, features: torch.Tensor) -> torch.Tensor:
+        """The policy's action without noise: tanh of the mean."""
+        mean, _ = self.net(features).chunk(2, dim=-1)
+        return torch.tanh(mean)
+
+
+def _load_checked(module: nn.Module, state: dict[str, torch.Tensor], prefix: str) -> None:
+    """``module.load_state_dict(state)``, after checking every tensor's name, shape, type and
+    values, so that a file that does not fit says which tensor and why (ValueError)."""
+    expected = module.state_dict()
+    for name in sorted(set(expected) | set(state)):
+        if name not in state:
+            raise ValueError(f"tensor {prefix}{name} is missing")
+        if name not in expected:
+            raise ValueError(f"tensor {prefix}{name} is not part of this agent")
+        tensor, own = state[name], expected[name]
+        if tuple(tensor.shape) != tuple(own.shape):
+            raise ValueError(f"tensor {prefix}{name} has shape {tuple(tensor.shape)}, this agent's is {tuple(own.shape)}")
+        if tensor.dtype != own.dtype:
+            raise ValueError(f"tensor {prefix}{name} is {tensor.dtype}, this agent's is {own.dtype}")
+        if not bool(torch.isfinite(tensor).all()):
+            raise ValueError(f"tensor {prefix}{name} holds NaN or infinite values")
+    module.load_state_dict(state)
 
 
 # -- the agent --------------------------------------------------------------------------------
@@ -228,12 +196,25 @@ class SAC:
         """:func:`split_observation` as this agent reads observations (with or without the score window)."""
         return split_observation(observation, self.config.score_input)
 
+    # -- acting: the controller interface (reset, act) and training's noisy samples -------------
+    def reset(self) -> None:
+        """Start of an episode: a policy remembers nothing between steps, so nothing to do."""
+
     @torch.no_grad()
-    def act(self, vector: np.ndarray, tactile: np.ndarray | None, deterministic: bool = False) -> np.ndarray:
+    def act(self, observation: dict) -> np.ndarray:
+        """The deterministic action for an observation (evaluation and performance)."""
+        return self.actor.deterministic(self._features(*self.split(observation)))[0].numpy()
+
+    @torch.no_grad()
+    def sample(self, vector: np.ndarray, tactile: np.ndarray | None) -> np.ndarray:
+        """A noisy action from :meth:`split` inputs (training's behaviour policy)."""
+        action, _, _ = self.actor(self._features(vector, tactile))
+        return action[0].numpy()
+
+    def _features(self, vector: np.ndarray, tactile: np.ndarray | None) -> torch.Tensor:
         v = torch.from_numpy(np.asarray(vector, np.float32)).unsqueeze(0)
         t = None if tactile is None else torch.from_numpy(np.asarray(tactile)).unsqueeze(0)
-        action, _ = self.actor(self.critic.encoder(v, t), deterministic)
-        return action[0].numpy()
+        return self.critic.encoder(v, t)
 
     def update(self, batch: dict[str, torch.Tensor]) -> dict[str, float]:
         """One gradient step on critic, actor and temperature from a replay batch."""
@@ -241,7 +222,7 @@ class SAC:
         now = self.critic.encoder(batch["vector"], batch["tactile"])
         with torch.no_grad():
             after = self.critic.encoder(batch["next_vector"], batch["next_tactile"])
-            next_action, next_log_prob = self.actor(after)
+            next_action, next_log_prob, _ = self.actor(after)
             target_features = self.target.encoder(batch["next_vector"], batch["next_tactile"])
             next_q = self.target.q(target_features, next_action).min(dim=0).values - alpha * next_log_prob
             target_q = batch["reward"] + self.config.discount * (1.0 - batch["terminated"]) * next_q
@@ -253,14 +234,14 @@ class SAC:
         self.critic_optimizer.step()
 
         features = now.detach()
-        action, log_prob = self.actor(features)
+        action, log_prob, mean_action = self.actor(features)
         self.critic.layers.requires_grad_(False)  # the actor's loss needs no gradient for the critic
         actor_q = self.critic.q(features, action).min(dim=0).values
         actor_loss = (alpha * log_prob - actor_q).mean()
         demo = batch.get("demo")
         if self.config.demo_weight > 0 and demo is not None and bool(demo.any()):
             # TD3+BC: the critic's term normalised by the scale of Q, plus cloning the demonstrations
-            cloning = ((self.actor.mean_action - batch["expert"]).pow(2).sum(-1) * demo).sum() / demo.sum()
+            cloning = ((mean_action - batch["expert"]).pow(2).sum(-1) * demo).sum() / demo.sum()
             scale = self.config.demo_q_weight / actor_q.abs().mean().detach().clamp(min=1e-3)
             actor_loss = scale * actor_loss + self.config.demo_weight * cloning
         self.actor_optimizer.zero_grad(set_to_none=True)
@@ -274,7 +255,8 @@ class SAC:
         self.alpha_optimizer.step()
 
         with torch.no_grad():
-            torch._foreach_lerp_(self._target_params, self._critic_params, self.config.tau)
+            for target, online in zip(self._target_params, self._critic_params):
+                target.lerp_(online, self.config.tau)
         self.updates += 1
         return {
             "critic_loss": float(critic_loss.detach()),
@@ -300,17 +282,22 @@ class SAC:
         return {k: v.detach().contiguous().clone() for k, v in out.items()}
 
     def load_tensors(self, tensors: dict[str, torch.Tensor], with_training_state: bool = True) -> None:
+        """Load :meth:`tensors`' output; raises ValueError naming the first tensor that does not fit."""
+        # files of manifest format 1 also held the tactile convolutions under encoder.conv.*,
+        # a second name for encoder.tactile.0.*
+        tensors = {k: v for k, v in tensors.items() if "encoder.conv." not in k}
+
         def section(prefix: str) -> dict[str, torch.Tensor]:
             return {k[len(prefix) :]: v for k, v in tensors.items() if k.startswith(prefix)}
 
-        self.actor.load_state_dict(section("actor."))
-        self.critic.encoder.load_state_dict(section("encoder."))
+        _load_checked(self.actor, section("actor."), "actor.")
+        _load_checked(self.critic.encoder, section("encoder."), "encoder.")
         if not with_training_state:
             return
         critic = section("critic.")
         critic.update({f"encoder.{k}": v for k, v in section("encoder.").items()})
-        self.critic.load_state_dict(critic)
-        self.target.load_state_dict(section("target."))
+        _load_checked(self.critic, critic, "critic.")
+        _load_checked(self.target, section("target."), "target.")
         with torch.no_grad():
             self.log_alpha.copy_(tensors["log_alpha"][0])
         for name, optimizer in self._optimizers().items():

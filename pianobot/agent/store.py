@@ -18,7 +18,6 @@ from __future__ import annotations
 import hashlib
 import json
 import shutil
-from dataclasses import asdict
 from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
 
@@ -26,11 +25,21 @@ import torch
 from safetensors import SafetensorError
 from safetensors.torch import load_file, save_file
 
+from pianobot.config import to_dict
 from pianobot.errors import PianobotError
 from pianobot.files import atomic_write, move_into_place, temporary_beside
 
-FORMAT = 1
-"""Version of the manifest layout."""
+FORMAT = 2
+"""Version of the model files (manifest layout and tensor names). Older versions are upgraded on
+reading (:func:`upgrade_manifest`), so every model a user has keeps playing.
+
+- 2: one tactile image size, ``config.env.tactile_pool``; every tensor stored once.
+- 1: the agent's ``config.sac.tactile_resolution`` overrode ``config.env.tactile_pool``; the
+  policy file held the tactile convolutions twice (``encoder.conv.*`` beside
+  ``encoder.tactile.0.*``); manifests written before the finger targets carried velocity and
+  onsets, and before the score window became optional, lack those fields, which then meant
+  ``target_velocity=False``, ``target_onsets=False`` and ``score_input=True``.
+"""
 POLICY_FILE = "policy.safetensors"
 MANIFEST_FILE = "manifest.json"
 CHECKPOINT_DIR = "checkpoint"
@@ -38,7 +47,7 @@ CHECKPOINT_DIR = "checkpoint"
 
 def config_hash(config) -> str:
     """A stable digest of a (dataclass) training configuration."""
-    return hashlib.sha256(json.dumps(asdict(config), sort_keys=True, default=str).encode()).hexdigest()[:12]
+    return hashlib.sha256(json.dumps(to_dict(config), sort_keys=True, default=str).encode()).hexdigest()[:12]
 
 
 def model_dir(root: Path, key: str, config) -> Path:
@@ -83,7 +92,22 @@ def save_policy(folder: Path, tensors: dict[str, torch.Tensor], manifest: dict) 
     atomic_write(folder / MANIFEST_FILE, json.dumps(manifest, indent=2, default=str) + "\n")
 
 
+def upgrade_manifest(manifest: dict) -> dict:
+    """A manifest of any earlier :data:`FORMAT` as the current format says it (a new dict)."""
+    manifest = json.loads(json.dumps(manifest))  # a deep copy
+    if manifest.get("format") == 1:
+        config = manifest["config"]
+        env, sac = config["env"], config["sac"]
+        env["tactile_pool"] = sac.pop("tactile_resolution", env.get("tactile_pool"))
+        env.setdefault("target_velocity", False)
+        env.setdefault("target_onsets", False)
+        sac.setdefault("score_input", True)
+        manifest["format"] = 2
+    return manifest
+
+
 def read_manifest(folder: Path) -> dict:
+    """The manifest of a trained policy, upgraded to the current format."""
     path = folder / MANIFEST_FILE
     try:
         manifest = json.loads(path.read_text())
@@ -91,9 +115,11 @@ def read_manifest(folder: Path) -> dict:
         raise PianobotError(f"{folder} holds no {MANIFEST_FILE}: it is not a trained pianobot policy") from None
     except (OSError, UnicodeDecodeError, json.JSONDecodeError) as e:
         raise PianobotError(f"{path} is not a readable manifest ({e}): retrain the phrase with --force") from None
-    if not isinstance(manifest, dict) or manifest.get("format") != FORMAT:
-        raise PianobotError(f"{path} is not a pianobot model manifest (format {FORMAT}): retrain the phrase with --force")
-    return manifest
+    if not isinstance(manifest, dict) or manifest.get("format") not in range(1, FORMAT + 1):
+        raise PianobotError(f"{path} is not a pianobot model manifest (formats 1 to {FORMAT}): retrain the phrase with --force")
+    if not isinstance(manifest.get("config"), dict) or not all(isinstance(manifest["config"].get(k), dict) for k in ("env", "sac")):
+        raise PianobotError(f"{path} does not record the configuration its policy was trained with: retrain the phrase with --force")
+    return upgrade_manifest(manifest)
 
 
 def is_trained(folder: Path) -> bool:

@@ -1,11 +1,14 @@
 """The `pianobot` command line: thin wrappers that read arguments, call the library and print.
 
 Every :class:`PianobotError` becomes one red line on stderr and exit code 2; warnings about
-repaired input are printed in yellow and do not stop the command.
+repaired input are printed in yellow and do not stop the command. Option defaults come from the
+configuration dataclasses. The simulator, torch and the metrics are imported inside the commands
+that need them, so that `pianobot --version` and `pianobot score` start quickly.
 """
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import json
 import os
@@ -16,34 +19,23 @@ from typing import Optional
 
 import typer
 from rich.console import Console
-from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 
 from pianobot import __version__
-from pianobot.cli import display
+from pianobot.agent.config import SACConfig
 from pianobot.errors import PianobotError, PianobotWarning
 from pianobot.files import atomic_write, check_writable
-from pianobot.music.metrics import DEFAULT_ONSET_TOLERANCE, compare, plot_report
-from pianobot.music import midi_io
-from pianobot.music.instrument import HandSpec, KeyboardSpec, check_playable
-from pianobot.agent import store
-from pianobot.agent.sac import SACConfig
-from pianobot.env.piano import JOINT_KINDS, EnvConfig
+from pianobot.learn.config import TrainConfig
 from pianobot.learn.explore import EXPLORATIONS
-from pianobot.music.tasks import TASKS
-from pianobot.env.rewards import REWARDS, RewardConfig
-from pianobot.sim.world import CONTROL_MODES
-from pianobot.learn.train import TASK_EVAL_EPISODES, TRAIN_JOINTS, PhraseJob, TrainConfig, plan_jobs, run_jobs
-from pianobot.pianist.fingering import ensure_fingering
-from pianobot.music.load import HANDS, LoadOptions, hand_tracks, load_part, load_piece
-from pianobot.music.midi_io import write_midi
-from pianobot.perform.audio import write_wav
-from pianobot.perform.compose import CompositionalController, missing_phrases, trained_split, training_config
-from pianobot.perform.perform import CONTROLLERS, perform, write_video
-from pianobot.sim.hand import HandConfig
-from pianobot.sim.keyboard import KeyboardConfig
-from pianobot.sim.world import WorldConfig
-from pianobot.music.phrases import DEFAULT_MAX_NOTES, split_phrases
+from pianobot.env.piano import EnvConfig
+from pianobot.env.rewards import RewardConfig
+from pianobot.music.instrument import HandSpec, KeyboardSpec
+from pianobot.music.load import LoadOptions
+from pianobot.music.metrics import DEFAULT_ONSET_TOLERANCE
+from pianobot.music.phrases import DEFAULT_MAX_NOTES
 from pianobot.music.piece import Piece, parse_pitch, pitch_name
+from pianobot.music.tasks import TASKS
+from pianobot.perform.controllers import CONTROLLERS
+from pianobot.sim.world import WorldConfig
 
 app = typer.Typer(
     help="Teach a simulated robot hand with touch sensors to play the piano from MIDI files.",
@@ -80,10 +72,20 @@ def friendly(command):
     return wrapper
 
 
+@contextlib.contextmanager
+def option(name: str | None = None, value=None):
+    """Phrase a library's ValueError about an option's value (or about options together: no
+    name) as the command's error."""
+    try:
+        yield
+    except ValueError as e:
+        raise PianobotError(f"{name} {value}: {e}" if name else str(e)) from None
+
+
 # -- shared options --------------------------------------------------------------------------
 Track = typer.Option(None, "--track", help="Read only this track (index or name); default: merge all tracks.")
 Tempo = typer.Option(None, "--tempo", help="Re-time the piece at this constant tempo in bpm (the paper uses 60).")
-Transpose = typer.Option(0, "--transpose", help="Shift every note by this many semitones.")
+Transpose = typer.Option(LoadOptions.transpose, "--transpose", help="Shift every note by this many semitones.")
 Fingering = typer.Option(
     None, "--fingering", help="PIG fingering file for the notes (default: <song>_fingering.txt beside the .mid, if any)."
 )
@@ -97,14 +99,15 @@ PlayPhraseNotes = typer.Option(
     None, "--phrase-notes", help=f"Most notes in one phrase (default: the longest phrases, up to {DEFAULT_MAX_NOTES} notes, whose policies are all trained)."
 )
 Hand = typer.Option(None, "--hand", help="Play one hand's part of a two-hand piece: right or left (tracks named for it, else split by pitch).")
-Split = typer.Option("C4", "--split", help="With --hand and no track named for it: lowest note of the right hand's part.")
+Split = typer.Option(pitch_name(LoadOptions.split), "--split", help="With --hand and no track named for it: lowest note of the right hand's part.")
 Quantize = typer.Option(None, "--quantize", help="Move onsets and offsets to a grid, e.g. 1/16 (for recordings of human players).")
-Refinger = typer.Option(False, "--refinger", help="Replace the file's fingering with the planner's (e.g. human fingering for five fingers).")
+Refinger = typer.Option(LoadOptions.refinger, "--refinger", help="Replace the file's fingering with the planner's (e.g. human fingering for five fingers).")
 
 
-def make_options(track, tempo, transpose, fingering, hand=None, split="C4", quantize=None, refinger=False) -> LoadOptions:
+def make_options(track, tempo, transpose, fingering, hand=None, split=None, quantize=None, refinger=False) -> LoadOptions:
+    split = LoadOptions.split if split is None else parse_pitch(split)
     return LoadOptions(track=track, tempo=tempo, transpose=transpose, fingering=fingering, hand=hand,
-                       split=parse_pitch(split), quantize=quantize, refinger=refinger)
+                       split=split, quantize=quantize, refinger=refinger)
 
 
 def check_midi_output(output: Path, song: Path, what: str) -> None:
@@ -117,6 +120,10 @@ def check_midi_output(output: Path, song: Path, what: str) -> None:
 
 def read_song(song: Path, options: LoadOptions, keyboard: KeyboardSpec, hand: HandSpec) -> Piece:
     """Load a piece for this hand and keyboard; finger it with the planner when it has no fingering."""
+    from pianobot.music.instrument import check_playable
+    from pianobot.music.load import load_part
+    from pianobot.pianist.fingering import ensure_fingering
+
     piece = load_part(song, options, hand)
     piece, plan = ensure_fingering(piece, keyboard, hand, options.refinger)
     if plan is not None:
@@ -156,6 +163,13 @@ def inspect(
     models: Path = typer.Option(Path("models"), "--models", help="Model store whose trained phrase split to show (as play uses it)."),
 ):
     """Explain what a file holds (tracks, hands, pedal, range, polyphony, fingering) and whether the hand can play it."""
+    from pianobot.cli import display
+    from pianobot.music import midi_io
+    from pianobot.music.instrument import check_playable
+    from pianobot.music.load import HANDS, hand_tracks, load_part
+    from pianobot.perform.compose import missing_phrases, trained_split
+    from pianobot.pianist.fingering import ensure_fingering
+
     keyboard, hand_spec = make_instrument(lowest_note, keys, thumb)
     options = make_options(track, tempo, transpose, fingering, hand_part, split, quantize, refinger)
     if song.suffix.lower() != ".txt":
@@ -210,6 +224,12 @@ def finger(
     thumb: bool = Thumb,
 ):
     """Plan a fingering for the robot hand (least wrist travel within its reach) and write it to a MIDI file."""
+    from pianobot.cli import display
+    from pianobot.music.load import load_part
+    from pianobot.music.midi_io import write_midi
+    from pianobot.music.phrases import split_phrases
+    from pianobot.pianist.fingering import ensure_fingering
+
     check_midi_output(output, song, "the fingered piece")
     check_writable(output)
     keyboard, hand_spec = make_instrument(lowest_note, keys, thumb)
@@ -239,6 +259,11 @@ def score(
     notes: bool = typer.Option(True, "--notes/--no-notes", help="Print the per-note table."),
 ):
     """Compare a performance with its reference: note F1, velocity and timing errors, fingering."""
+    from pianobot.cli import display
+    from pianobot.music import midi_io
+    from pianobot.music.load import load_piece
+    from pianobot.music.metrics import compare, plot_report
+
     if not 0 < onset_tolerance <= 1:
         raise PianobotError(f"--onset-tolerance {onset_tolerance}: give seconds between 0 and 1, e.g. 0.05")
     if plot is not None and plot.suffix.lower() != ".png":
@@ -264,7 +289,7 @@ def score(
 def play(
     song: Path = typer.Argument(..., help="The piece to play, a .mid file with fingering."),
     output: Path = typer.Option(..., "--output", "-o", help="Write what the simulated piano sounded to this .mid file."),
-    controller: str = typer.Option("sac", "--controller", help="Who plays: 'sac' (the trained phrase policies), 'scripted' (the hand-written pianist) or 'random'."),
+    controller: str = typer.Option(CONTROLLERS[0], "--controller", help="Who plays: 'sac' (the trained phrase policies), 'scripted' (the hand-written pianist) or 'random'."),
     models: Path = typer.Option(Path("models"), "--models", help="Folder of the model store (for --controller sac)."),
     fallback: Optional[str] = typer.Option(None, "--fallback", help="'scripted': play phrases that have no trained policy with the scripted pianist."),
     phrase_notes: Optional[int] = PlayPhraseNotes,
@@ -285,6 +310,18 @@ def play(
     thumb: bool = Thumb,
 ):
     """Perform a piece in the simulator; write the played notes (velocities, fingers) and a velocity-error report."""
+    from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
+
+    from pianobot.cli import display
+    from pianobot.music.metrics import compare
+    from pianobot.music.midi_io import write_midi
+    from pianobot.music.phrases import split_phrases
+    from pianobot.perform.audio import write_wav
+    from pianobot.perform.compose import CompositionalController, missing_phrases, shared_env_config, trained_split
+    from pianobot.perform.perform import PLAY_CONFIG, perform, write_video
+    from pianobot.sim.hand import HandConfig
+    from pianobot.sim.keyboard import KeyboardConfig
+
     check_midi_output(output, song, "the performance")
     report_path = output.with_suffix(".report.json")
     for target in (output, report_path, video, wav):
@@ -303,10 +340,13 @@ def play(
     keyboard, hand = make_instrument(lowest_note, keys, thumb)
     piece = read_song(song, make_options(track, tempo, transpose, fingering, hand_part, split, quantize, refinger), keyboard, hand)
     world = WorldConfig(keyboard=KeyboardConfig(spec=keyboard), hand=HandConfig(spec=hand), gui=gui)
-    config = EnvConfig(world=world, tactile=False, actuated=JOINT_KINDS)  # the scripted pianist moves every joint
+    config = replace(PLAY_CONFIG, world=world)
     sources: dict = {}
     who = controller
     if controller == "sac":
+        import torch
+
+        torch.set_num_threads(1)  # batch-1 inference: more threads only spin against other work on the cores
         phrases = trained_split(models, piece, phrase_notes)
         missing = missing_phrases(models, phrases)
         if phrase_notes is None and phrases != split_phrases(piece, DEFAULT_MAX_NOTES):
@@ -319,10 +359,10 @@ def play(
                 f"train it with `pianobot train {song}` (same reading options), add --fallback scripted, "
                 f"or play with --controller scripted"
             )
-        trained = training_config(models, phrases)
+        trained = shared_env_config(models, phrases)
         if trained is not None:
-            config = replace(trained.env, tactile_pool=trained.sac.tactile_resolution, world=replace(trained.env.world, gui=gui))
-            if trained.env.world.keyboard.spec != keyboard or trained.env.world.hand.spec != hand:
+            config = replace(trained, world=replace(trained.world, gui=gui))
+            if trained.world.keyboard.spec != keyboard or trained.world.hand.spec != hand:
                 raise PianobotError(f"the policies in {models} were trained for another keyboard or hand: use the same --lowest-note/--keys/--thumb")
         if missing and config.world.control != "velocity":
             raise PianobotError("--fallback scripted needs policies trained with --control velocity")
@@ -335,7 +375,7 @@ def play(
         task = bar.add_task(f"playing {song.name}", total=None)
         result = perform(piece, who, config, seed=seed, video=video is not None,
                          on_step=lambda done, total: bar.update(task, completed=done, total=total))
-    report = compare(piece, result.played)
+    report = result.report()
     write_midi(result.played, output, name=f"pianobot {controller}: {song.stem}")
     extra = {"phrases": {str(k): v for k, v in sources.items()}} if sources else {}
     atomic_write(report_path, json.dumps({"controller": controller, "seed": seed, **extra, **report.to_dict()}, indent=2) + "\n")
@@ -359,16 +399,16 @@ def train(
     task: Optional[str] = typer.Option(None, "--task", help=f"Train on one of the paper's task families instead: {', '.join(TASKS)}."),
     steps: int = typer.Option(TrainConfig.steps, "--steps", help="Environment steps per phrase, exploration included."),
     seed: int = typer.Option(TrainConfig.seed, "--seed", help="Seed of the simulation, the exploration and the networks."),
-    until_f1: Optional[float] = typer.Option(None, "--until-f1", help="Stop a phrase early once an evaluation reaches this note F1 (e.g. 0.95)."),
+    until_f1: Optional[float] = typer.Option(TrainConfig.until_f1, "--until-f1", help="Stop a phrase early once an evaluation reaches this note F1 (e.g. 0.95)."),
     workers: int = typer.Option(1, "--workers", help="Train this many phrases at once, in separate processes."),
     threads: int = typer.Option(1, "--threads", help="Torch threads per training process (workers x threads should not exceed the cores)."),
     control: str = typer.Option(WorldConfig.control, "--control", help="Finger control: velocity or torque."),
     reward: str = typer.Option(RewardConfig.kind, "--reward", help="Reward: linear, squared or wasserstein."),
     explore: str = typer.Option(TrainConfig.explore, "--explore", help=f"Exploration before learning: {', '.join(EXPLORATIONS)}."),
     exploration_steps: int = typer.Option(SACConfig.exploration_steps, "--exploration-steps", help="Steps of exploration before learning starts."),
-    tactile: bool = typer.Option(True, "--tactile/--no-tactile", help="Observe the fingertips' tactile images."),
-    joints: str = typer.Option(",".join(TRAIN_JOINTS), "--joints", help="Finger joints the policy moves, from abd,mcp,pip,dip; the others hold still."),
-    fingering_gate: bool = typer.Option(RewardConfig.fingering_gate, "--fingering/--no-fingering", help="Credit a key only when the score's finger pressed it."),
+    tactile: bool = typer.Option(EnvConfig.tactile, "--tactile/--no-tactile", help="Observe the fingertips' tactile images."),
+    joints: str = typer.Option(",".join(EnvConfig.actuated), "--joints", help="Finger joints the policy moves, from abd,mcp,pip,dip; the others hold still."),
+    fingering_gate: bool = typer.Option(RewardConfig.fingering_gate, "--fingering-gate/--no-fingering-gate", help="Reward a key only when the score's finger pressed it (the paper's fingering indicator)."),
     force: bool = typer.Option(False, "--force", help="Retrain phrases that already have a stored policy."),
     models: Path = typer.Option(Path("models"), "--models", help="Folder of the model store."),
     track: Optional[str] = Track,
@@ -385,44 +425,43 @@ def train(
     phrase_notes: int = PhraseNotes,
 ):
     """Train one Soft Actor-Critic policy per phrase of a piece (or one for a task family) and store them."""
+    from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
+
+    from pianobot.agent import store
+    from pianobot.cli import display
+    from pianobot.learn.jobs import phrase_jobs, plan_jobs, run_jobs, task_job
+    from pianobot.learn.train import TASK_EVAL_EPISODES
+    from pianobot.music.phrases import split_phrases
+    from pianobot.sim.hand import HandConfig
+    from pianobot.sim.keyboard import KeyboardConfig
+
     if (song is None) == (task is None):
         raise PianobotError("give a .mid file to train on, or --task NAME (not both)")
     if task is not None and task not in TASKS:
         raise PianobotError(f"--task {task}: choose one of {', '.join(TASKS)}")
-    if control not in CONTROL_MODES:
-        raise PianobotError(f"--control {control}: choose velocity or torque")
-    if reward not in REWARDS:
-        raise PianobotError(f"--reward {reward}: choose one of {', '.join(REWARDS)}")
-    if explore not in EXPLORATIONS:
-        raise PianobotError(f"--explore {explore}: choose one of {', '.join(EXPLORATIONS)}")
-    if explore == "scripted" and control != "velocity":
-        raise PianobotError("--explore scripted needs --control velocity (the scripted pianist drives joint speeds)")
-    if not 0 <= exploration_steps < steps:
-        raise PianobotError(f"--steps {steps} must exceed --exploration-steps {exploration_steps}, or nothing is learnt")
-    actuated = tuple(j.strip() for j in joints.split(",") if j.strip())
-    if not actuated or set(actuated) - set(JOINT_KINDS):
-        raise PianobotError(f"--joints {joints}: name finger joints from {','.join(JOINT_KINDS)}, e.g. mcp,pip")
-    if until_f1 is not None and not 0.0 < until_f1 <= 1.0:
-        raise PianobotError(f"--until-f1 {until_f1}: give a note F1 between 0 and 1, e.g. 0.95")
     if workers < 1 or threads < 1:
         raise PianobotError(f"--workers {workers} --threads {threads}: give 1 or more of each")
     if models.exists() and not models.is_dir():
         raise PianobotError(f"--models {models} is a file: give a folder")
     keyboard, hand = make_instrument(lowest_note, keys, thumb)
-    world = WorldConfig(keyboard=KeyboardConfig(spec=keyboard), hand=HandConfig(spec=hand), control=control)
-    env = EnvConfig(world=world, reward=RewardConfig(kind=reward, fingering_gate=fingering_gate), tactile=tactile,
-                    actuated=tuple(j for j in JOINT_KINDS if j in actuated))
-    config = TrainConfig(steps=steps, seed=seed, explore=explore, until_f1=until_f1, sac=SACConfig(exploration_steps=exploration_steps), env=env,
-                         eval_episodes=TASK_EVAL_EPISODES if task is not None else TrainConfig.eval_episodes)
+    with option("--control", control):
+        world = WorldConfig(keyboard=KeyboardConfig(spec=keyboard), hand=HandConfig(spec=hand), control=control)
+    with option("--reward", reward):
+        rewards = RewardConfig(kind=reward, fingering_gate=fingering_gate)
+    with option("--joints", joints):
+        env = EnvConfig(world=world, reward=rewards, tactile=tactile, actuated=tuple(j.strip() for j in joints.split(",") if j.strip()))
+    with option("--exploration-steps", exploration_steps):
+        sac = SACConfig(exploration_steps=exploration_steps)
+    with option():
+        config = TrainConfig(steps=steps, seed=seed, explore=explore, until_f1=until_f1, sac=sac, env=env,
+                             eval_episodes=TASK_EVAL_EPISODES if task is not None else TrainConfig.eval_episodes)
     if task is not None:
-        jobs = [PhraseJob(f"task-{task}", task, store.model_dir(models, f"task-{task}", config), [0], f"task {task}")]
-        todo = [j for j in jobs if force or not store.is_trained(j.folder)]
-        done = [j for j in jobs if j not in todo]
+        todo, done = plan_jobs([task_job(task, config, models)], force)
         label = f"task {task}"
     else:
         piece = read_song(song, make_options(track, tempo, transpose, fingering, hand_part, split, quantize, refinger), keyboard, hand)
         phrases = split_phrases(piece, phrase_notes)
-        todo, done = plan_jobs(phrases, config, models, force, piece=song.name)
+        todo, done = plan_jobs(phrase_jobs(phrases, config, models, piece=song.name), force)
         label = f"{song.name}: {len(phrases)} phrases"
     models.mkdir(parents=True, exist_ok=True)
     for job in done:

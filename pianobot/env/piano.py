@@ -2,15 +2,25 @@
 
 ``step()`` acts on the physics, then observes, then computes the reward. The episode lasts a
 lead-in (the hand gets ready), the phrase, and a short tail; its end is ``truncated``, never
-``terminated``: nothing about the state makes the future worthless.
+``terminated``: nothing about the state makes the future worthless. ``info`` carries the reward
+terms, the key events with the finger that struck each key, and the keys to press now.
 
-Observations (a dict, see docs/environment.md): the score's L x (2+F) matrix for the current
-step and ``lookahead`` following steps; the fingertips' tactile images of the last two steps
-(uint8, pooled by default); wrist position and speed; finger joint angles and speeds; for each
-finger, where the next key it has to play lies relative to its fingertip, how soon and how loud
-(our addition, see docs/training.md); and, only when asked for (the paper's ablation), key angles and speeds.
+Observations (a dict; docs/simulator.md describes each): the score's L x (2+F) matrix for the
+current step and ``lookahead`` following steps; the fingertips' tactile images of the last two
+steps (uint8, pooled to ``tactile_pool``); wrist position and speed; finger joint angles and
+speeds; for each finger, where the next key it has to play lies relative to its fingertip, how
+soon, how loud, and how much longer to hold the key it holds (:func:`finger_targets`, not in the
+paper); and, only when asked for (the paper's ablation), key angles and speeds.
 Actions: the actuated finger joints (of abduction, MCP, PIP, DIP per finger) then the wrist,
 each in [-1, 1].
+
+Version history (ids ``pianobot/Piano-v0``, ``pianobot/OneNote-v0``, ...; a stored model
+records the :class:`EnvConfig` it was trained with, and :data:`pianobot.agent.store.FORMAT`
+says how older records are read):
+
+- v0: the finger targets carry the next note's velocity (``target_velocity``) and point at
+  note onsets, with the time left to hold a held key (``target_onsets``); both can be turned
+  off to reproduce the observations of policies trained before them.
 """
 
 from __future__ import annotations
@@ -103,6 +113,13 @@ def finger_targets(
     return np.clip(targets, -SPEED_BOUND, SPEED_BOUND)
 
 
+def actuated_indices(config: "EnvConfig") -> np.ndarray:
+    """Where the action's values go in the full command (every finger joint, then the wrist):
+    the actuated joints of each finger in :data:`JOINT_KINDS` order, then the wrist."""
+    joints = len(config.world.hand.spec.fingers) * len(JOINT_KINDS)
+    return np.array([i for i in range(joints) if JOINT_KINDS[i % len(JOINT_KINDS)] in config.actuated] + [joints])
+
+
 @dataclass(frozen=True)
 class EnvConfig:
     """Everything that shapes an episode, its observations and its reward."""
@@ -111,12 +128,13 @@ class EnvConfig:
     """Keyboard, hand, physics rates and control mode."""
     reward: RewardConfig = field(default_factory=RewardConfig)
     lookahead: int = 10
-    """Score steps observed after the current one (10 = 0.5 s at 20 Hz)."""
+    """Score steps observed after the current one (10 = 0.5 s at the default 20 Hz)."""
     tactile: bool = True
     """Observe the fingertips' tactile images."""
     tactile_sensor: TactileConfig = field(default_factory=TactileConfig)
     tactile_pool: tuple[int, int] | None = (15, 20)
-    """Average-pool the 60 x 80 images to this size (None keeps full resolution)."""
+    """Average-pool the 60 x 80 images to this size (None keeps full resolution): what the agent
+    sees, stores in its replay buffer and feeds its convolutions."""
     key_observations: bool = False
     """Also observe key angles and speeds (privileged; the paper's ablation)."""
     lead_in: float = 1.0
@@ -126,18 +144,27 @@ class EnvConfig:
     target_observations: bool = True
     """Observe each finger's offset to the next key it plays (not in the paper; see docs/training.md)."""
     target_velocity: bool = True
-    """With the target observations, also the velocity that key is to sound at (policies trained
-    before 2026-11-22 were trained without it)."""
+    """With the target observations, also the velocity that key is to sound at."""
     target_onsets: bool = True
     """With the target observations, point each finger at its next note *onset* and say how much
-    longer it is to hold the key it holds (policies trained before 2026-11-22 saw a held note as
-    one to strike now, and missed repeated notes)."""
+    longer it is to hold the key it holds (without it a held note reads as one to strike now,
+    and repeated notes cannot be told apart)."""
     random_start: bool = True
     """Start the wrist at a random position along the keyboard (else at its centre)."""
     actuated: tuple[str, ...] = JOINT_KINDS
-    """Finger joints the policy moves; the others hold their starting angle (the paper froze the
-    joints not crucial to a task). E.g. ("mcp", "pip") leaves 2 per finger plus the wrist, the
-    training default (:data:`pianobot.learn.train.TRAIN_JOINTS`)."""
+    """Finger joints the policy moves, all four by default (abduction is needed for chords and
+    for keys beside the wrist's line); the others hold their starting angle, as the paper froze
+    the joints not crucial to a task: ("mcp", "pip") leaves 2 per finger plus the wrist."""
+
+    def __post_init__(self) -> None:
+        if not self.actuated or set(self.actuated) - set(JOINT_KINDS) or len(set(self.actuated)) < len(self.actuated):
+            raise ValueError(f"actuated joints must be distinct names from {', '.join(JOINT_KINDS)}; got {', '.join(self.actuated) or 'none'}")
+        if self.lookahead < 0 or self.lead_in < 0 or self.tail < 0:
+            raise ValueError("lookahead, lead_in and tail cannot be negative")
+        if self.tactile_pool is not None:
+            (rows, cols), sensor = self.tactile_pool, self.tactile_sensor
+            if not (rows >= 1 and cols >= 1 and sensor.rows % rows == 0 and sensor.cols % cols == 0):
+                raise ValueError(f"tactile_pool {rows} x {cols} must divide the sensor's {sensor.rows} x {sensor.cols} images")
 
     @property
     def score_spec(self) -> ScoreSpec:
@@ -147,7 +174,7 @@ class EnvConfig:
 class PianoEnv(gym.Env):
     """The hand plays ``piece`` (a phrase), or a fresh random instance of ``task`` at each reset."""
 
-    metadata = {"render_modes": ["rgb_array"], "render_fps": 20}
+    metadata = {"render_modes": ["rgb_array"], "render_fps": WorldConfig.control_hz}
 
     def __init__(
         self,
@@ -193,10 +220,7 @@ class PianoEnv(gym.Env):
             obs["keys"] = spaces.Box(-SPEED_BOUND, SPEED_BOUND, (keys,), np.float32)
             obs["key_velocities"] = spaces.Box(-SPEED_BOUND, SPEED_BOUND, (keys,), np.float32)
         self.observation_space = spaces.Dict(obs)
-        unknown = set(config.actuated) - set(JOINT_KINDS)
-        if unknown or not config.actuated:
-            raise ValueError(f"actuated joints must be among {JOINT_KINDS}; got {config.actuated}")
-        self.actuated = np.array([i for i in range(self.n_joints) if JOINT_KINDS[i % 4] in config.actuated] + [self.n_joints])
+        self.actuated = actuated_indices(config)
         self.action_space = spaces.Box(-1.0, 1.0, (len(self.actuated),), np.float32)
         if piece is not None:
             self._set_piece(piece)

@@ -28,16 +28,12 @@ SCRIPTED_NOISE = (0.005, 0.2)
 class Explorer:
     """``reset()`` at each episode start, then ``act(observation)``."""
 
-    def __init__(self, kind: str, action_size: int, config: EnvConfig, rng: np.random.Generator, select: np.ndarray | None = None):
-        """``select``: which of the scripted pianist's full actions the policy's action holds (frozen joints left out)."""
+    def __init__(self, kind: str, action_size: int, config: EnvConfig, rng: np.random.Generator):
         if kind not in EXPLORATIONS:
             raise ValueError(f"exploration must be one of {', '.join(EXPLORATIONS)}; got {kind!r}")
-        if kind == "scripted" and config.world.control != "velocity":
-            raise ValueError("--explore scripted needs --control velocity (the scripted pianist drives joint speeds)")
         self.kind, self.size, self.rng = kind, action_size, rng
-        self.pianist = ScriptedPianist(config) if kind == "scripted" else None
+        self.pianist = ScriptedPianist(config) if kind == "scripted" else None  # needs velocity control
         self.previous: np.ndarray | None = None
-        self.select = select
         self.noise = 0.0
 
     def reset(self) -> None:
@@ -52,8 +48,7 @@ class Explorer:
         it remembers the previous score row), or None when exploring without it."""
         if self.pianist is None:
             return None
-        action = self.pianist.act(observation)
-        return (action if self.select is None else action[self.select]).astype(np.float32)
+        return self.pianist.act(observation)
 
     def act(self, observation: dict, taught: np.ndarray | None = None) -> np.ndarray:
         """An exploration action; ``taught`` is this step's :meth:`teach` result, if already asked."""

@@ -103,7 +103,7 @@ def _arrays(piece: Piece) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return intervals, pitches, velocities
 
 
-def key_press_f1(reference: Piece, played: Piece, control_hz: float = 20.0) -> tuple[float, float, float]:
+def key_press_f1(reference: Piece, played: Piece, control_hz: float = ScoreSpec.control_hz) -> tuple[float, float, float]:
     """RoboPianist's per-step key-press precision, recall and F1, averaged over control steps."""
     spec = ScoreSpec(control_hz=control_hz)
     spans = {"ref": note_steps(reference, spec), "out": note_steps(played, spec)}
@@ -129,7 +129,7 @@ def compare(
     reference: Piece,
     played: Piece,
     onset_tolerance: float = DEFAULT_ONSET_TOLERANCE,
-    control_hz: float = 20.0,
+    control_hz: float = ScoreSpec.control_hz,
 ) -> Report:
     """Score ``played`` against ``reference``."""
     ref_int, ref_hz, ref_vel = _arrays(reference)

@@ -19,14 +19,15 @@ from pathlib import Path
 import numpy as np
 
 from pianobot.agent import store
-from pianobot.pianist.scripted import ScriptedPianist
-from pianobot.env.piano import PianoEnv
+from pianobot.agent.policy import load_policy, policy_configs
+from pianobot.env.piano import EnvConfig, PianoEnv
 from pianobot.errors import PianobotError
 from pianobot.music.metrics import DEFAULT_ONSET_TOLERANCE
 from pianobot.music.phrases import DEFAULT_MAX_NOTES, Phrase, split_phrases
 from pianobot.music.piece import Piece
 from pianobot.music.tensor import score_tensor
-from pianobot.learn.train import TrainConfig, config_from_manifest, load_policy, phrase_target
+from pianobot.perform.rollout import Controller
+from pianobot.pianist.scripted import ScriptedPianist
 
 
 @dataclass
@@ -38,7 +39,7 @@ class Section:
     """Env step at which this phrase's controller takes over."""
     score: np.ndarray
     """The whole performance's score timeline with only this phrase's notes."""
-    controller: object
+    controller: Controller
     source: str
     """'policy <folder name>' or 'scripted (fallback)'."""
 
@@ -70,19 +71,14 @@ def trained_split(models: Path, piece: Piece, phrase_notes: int | None) -> list[
     return split_phrases(piece, DEFAULT_MAX_NOTES)
 
 
-def training_config(models: Path, phrases: list[Phrase]) -> TrainConfig | None:
-    """The configuration the stored policies share (None when no phrase has one)."""
-    configs = []
-    for phrase in phrases:
-        folder = find_policy(models, phrase)
-        if folder is not None:
-            configs.append(config_from_manifest(store.read_manifest(folder)))
-    if not configs:
-        return None
-    env_configs = {repr(c.env) + repr(c.sac.tactile_resolution) for c in configs}
-    if len(env_configs) > 1:
+def shared_env_config(models: Path, phrases: list[Phrase]) -> EnvConfig | None:
+    """The environment the stored policies of these phrases were trained in (None when no
+    phrase has a policy); they must share one, since they play in one simulation."""
+    folders = [find_policy(models, phrase) for phrase in phrases]
+    configs = {policy_configs(folder)[0] for folder in folders if folder is not None}
+    if len(configs) > 1:
         raise PianobotError(f"the policies in {models} for this piece were trained with different environments: retrain them with one set of options")
-    return configs[0]
+    return configs.pop() if configs else None
 
 
 class CompositionalController:
@@ -102,13 +98,12 @@ class CompositionalController:
                 latest = max(start - 1, previous_last_onset + 1)
                 first = max(min(previous_last_onset + 1 + grace, latest), start - lead)
             timeline = np.zeros_like(env.score)
-            tensor = score_tensor(phrase_target(phrase), spec)
+            tensor = score_tensor(phrase.piece(), spec)
             end = min(start + len(tensor), len(timeline))
             timeline[start:end] = tensor[: end - start]
             folder = find_policy(models, phrase)
             if folder is not None:
-                own = config_from_manifest(store.read_manifest(folder))  # its agent's settings (the env is shared)
-                controller, source = load_policy(folder, own, env), f"policy {folder.name}"
+                controller, source = load_policy(folder, env), f"policy {folder.name}"
             elif fallback:
                 controller, source = ScriptedPianist(env.config), "scripted (fallback)"
             else:  # checked before simulating; kept as a guard
@@ -117,14 +112,12 @@ class CompositionalController:
             previous_last_onset = lead + spec.step_of(phrase.notes[-1].onset)
         self.env = env
         self.lookahead = env.config.lookahead
-        self.actuated = env.actuated
         self.step = 0
 
     def reset(self) -> None:
         self.step = 0
         for section in self.sections:
-            if isinstance(section.controller, ScriptedPianist):
-                section.controller.reset()
+            section.controller.reset()
 
     def section_at(self, step: int) -> Section:
         active = self.sections[0]
@@ -140,6 +133,4 @@ class CompositionalController:
         if "targets" in observation:  # what the phrase's own window asks of each finger
             observation["targets"] = self.env.targets(window, section.score)
         self.step += 1
-        if isinstance(section.controller, ScriptedPianist):
-            return section.controller.act(observation)[self.actuated]  # the joints the policies move
-        return section.controller.act(*section.controller.split(observation), deterministic=True)
+        return section.controller.act(observation)

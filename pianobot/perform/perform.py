@@ -1,61 +1,35 @@
 """Performing a whole piece in one continuous simulation and recording what the piano sounded.
 
-:func:`perform` runs a controller (anything with ``reset()`` and ``act(observation)``) through
-the piece from the first step to the last, collects the keyboard's note events with the finger
-that touched each key, and returns them as a :class:`~pianobot.music.piece.Piece` beside the
-score it was asked to play.
+:func:`perform` runs a controller through the piece from the first step to the last (one
+:func:`~pianobot.perform.rollout.rollout`) and returns what was played as a
+:class:`~pianobot.music.piece.Piece`; :func:`write_video` encodes the frames.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable, Protocol
+from typing import Callable
 
 import numpy as np
 
-from pianobot.pianist.scripted import RandomController, ScriptedPianist
-from pianobot.env.piano import JOINT_KINDS, EnvConfig, PianoEnv
-from pianobot.errors import PianobotError
+from pianobot.env.piano import EnvConfig, PianoEnv
 from pianobot.files import check_writable, move_into_place, temporary_beside
 from pianobot.music.piece import Piece
-from pianobot.sim.recorder import NoteRecorder
+from pianobot.perform.controllers import make_controller
+from pianobot.perform.rollout import Controller, Rollout, rollout
 
-CONTROLLERS = ("sac", "scripted", "random")
-
-
-class Controller(Protocol):
-    def reset(self) -> None: ...
-
-    def act(self, observation: dict) -> np.ndarray: ...
-
-
-@dataclass
-class Performance:
-    """What was played, and the frames of the video if one was asked for."""
-
-    played: Piece
-    steps: int
-    frames: list[np.ndarray] | None = None
-
-
-def make_controller(name: str, env: PianoEnv, seed: int | None = None) -> Controller:
-    """The scripted or random controller (``sac`` needs the model store: see pianobot.perform.compose)."""
-    if name == "scripted":
-        return ScriptedPianist(env.config)
-    if name == "random":
-        return RandomController(env.action_space.shape[0], seed=seed)
-    raise PianobotError(f"--controller {name}: choose one of {', '.join(CONTROLLERS)}")
+PLAY_CONFIG = EnvConfig(tactile=False)
+"""The environment for controllers that do not read touch (the scripted pianist, random actions)."""
 
 
 def perform(
     piece: Piece,
     controller: str | Callable[[PianoEnv], Controller] = "scripted",
-    config: EnvConfig = EnvConfig(tactile=False, actuated=JOINT_KINDS),
+    config: EnvConfig = PLAY_CONFIG,
     seed: int = 0,
     video: bool = False,
     on_step: Callable[[int, int], None] | None = None,
-) -> Performance:
+) -> Rollout:
     """Play ``piece`` from start to end in one continuous simulation.
 
     ``controller`` is 'scripted', 'random', or a function that makes a controller for the
@@ -64,23 +38,7 @@ def perform(
     env = PianoEnv(piece=piece, config=config)
     try:
         agent = controller(env) if callable(controller) else make_controller(controller, env, seed)
-        observation, _ = env.reset(seed=seed)
-        agent.reset()
-        recorder = NoteRecorder()
-        frames = [env.render()] if video else None
-        steps = 0
-        while True:
-            observation, _, terminated, truncated, info = env.step(agent.act(observation))
-            recorder.add(info["events"], info["fingers"])
-            steps += 1
-            if frames is not None:
-                frames.append(env.render())
-            if on_step is not None:
-                on_step(steps, env.horizon)
-            if terminated or truncated:
-                break
-        played = recorder.piece(end=env.world.time, start=env.score_start, bpm=piece.bpm)
-        return Performance(played, steps, frames)
+        return rollout(env, agent, seed=seed, video=video, on_step=on_step)
     finally:
         env.close()
 

@@ -1,7 +1,7 @@
-"""Controllers with the interface a trained policy has: ``reset()``, then ``act(observation) -> action``.
+"""The scripted pianist: a hand-written controller with the interface a trained policy has
+(``reset()``, then ``act(observation) -> action``).
 
-- :class:`RandomController`: uniform random actions (the paper's random baseline).
-- :class:`ScriptedPianist`: plays from the score window in the observation with human priors:
+It plays from the score window in the observation with human priors:
   the wrist slides so the assigned fingers can reach their keys, abduction puts each fingertip
   over its key, and the assigned finger strikes at the speed that the keyboard's velocity
   curve turns into the target velocity, starting early enough to land on the onset.
@@ -17,24 +17,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pianobot.env.piano import EnvConfig
+from pianobot.env.piano import EnvConfig, actuated_indices
 from pianobot.music.tensor import FINGER, NOTE, VELOCITY
 from pianobot.sim.hand import FINGER_BASE_X, PREFERRED_TILT, TILT_RANGE, finger_ik, lowest_point_in_finger_plane
 from pianobot.sim.keyboard import BLACK_STRIKE_FROM_FRONT, WHITE_STRIKE_FROM_FRONT, key_boxes
-
-
-class RandomController:
-    """Uniform random actions in [-1, 1]."""
-
-    def __init__(self, action_size: int, seed: int | None = None):
-        self.action_size = action_size
-        self.rng = np.random.default_rng(seed)
-
-    def reset(self) -> None:
-        pass
-
-    def act(self, observation: dict) -> np.ndarray:
-        return self.rng.uniform(-1.0, 1.0, self.action_size).astype(np.float32)
 
 
 @dataclass
@@ -90,10 +76,6 @@ class ScriptedPianist:
     """Most change (rad) of the fingertip's tilt the IK asks for in one control step."""
     hold_reach = 0.030
     """How far (m) the wrist may be from straight over a held key (the abduction makes up for it)."""
-    white_gain = 1.0
-    """Correction on the strike speed for white keys, measured (see docs/simulator.md)."""
-    black_gain = 1.0
-    """Correction on the strike speed for black keys, measured."""
 
     def __init__(self, config: EnvConfig):
         if config.world.control != "velocity":
@@ -118,6 +100,7 @@ class ScriptedPianist:
         self.black_contact_y = geometry.black_length - BLACK_STRIKE_FROM_FRONT
         self.black_rise = world.keyboard.geometry.black_rise
         self.black_band_y = world.keyboard.geometry.black_length + world.hand.geometry.tip_radius
+        self.actuated = actuated_indices(config)  # the joints the environment's actions move
         self.reset()
 
     def reset(self) -> None:
@@ -158,8 +141,7 @@ class ScriptedPianist:
     def _tip_speed(self, key: int, velocity: float) -> float:
         """Downward fingertip speed (m/s) at which a strike on ``key`` sounds at ``velocity``."""
         front_speed = float(self.curve.speed(velocity))  # the keyboard's curve is in front-edge speed
-        gain = self.black_gain if self.black[key] else self.white_gain
-        return gain * front_speed * self._contact_y(key) / self.white_length
+        return front_speed * self._contact_y(key) / self.white_length
 
     def _strike_depth(self, key: int) -> float:
         """How far below the key's top surface the fingertip is when the key sounds (m)."""
@@ -196,7 +178,7 @@ class ScriptedPianist:
                 plans[finger] = plan
         self._let_go(plans, joints, wrist)
         self.previous_row = score[0].copy()
-        return self._command(plans, joints, wrist)
+        return self._command(plans, joints, wrist)[self.actuated]
 
     def _wrist_for(self, finger: int, key: int) -> float:
         """Wrist position that puts ``finger`` straight over ``key``."""

@@ -13,6 +13,7 @@ import tempfile
 from dataclasses import dataclass, field
 
 import numpy as np
+from pianobot.music.tensor import ScoreSpec
 from pianobot.sim.bullet import p
 
 from pianobot.sim.hand import HandConfig, hand_urdf, joint_names
@@ -31,8 +32,8 @@ class WorldConfig:
     hand: HandConfig = field(default_factory=HandConfig)
     physics_hz: float = 240.0
     """Physics steps per second (500 Hz cost twice as much and showed no benefit)."""
-    control_hz: float = 20.0
-    """Control steps per second; each runs physics_hz / control_hz physics steps."""
+    control_hz: float = ScoreSpec.control_hz
+    """Control steps per second; each runs physics_hz / control_hz physics steps (the score's rate)."""
     solver_iterations: int = 15
     """Constraint solver iterations per physics step (50 is PyBullet's default; 15 is twice as fast and keys stay stable)."""
     control: str = "velocity"
@@ -41,6 +42,12 @@ class WorldConfig:
     """If True the wrist action picks one of the white keys' positions and the wrist servoes there."""
     gui: bool = False
     """Open PyBullet's window instead of running headless."""
+
+    def __post_init__(self) -> None:
+        if self.control not in CONTROL_MODES:
+            raise ValueError(f"control must be one of {', '.join(CONTROL_MODES)}; got {self.control!r}")
+        if not 0 < self.control_hz <= self.physics_hz:
+            raise ValueError(f"control_hz {self.control_hz} must be positive and at most physics_hz {self.physics_hz}")
 
     @property
     def substeps(self) -> int:
@@ -65,8 +72,6 @@ class PianoWorld:
     """One PyBullet client holding the keyboard and the hand."""
 
     def __init__(self, config: WorldConfig = WorldConfig()):
-        if config.control not in CONTROL_MODES:
-            raise ValueError(f"control must be one of {CONTROL_MODES}, got {config.control!r}")
         self.config = config
         self.client = p.connect(p.GUI if config.gui else p.DIRECT)
         self.dt = 1.0 / config.physics_hz

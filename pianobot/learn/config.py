@@ -1,0 +1,49 @@
+"""One training run's settings (:class:`TrainConfig`), and reading them back from a stored model."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from pianobot.agent.config import SACConfig
+from pianobot.config import ConfigError, from_dict
+from pianobot.env.piano import EnvConfig
+from pianobot.errors import PianobotError
+from pianobot.learn.explore import EXPLORATIONS
+
+
+@dataclass(frozen=True)
+class TrainConfig:
+    """One training run of one policy. Its hash (with the phrase's) names the model folder."""
+
+    steps: int = 50_000
+    """Environment steps, exploration included."""
+    seed: int = 0
+    explore: str = "scripted"
+    """'uniform', 'repeat', 'prior' (the paper's best) or 'scripted' (ours)."""
+    eval_every: int = 5_000
+    eval_episodes: int = 3
+    checkpoint_every: int = 5_000
+    until_f1: float | None = None
+    """Stop early once an evaluation reaches this note F1 (None: always train ``steps`` steps)."""
+    sac: SACConfig = field(default_factory=SACConfig)
+    env: EnvConfig = field(default_factory=EnvConfig)
+
+    def __post_init__(self) -> None:
+        if self.explore not in EXPLORATIONS:
+            raise ValueError(f"exploration must be one of {', '.join(EXPLORATIONS)}; got {self.explore!r}")
+        if self.explore == "scripted" and self.env.world.control != "velocity":
+            raise ValueError("scripted exploration needs velocity control (the scripted pianist drives joint speeds)")
+        if not 0 <= self.sac.exploration_steps < self.steps:
+            raise ValueError(f"{self.steps} steps must exceed the {self.sac.exploration_steps} exploration steps, or nothing is learnt")
+        if self.until_f1 is not None and not 0.0 < self.until_f1 <= 1.0:
+            raise ValueError(f"the note F1 to stop at must lie in (0, 1]; got {self.until_f1}")
+        if min(self.eval_every, self.eval_episodes, self.checkpoint_every) < 1:
+            raise ValueError("eval_every, eval_episodes and checkpoint_every must be 1 or more")
+
+
+def config_from_manifest(manifest: dict) -> TrainConfig:
+    """The TrainConfig a stored policy was trained with (from :func:`pianobot.agent.store.read_manifest`)."""
+    try:
+        return from_dict(TrainConfig, manifest["config"])
+    except ConfigError as e:
+        raise PianobotError(f"model manifest: {e}: retrain with --force") from None

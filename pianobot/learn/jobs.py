@@ -1,0 +1,127 @@
+"""Training a whole piece: one job per distinct phrase (or one for a task family), run one after
+another or in parallel worker processes, each skipped when its policy is already stored."""
+
+from __future__ import annotations
+
+import os
+import threading
+import time
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable
+
+import torch
+
+from pianobot.agent import store
+from pianobot.learn.train import Progress, TrainConfig, train_policy
+from pianobot.music.phrases import Phrase
+from pianobot.music.piece import Piece
+
+
+@dataclass
+class PhraseJob:
+    """One policy to train: a phrase (by content hash) or a task family, and the phrases that use it."""
+
+    key: str
+    target: Piece | str
+    folder: Path
+    phrases: list[int]
+    piece: str = ""
+
+    def about(self) -> dict:
+        return {"key": self.key, "piece": self.piece, "phrases": self.phrases}
+
+
+def _exit_with_parent(parent: int, every: float = 0.5) -> None:
+    """Worker initializer: end this process when the process that started it is gone.
+
+    Ctrl-C reaches every process in the terminal's group, but a parent killed on its own
+    (``kill PID``, a closed session) would leave its workers training on unseen. Checkpoints
+    are written atomically, so ending a worker at any moment loses at most the steps since its
+    last checkpoint, which the same command trains again."""
+
+    def watch() -> None:
+        while os.getppid() == parent:
+            time.sleep(every)
+        os._exit(1)
+
+    threading.Thread(target=watch, daemon=True, name="exit-with-parent").start()
+
+
+def _run_job(job: PhraseJob, config: TrainConfig, queue=None, threads: int | None = None) -> dict:
+    if threads is not None:
+        torch.set_num_threads(threads)
+
+    def report(progress: Progress) -> None:
+        if queue is not None:
+            queue.put((job.key, progress))
+
+    return train_policy(job.target, config, job.folder, report, about=job.about())
+
+
+def phrase_jobs(phrases: list[Phrase], config: TrainConfig, root: Path, piece: str = "") -> list[PhraseJob]:
+    """One job per distinct phrase (identical phrases share one policy)."""
+    by_hash: dict[str, PhraseJob] = {}
+    for phrase in phrases:
+        if phrase.hash in by_hash:
+            by_hash[phrase.hash].phrases.append(phrase.index)
+        else:
+            folder = store.model_dir(root, phrase.hash, config)
+            by_hash[phrase.hash] = PhraseJob(phrase.hash, phrase.piece(), folder, [phrase.index], piece)
+    return list(by_hash.values())
+
+
+def task_job(task: str, config: TrainConfig, root: Path) -> PhraseJob:
+    """The one job of a task family."""
+    key = f"task-{task}"
+    return PhraseJob(key, task, store.model_dir(root, key, config), [0], f"task {task}")
+
+
+def plan_jobs(jobs: list[PhraseJob], force: bool) -> tuple[list[PhraseJob], list[PhraseJob]]:
+    """(jobs to train, jobs already trained); ``force`` removes stored policies, so that an
+    interrupted forced run is not taken for a finished one (its checkpoint is kept and resumed)."""
+    todo, done = [], []
+    for job in jobs:
+        if store.is_trained(job.folder) and not force:
+            done.append(job)
+        else:
+            if force and job.folder.exists():
+                for name in (store.POLICY_FILE, store.MANIFEST_FILE):
+                    (job.folder / name).unlink(missing_ok=True)
+            todo.append(job)
+    return todo, done
+
+
+def run_jobs(
+    jobs: list[PhraseJob], config: TrainConfig, workers: int, on_progress: Callable[[str, Progress], None], threads: int = 1
+) -> dict[str, dict]:
+    """Train every job, ``workers`` at a time in separate processes (1: in this process), each with
+    ``threads`` torch threads (more threads than cores makes torch's thread pools spin against each other)."""
+    results: dict[str, dict] = {}
+    if workers <= 1 or len(jobs) <= 1:
+        torch.set_num_threads(threads)
+        for job in jobs:
+            results[job.key] = train_policy(job.target, config, job.folder, lambda p, key=job.key: on_progress(key, p), about=job.about())
+        return results
+    import multiprocessing
+
+    manager = multiprocessing.Manager()
+    queue = manager.Queue()
+    context = multiprocessing.get_context("spawn")
+    with ProcessPoolExecutor(max_workers=workers, mp_context=context, initializer=_exit_with_parent, initargs=(os.getpid(),)) as pool:
+        futures = {pool.submit(_run_job, job, config, queue, threads): job for job in jobs}
+        pending = set(futures)
+        while pending:
+            while not queue.empty():
+                key, progress = queue.get()
+                on_progress(key, progress)
+            finished = {f for f in pending if f.done()}
+            for future in finished:
+                results[futures[future].key] = future.result()
+            pending -= finished
+            time.sleep(0.2)
+        while not queue.empty():
+            key, progress = queue.get()
+            on_progress(key, progress)
+    return results
