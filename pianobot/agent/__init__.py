@@ -1,1 +1,1 @@
-"""The learning agent: Soft Actor-Critic and its replay buffer."""
+"""The learning agent: Soft Actor-Critic, its hyperparameters, its replay buffer, and the model store of trained policies."""

@@ -50,10 +50,6 @@ class ReplayBuffer:
         batch.setdefault("next_tactile", None)
         return batch
 
-    @property
-    def nbytes(self) -> int:
-        return sum(v.nbytes for v in self.arrays.values())
-
     # -- checkpoints: plain .npy files, read without pickle -----------------------------------
     def save(self, folder: Path) -> None:
         folder.mkdir(parents=True, exist_ok=True)

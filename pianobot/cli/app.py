@@ -313,7 +313,6 @@ def play(
     from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 
     from pianobot.cli import display
-    from pianobot.music.metrics import compare
     from pianobot.music.midi_io import write_midi
     from pianobot.music.phrases import split_phrases
     from pianobot.perform.audio import write_wav

@@ -21,7 +21,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import linear_sum_assignment
 
 REWARDS = ("linear", "squared", "wasserstein")
 
@@ -86,6 +85,8 @@ def wasserstein_distance(played: np.ndarray, target: np.ndarray, sigma: float, k
     cost[: len(s), : len(t)] = move
     cost[: len(s), len(t):] = sigma  # remove a played key
     cost[len(s):, : len(t)] = sigma  # add a target key
+    from scipy.optimize import linear_sum_assignment  # only this reward needs scipy, slow to import
+
     rows, cols = linear_sum_assignment(cost)
     return float(cost[rows, cols].sum())
 

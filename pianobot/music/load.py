@@ -9,7 +9,7 @@ from pathlib import Path
 
 from pianobot.errors import PianobotError, PianobotWarning
 from pianobot.music import midi_io, pig
-from pianobot.music.instrument import HandSpec, KeyboardSpec, check_playable
+from pianobot.music.instrument import HandSpec
 from pianobot.music.piece import Note, Piece, pitch_name
 
 
@@ -166,11 +166,4 @@ def load_part(path: str | Path, options: LoadOptions, hand: HandSpec) -> Piece:
                 f"the {options.hand} hand's part has chords of more than {len(hand.fingers)} notes: "
                 f"kept the highest {len(hand.fingers)}, dropped {dropped} note(s)"
             ))
-    return piece
-
-
-def load_playable(path: str | Path, options: LoadOptions, keyboard: KeyboardSpec, hand: HandSpec) -> Piece:
-    """:func:`load_part`, then check that ``hand`` can play it on ``keyboard``."""
-    piece = load_part(path, options, hand)
-    check_playable(piece, keyboard, hand)
     return piece

@@ -13,7 +13,6 @@ import io
 import warnings
 from dataclasses import asdict, dataclass
 
-import mir_eval
 import numpy as np
 
 from pianobot.files import atomic_write
@@ -98,6 +97,8 @@ class Report:
 
 def _arrays(piece: Piece) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     intervals = np.array([[n.onset, n.offset] for n in piece.notes], dtype=float).reshape(-1, 2)
+    import mir_eval  # imported when needed: it takes a second, and `pianobot --version` need not wait
+
     pitches = mir_eval.util.midi_to_hz(np.array([n.pitch for n in piece.notes], dtype=float))
     velocities = np.array([n.velocity for n in piece.notes], dtype=float)
     return intervals, pitches, velocities
@@ -132,6 +133,8 @@ def compare(
     control_hz: float = ScoreSpec.control_hz,
 ) -> Report:
     """Score ``played`` against ``reference``."""
+    import mir_eval
+
     ref_int, ref_hz, ref_vel = _arrays(reference)
     out_int, out_hz, out_vel = _arrays(played)
     with warnings.catch_warnings():

@@ -159,19 +159,6 @@ def hand_urdf(config: HandConfig, rail: tuple[float, float]) -> str:
 
 
 # -- kinematics in the finger's plane, for controllers -----------------------------------------
-def tip_in_finger_plane(geometry: FingerGeometry, flexion: np.ndarray) -> tuple[float, float]:
-    """(forward reach, drop) of the fingertip's end from the abduction joint for MCP/PIP/DIP angles.
-
-    Reach is measured along the finger's pointing direction, drop downwards.
-    """
-    a1, a2, a3 = np.cumsum(flexion)
-    reach = geometry.base_to_mcp + geometry.proximal * math.cos(a1) + geometry.middle * math.cos(a2)
-    drop = geometry.proximal * math.sin(a1) + geometry.middle * math.sin(a2)
-    reach += geometry.distal * math.cos(a3)
-    drop += geometry.distal * math.sin(a3)
-    return reach, drop
-
-
 def lowest_point_in_finger_plane(geometry: FingerGeometry, flexion: np.ndarray) -> tuple[float, float]:
     """(reach, drop) of the lowest point of the fingertip sphere: where it meets a key from above."""
     a1, a2, a3 = np.cumsum(flexion)

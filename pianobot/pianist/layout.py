@@ -1,0 +1,52 @@
+"""The keyboard as the scripted pianist sees it: where each key is, how high, and where to strike it.
+
+Both halves of the pianist use it: :mod:`~pianobot.pianist.strikes` for strike depths and
+speeds, :mod:`~pianobot.pianist.motion` for where to put the wrist and the fingertips.
+Positions along the keyboard (x) are in metres from its left end, the wrist's coordinate;
+depths into the keyboard (y) are in metres from the keys' hinges; heights are in metres over
+the white keys' top surface.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from pianobot.sim.hand import FINGER_BASE_X
+from pianobot.sim.keyboard import BLACK_STRIKE_FROM_FRONT, WHITE_STRIKE_FROM_FRONT, key_boxes
+from pianobot.sim.world import WorldConfig
+
+
+class KeyLayout:
+    """Key positions, tops and strike points of ``world``'s keyboard, for ``world``'s hand."""
+
+    def __init__(self, world: WorldConfig):
+        geometry = world.keyboard.geometry
+        boxes = key_boxes(world.keyboard)
+        self.key_x = np.array([b.center[0] for b in boxes])
+        """Centre of each key along the keyboard (m), lowest key first."""
+        self.black = np.array([b.black for b in boxes])
+        """Whether each key is black."""
+        self.key_top = np.where(self.black, geometry.black_rise, 0.0)
+        """Height of each key's top surface (m): 0 for white keys, the black keys' rise for black ones."""
+        self.width = sum(not b for b in self.black) * geometry.white_pitch
+        """Length of the keyboard (m): the wrist's range."""
+        self.white_length = geometry.white_length
+        """Length of a white key from its hinge to its front edge (m)."""
+        self.black_rise = geometry.black_rise
+        """Height of the black keys' tops over the white keys' (m)."""
+        self.strike_angle = world.keyboard.strike_fraction * geometry.max_angle
+        """Key angle at which a key sounds (rad)."""
+        self.white_contact_y = geometry.white_length - WHITE_STRIKE_FROM_FRONT
+        """Where on a white key the fingertip strikes (m from the hinge): the keyboard's strike point."""
+        self.black_contact_y = geometry.black_length - BLACK_STRIKE_FROM_FRONT
+        """Where on a black key the fingertip strikes (m from the hinge)."""
+        self.black_band_y = geometry.black_length + world.hand.geometry.tip_radius
+        """A fingertip closer than this to the hinges (m) is over the black keys' band."""
+
+    def contact_y(self, key: int) -> float:
+        """Where on ``key`` the fingertip strikes (m from the hinge)."""
+        return self.black_contact_y if self.black[key] else self.white_contact_y
+
+    def wrist_for(self, finger: int, key: int) -> float:
+        """Wrist position that puts ``finger`` straight over ``key`` (m)."""
+        return float(self.key_x[key] - FINGER_BASE_X[finger])

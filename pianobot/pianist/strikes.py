@@ -1,0 +1,208 @@
+"""Strike planning: when each finger strikes which key, from how high and how fast.
+
+Every control step the planner reads each finger's notes from the score window
+(:func:`finger_runs`) and gives the finger a :class:`Plan` for this step:
+
+- ``ready``: hover over the next key at the height from which constant-speed travel, started
+  :attr:`Plan.lead` steps before the onset, reaches the strike depth on time;
+- ``strike``: go down at the speed that the keyboard's velocity curve turns into the target
+  velocity, so as to pass the strike depth in the onset's step. Every step re-plans from
+  where the fingertip actually is (closed loop);
+- ``hold``: keep a sounding key down, first going on down at the strike speed, so that a strike
+  that lands a little late still sounds at the right velocity.
+
+A held key is let go early when the hand must get ready for what comes next (:meth:`StrikePlanner.plan`).
+
+The planner knows no joints: it is given each fingertip's height, and
+:mod:`~pianobot.pianist.motion` turns its plans into joint speeds.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Literal, NamedTuple
+
+import numpy as np
+
+from pianobot.music.tensor import FINGER, NOTE, VELOCITY
+from pianobot.pianist.layout import KeyLayout
+from pianobot.pianist.tuning import PianistTuning
+from pianobot.sim.world import WorldConfig
+
+
+class Run(NamedTuple):
+    """One note of one finger in the score window: consecutive rows with its key on."""
+
+    key: int
+    """The key (0 = the keyboard's lowest)."""
+    start: int
+    """Its first row: control steps from now until its onset (0 = this step)."""
+    end: int
+    """The row after its last one (control steps from now until it ends)."""
+    velocity: float
+    """The MIDI velocity it is to sound at."""
+
+
+def finger_runs(score: np.ndarray, slot: int) -> list[Run]:
+    """The notes of the hand's ``slot``-th finger in the score window (T, L, 5), in time order."""
+    on = (score[:, :, NOTE] > 0.5) & (score[:, :, FINGER + slot] > 0.5)
+    runs = []
+    for key in np.flatnonzero(on.any(axis=0)):
+        column = np.concatenate([[0], on[:, key].astype(int), [0]])
+        starts, ends = np.flatnonzero(np.diff(column) == 1), np.flatnonzero(np.diff(column) == -1)
+        for s, e in zip(starts, ends):
+            runs.append(Run(int(key), int(s), int(e), float(score[s, key, VELOCITY]) * 127))
+    return sorted(runs, key=lambda r: r.start)
+
+
+Phase = Literal["ready", "strike", "hold"]
+
+
+@dataclass(frozen=True)
+class Plan:
+    """What one finger does in this control step. Heights are over the key's top surface (m)."""
+
+    key: int
+    phase: Phase
+    """'ready' (hover at ``height``), 'strike' (down to ``goal``) or 'hold' (keep the key down, going to ``goal``)."""
+    height: float = 0.0
+    """Ready height: where a strike starts (m)."""
+    goal: float = 0.0
+    """Fingertip height to reach by the end of this step (m)."""
+    start: int = 0
+    """Control steps until the note's onset."""
+    lead: int = 0
+    """Control steps the strike takes from the ready height."""
+    next_note: Run | None = None
+    """While holding: this finger's next note in the window."""
+    next_lead: int = 0
+    """While holding: control steps the next note's strike takes from its ready height."""
+
+
+class StrikePlanner:
+    """Plans every finger's strikes from the score window; see the module docstring."""
+
+    def __init__(self, world: WorldConfig, layout: KeyLayout, tuning: PianistTuning):
+        self.layout = layout
+        self.tuning = tuning
+        self.fingers = world.hand.spec.fingers
+        self.dt = 1.0 / world.control_hz
+        self.curve = world.keyboard.curve
+        self.max_wrist_speed = world.hand.max_wrist_speed
+
+    def plan(self, score: np.ndarray, previous_row: np.ndarray | None, heights: dict[int, float]) -> dict[int, Plan]:
+        """The plan of every finger that has something to do, by finger.
+
+        ``previous_row`` is the score row of the previous step (None at the first step): it tells a
+        note that began earlier, to hold, from one to strike now. ``heights`` are the fingertips'
+        heights over the white keys' top (m), by finger.
+        """
+        plans: dict[int, Plan] = {}
+        for slot, finger in enumerate(self.fingers):
+            plan = self._plan_finger(score, slot, previous_row, heights[finger])
+            if plan is not None:
+                plans[finger] = plan
+        self._let_go(plans, heights)
+        return plans
+
+    # -- speed, depth and timing of one strike -----------------------------------------------------
+    def tip_speed(self, key: int, velocity: float) -> float:
+        """Downward fingertip speed (m/s) at which a strike on ``key`` sounds at ``velocity``."""
+        front_speed = float(self.curve.speed(velocity))  # the keyboard's curve is in front-edge speed
+        return front_speed * self.layout.contact_y(key) / self.layout.white_length
+
+    def strike_depth(self, key: int) -> float:
+        """How far below the key's top surface the fingertip is when the key sounds (m)."""
+        return self.layout.contact_y(key) * math.tan(self.layout.strike_angle)
+
+    def overshoot(self, tip_speed: float) -> float:
+        """How far (m) past the strike depth the fingertip is planned to be when the key sounds."""
+        return min(self.tuning.strike_margin, tip_speed * self.dt / 4)
+
+    def strike_point(self, tip_speed: float) -> float:
+        """When in the onset's control step (0 = its start, 1 = its end) the key should sound.
+
+        The environment's steps are centred on the score's rows, so the middle of the step is
+        on time. A loud (fast) strike sounds later in the step: the fingertip goes on at the
+        strike speed for the rest of the step and must stop short of the key's bottom
+        (``hold_depth_margin`` past the strike depth), or the step's speed would drop."""
+        room = self.tuning.hold_depth_margin - self.overshoot(tip_speed)  # below the strike depth
+        return float(np.clip(1.0 - room / (tip_speed * self.dt), 0.5, 1.0))
+
+    def ready_steps(self, tip_speed: float, depth: float) -> int:
+        """Control steps of constant-speed travel from the ready height before the onset's step."""
+        point = self.strike_point(tip_speed)
+        return max(1, math.ceil((self.tuning.min_ready_height + depth) / (tip_speed * self.dt) - point))
+
+    # -- plans ----------------------------------------------------------------------------------
+    def _plan_finger(self, score: np.ndarray, slot: int, previous_row: np.ndarray | None, height: float) -> Plan | None:
+        """What one finger should do now (``height``: its tip's over the white keys), or None when it has nothing to do."""
+        runs = finger_runs(score, slot)
+        current = next((r for r in runs if r.start == 0), None)
+        upcoming = next((r for r in runs if r.start > 0), None)
+        if current is None:
+            return self._approach(upcoming, height) if upcoming is not None else None
+        key = current.key
+        began_earlier = previous_row is not None and (previous_row[key, NOTE] > 0.5 and previous_row[key, FINGER + slot] > 0.5)
+        if not began_earlier:
+            return self._approach(current, height)  # the onset step itself: strike now
+        tip_height = height - self.layout.key_top[key]
+        floor = -self.strike_depth(key) - self.tuning.hold_depth_margin
+        goal = max(tip_height - self.tip_speed(key, current.velocity) * self.dt, floor)
+        if upcoming is None:
+            return Plan(key, "hold", goal=goal)
+        next_lead = self.ready_steps(self.tip_speed(upcoming.key, upcoming.velocity), self.strike_depth(upcoming.key))
+        return Plan(key, "hold", goal=goal, next_note=upcoming, next_lead=next_lead)
+
+    def _approach(self, run: Run, height: float) -> Plan:
+        """The plan for striking ``run``: hover while its onset is far, else strike (``height``: the tip's over the white keys)."""
+        key, start = run.key, run.start
+        speed = self.tip_speed(key, run.velocity)
+        depth = self.strike_depth(key)
+        steps = self.ready_steps(speed, depth)
+        point = self.strike_point(speed)
+        ready = (steps + point) * speed * self.dt - depth
+        if start > steps:
+            return Plan(key, "ready", height=ready, start=start, lead=steps)
+        # closed loop: after this step the fingertip should be where constant-speed travel passes
+        # the strike depth at the strike point of the onset's step, (start - 1 + point) steps on
+        tip_height = height - self.layout.key_top[key]
+        goal = tip_height - speed * self.dt if start == 0 else -depth - self.overshoot(speed) + speed * self.dt * (start - 1 + point)
+        floor = -depth - self.tuning.hold_depth_margin
+        return Plan(key, "strike", height=ready, goal=float(np.clip(goal, floor, tip_height)), start=start, lead=steps)
+
+    def _let_go(self, plans: dict[int, Plan], heights: dict[int, float]) -> None:
+        """Release held keys early when the hand must get ready for what comes next.
+
+        A holding finger lets go in time for its own next strike; every holding finger lets go
+        in time for a strike (its own or another finger's) that needs the wrist where a held
+        key is out of reach, counting the steps the wrist needs to get there.
+        """
+        tuning, layout = self.tuning, self.layout
+
+        def release(finger: int) -> None:
+            upcoming = plans[finger].next_note
+            if upcoming is None:
+                del plans[finger]
+            else:
+                plans[finger] = self._approach(upcoming, heights[finger])
+
+        for finger, plan in list(plans.items()):
+            if plan.phase == "hold" and plan.next_note is not None and plan.next_note.start - plan.next_lead - tuning.prepare_steps <= 0:
+                release(finger)
+        holds = {f: p for f, p in plans.items() if p.phase == "hold"}
+        if not holds:
+            return
+        low = max(layout.wrist_for(f, p.key) for f, p in holds.items()) - tuning.hold_reach
+        high = min(layout.wrist_for(f, p.key) for f, p in holds.items()) + tuning.hold_reach
+        strikes = [(f, p.key, p.start, p.lead) for f, p in plans.items() if p.phase != "hold"]
+        strikes += [(f, p.next_note.key, p.next_note.start, p.next_lead) for f, p in holds.items() if p.next_note is not None]
+        for finger, key, start, lead in strikes:
+            wanted = layout.wrist_for(finger, key)
+            travel = max(0.0, low - wanted, wanted - high)
+            shift_steps = math.ceil(travel / (self.max_wrist_speed * self.dt))
+            if travel > 0 and start - lead - tuning.prepare_steps - shift_steps <= 0:
+                for held in holds:
+                    release(held)
+                return

@@ -1,0 +1,52 @@
+"""The scripted pianist's tuning constants, in one place, each with its unit.
+
+Lengths are in metres (m), angles in radians (rad), times in control steps (50 ms at the
+default 20 Hz). Heights are measured from a fingertip's lowest point to a key's top surface.
+They were tuned by hand on the examples and the task families (tests/test_controllers.py);
+:mod:`~pianobot.pianist.strikes` reads the strike constants and
+:mod:`~pianobot.pianist.motion` the positioning ones.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True)
+class PianistTuning:
+    """How the scripted pianist moves: hover heights, tolerances, margins and speed limits."""
+
+    # -- strikes (pianobot/pianist/strikes.py) ---------------------------------------------------
+    min_ready_height: float = 0.003
+    """Lowest hover height over the key's top before a strike (m)."""
+    strike_margin: float = 0.001
+    """The fingertip is planned to pass the strike depth by up to this much at the onset (m)."""
+    hold_depth_margin: float = 0.0025
+    """A struck key is pressed this far past its strike depth before the finger just holds it (m).
+    It also bounds when in the onset's step a loud strike sounds: the fingertip must not reach
+    the key's bottom within that step, or the step's speed, and the note, would be softer."""
+    prepare_steps: int = 4
+    """Time a finger needs to lift, move over and settle before a strike from the ready height (control steps)."""
+    hold_reach: float = 0.030
+    """Farthest the wrist may be from straight over a held key: the abduction makes up for it (m)."""
+
+    # -- motion (pianobot/pianist/motion.py) -----------------------------------------------------
+    idle_height: float = 0.010
+    """Fingertip height over its key's top (or the white keys' top) when it has nothing to do (m)."""
+    aim_tolerance: float = 0.004
+    """A finger waits at idle height until its tip is this close to above its key (m)."""
+    path_tolerance: float = 0.002
+    """A fingertip that must rise more than this rises first; one that must move across more than this moves across before it goes down (m)."""
+    clearance: float = 0.003
+    """The hand does not slide while a finger that has let go is lower than this over the white keys (m)."""
+    band_clearance: float = 0.004
+    """Crossing into or out of the black keys' band, the fingertip stays this far above their tops (m)."""
+    band_tolerance: float = 0.0002
+    """A fingertip this little under the safe height for crossing counts as over it (m).
+    One that rose towards it could stop a hair short of it and wait there for ever."""
+    max_move: float = 0.008
+    """Longest fingertip move in one step when positioning; strikes are not limited (m per control step)."""
+    hold_slide: float = 0.008
+    """Farthest the wrist may move in one step while a finger holds a key (m per control step)."""
+    tilt_step: float = 0.15
+    """Most change of the fingertip's tilt the inverse kinematics asks for in one step (rad per control step)."""
