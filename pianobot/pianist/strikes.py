@@ -91,19 +91,19 @@ class StrikePlanner:
         self.curve = world.keyboard.curve
         self.max_wrist_speed = world.hand.max_wrist_speed
 
-    def plan(self, score: np.ndarray, previous_row: np.ndarray | None, heights: dict[int, float]) -> dict[int, Plan]:
+    def plan(self, score: np.ndarray, previous_row: np.ndarray | None, tips: dict[int, float]) -> dict[int, Plan]:
         """The plan of every finger that has something to do, by finger.
 
         ``previous_row`` is the score row of the previous step (None at the first step): it tells a
-        note that began earlier, to hold, from one to strike now. ``heights`` are the fingertips'
+        note that began earlier, to hold, from one to strike now. ``tips`` are the fingertips'
         heights over the white keys' top (m), by finger.
         """
         plans: dict[int, Plan] = {}
         for slot, finger in enumerate(self.fingers):
-            plan = self._plan_finger(score, slot, previous_row, heights[finger])
+            plan = self._plan_finger(score, slot, previous_row, tips[finger])
             if plan is not None:
                 plans[finger] = plan
-        self._let_go(plans, heights)
+        self._let_go(plans, tips)
         return plans
 
     # -- speed, depth and timing of one strike -----------------------------------------------------
@@ -136,18 +136,18 @@ class StrikePlanner:
         return max(1, math.ceil((self.tuning.min_ready_height + depth) / (tip_speed * self.dt) - point))
 
     # -- plans ----------------------------------------------------------------------------------
-    def _plan_finger(self, score: np.ndarray, slot: int, previous_row: np.ndarray | None, height: float) -> Plan | None:
-        """What one finger should do now (``height``: its tip's over the white keys), or None when it has nothing to do."""
+    def _plan_finger(self, score: np.ndarray, slot: int, previous_row: np.ndarray | None, tip: float) -> Plan | None:
+        """What one finger should do now, or None when it has nothing to do (``tip``: its height over the white keys, m)."""
         runs = finger_runs(score, slot)
         current = next((r for r in runs if r.start == 0), None)
         upcoming = next((r for r in runs if r.start > 0), None)
         if current is None:
-            return self._approach(upcoming, height) if upcoming is not None else None
+            return self._approach(upcoming, tip) if upcoming is not None else None
         key = current.key
         began_earlier = previous_row is not None and (previous_row[key, NOTE] > 0.5 and previous_row[key, FINGER + slot] > 0.5)
         if not began_earlier:
-            return self._approach(current, height)  # the onset step itself: strike now
-        tip_height = height - self.layout.key_top[key]
+            return self._approach(current, tip)  # the onset step itself: strike now
+        tip_height = tip - self.layout.key_top[key]
         floor = -self.strike_depth(key) - self.tuning.hold_depth_margin
         goal = max(tip_height - self.tip_speed(key, current.velocity) * self.dt, floor)
         if upcoming is None:
@@ -155,24 +155,24 @@ class StrikePlanner:
         next_lead = self.ready_steps(self.tip_speed(upcoming.key, upcoming.velocity), self.strike_depth(upcoming.key))
         return Plan(key, "hold", goal=goal, next_note=upcoming, next_lead=next_lead)
 
-    def _approach(self, run: Run, height: float) -> Plan:
-        """The plan for striking ``run``: hover while its onset is far, else strike (``height``: the tip's over the white keys)."""
+    def _approach(self, run: Run, tip: float) -> Plan:
+        """The plan for striking ``run``: hover while its onset is far, else strike (``tip``: the fingertip's height over the white keys, m)."""
         key, start = run.key, run.start
         speed = self.tip_speed(key, run.velocity)
         depth = self.strike_depth(key)
         steps = self.ready_steps(speed, depth)
         point = self.strike_point(speed)
-        ready = (steps + point) * speed * self.dt - depth
+        height = (steps + point) * speed * self.dt - depth
         if start > steps:
-            return Plan(key, "ready", height=ready, start=start, lead=steps)
+            return Plan(key, "ready", height=height, start=start, lead=steps)
         # closed loop: after this step the fingertip should be where constant-speed travel passes
         # the strike depth at the strike point of the onset's step, (start - 1 + point) steps on
-        tip_height = height - self.layout.key_top[key]
+        tip_height = tip - self.layout.key_top[key]
         goal = tip_height - speed * self.dt if start == 0 else -depth - self.overshoot(speed) + speed * self.dt * (start - 1 + point)
         floor = -depth - self.tuning.hold_depth_margin
-        return Plan(key, "strike", height=ready, goal=float(np.clip(goal, floor, tip_height)), start=start, lead=steps)
+        return Plan(key, "strike", height=height, goal=float(np.clip(goal, floor, tip_height)), start=start, lead=steps)
 
-    def _let_go(self, plans: dict[int, Plan], heights: dict[int, float]) -> None:
+    def _let_go(self, plans: dict[int, Plan], tips: dict[int, float]) -> None:
         """Release held keys early when the hand must get ready for what comes next.
 
         A holding finger lets go in time for its own next strike; every holding finger lets go
@@ -186,7 +186,7 @@ class StrikePlanner:
             if upcoming is None:
                 del plans[finger]
             else:
-                plans[finger] = self._approach(upcoming, heights[finger])
+                plans[finger] = self._approach(upcoming, tips[finger])
 
         for finger, plan in list(plans.items()):
             if plan.phase == "hold" and plan.next_note is not None and plan.next_note.start - plan.next_lead - tuning.prepare_steps <= 0:

@@ -1,0 +1,170 @@
+"""Motion: turning the strike planner's plans into joint speeds, one control step at a time.
+
+- The wrist slides towards where the planned fingers are over their keys (their mean), only a
+  little while a finger holds a key, and not at all while a finger that let go of a key is
+  still low over the keys (it would drag across them).
+- Each finger's abduction aims its tip at its key from where the wrist will be at the end of
+  the step, so held keys stay held while the hand moves.
+- The fingertip goes to a waypoint by the end of the step: up first, then across, then down,
+  in short straight moves, and into or out of the black keys' band only above their tops;
+  strikes and holds go straight to the planned height.
+- Inverse kinematics (:func:`~pianobot.sim.hand.finger_ik`) turns the waypoint into flexion
+  angles, and the action is the joint speed that reaches them within the step.
+
+Heights are in metres over the white keys' top surface (or over a key's top, where it says so).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from pianobot.pianist.layout import KeyLayout
+from pianobot.pianist.strikes import Plan
+from pianobot.pianist.tuning import PianistTuning
+from pianobot.sim.hand import FINGER_BASE_X, PREFERRED_TILT, TILT_RANGE, finger_ik, lowest_point_in_finger_plane
+from pianobot.sim.world import WorldConfig
+
+
+class Motion:
+    """Joint speeds for the hand from the fingers' plans; see the module docstring."""
+
+    def __init__(self, world: WorldConfig, layout: KeyLayout, tuning: PianistTuning):
+        self.layout = layout
+        self.tuning = tuning
+        self.hand = world.hand
+        self.geometry = world.hand.geometry
+        self.fingers = world.hand.spec.fingers
+        self.dt = 1.0 / world.control_hz
+
+    def tip_height(self, q: np.ndarray) -> float:
+        """Height of the fingertip's lowest point over the white keys' top (m), from its joint angles."""
+        _, drop = lowest_point_in_finger_plane(self.geometry, q[1:])
+        return self.hand.palm_height - drop
+
+    def command(self, plans: dict[int, Plan], joints: np.ndarray, wrist: float) -> np.ndarray:
+        """The full command in [-1, 1]: every finger's four joint speeds, then the wrist's.
+
+        ``joints`` are the joint angles by finger slot (F, 4); ``wrist`` is its position (m)."""
+        step = self.hand.max_wrist_speed * self.dt
+        wrist_step = float(np.clip(self._wrist_target(plans, joints, wrist) - wrist, -step, step))
+        wrist_next = wrist + wrist_step  # fingers aim from where the wrist will be, so held keys stay held
+        action = np.zeros(len(self.fingers) * 4 + 1)
+        for slot, finger in enumerate(self.fingers):
+            action[slot * 4 : slot * 4 + 4] = self._finger_command(finger, plans.get(finger), joints[slot], wrist_next)
+        action[-1] = wrist_step / step
+        return action.astype(np.float32)
+
+    def _wrist_target(self, plans: dict[int, Plan], joints: np.ndarray, wrist: float) -> float:
+        """Where the wrist should go (m): where the planned fingers are over their keys, on average."""
+        layout, tuning = self.layout, self.tuning
+        target = wrist
+        if plans:
+            wanted = [layout.wrist_for(f, plan.key) for f, plan in plans.items()]
+            target = float(np.clip(np.mean(wanted), 0.0, layout.width))
+            holds = [layout.wrist_for(f, plan.key) for f, plan in plans.items() if plan.phase == "hold"]
+            if holds:  # a held key's finger may follow a small move only, and only while all held keys allow it
+                low = max(max(holds) - tuning.hold_reach, wrist - tuning.hold_slide)
+                high = min(min(holds) + tuning.hold_reach, wrist + tuning.hold_slide)
+                target = float(np.clip(target, low, high)) if low <= high else wrist
+        if any(self._low(joints[slot]) for slot, f in enumerate(self.fingers) if f not in plans or plans[f].phase == "ready"):
+            target = wrist  # a finger that lets go of a key rises before the hand moves
+        return target
+
+    def _finger_command(self, finger: int, plan: Plan | None, q: np.ndarray, wrist_next: float) -> np.ndarray:
+        """Joint speeds (actions) that bring the fingertip to this step's waypoint by the end of the step."""
+        now_reach, now_drop = lowest_point_in_finger_plane(self.geometry, q[1:])
+        now_height = self.hand.palm_height - now_drop
+        phase, abduction, reach, height = self._target(finger, plan, now_reach, wrist_next)
+        abduction, reach, height = self._waypoint(phase, abduction, reach, height, q, now_reach, now_height)
+        flexion = self._ik(reach, self.hand.palm_height - height, q[1:])
+        desired = np.concatenate([[abduction], flexion])
+        return np.clip((desired - q) / (self.hand.max_joint_speed * self.dt), -1.0, 1.0)
+
+    def _target(self, finger: int, plan: Plan | None, now_reach: float, wrist_next: float) -> tuple[str, float, float, float]:
+        """(phase, abduction, reach, height): where the fingertip goes, and what it does there.
+
+        The abduction aims the fingertip at the key's strike point; the reach (m from the
+        finger's base, in its plane) puts it at that depth even where the key is beyond the
+        abduction's limit. A finger not yet over its key waits at idle height ('idle'), and one
+        over it but not yet in front of it hovers ('ready'): a strike from there would hit the
+        key's edge. ``now_reach``: the fingertip's reach now."""
+        layout, tuning, geometry = self.layout, self.tuning, self.geometry
+        phase = plan.phase if plan is not None else "idle"
+        key = plan.key if plan is not None else None
+        contact_y = layout.contact_y(key) if key is not None else layout.white_contact_y
+        top = float(layout.key_top[key]) if key is not None else 0.0
+        forward = self.hand.palm_y - contact_y
+        offset = layout.key_x[key] - (wrist_next + FINGER_BASE_X[finger]) if key is not None else 0.0
+        abduction = float(np.clip(math.atan2(offset, forward), -geometry.abduction_limit, geometry.abduction_limit))
+        reach = forward / math.cos(abduction)  # keeps the tip at contact_y even when the key is out of reach
+        if phase in ("ready", "strike") and abs(offset - forward * math.tan(abduction)) > tuning.aim_tolerance:
+            phase = "idle"  # not over the key yet: wait high
+        if phase == "strike" and abs(reach - now_reach) > tuning.aim_tolerance:
+            phase = "ready"  # not in front of the key yet: a strike now would hit its edge
+        if phase == "idle":
+            height = top + tuning.idle_height
+        elif phase == "ready":
+            height = top + plan.height
+        else:  # strike or hold: the planned height for the end of this step
+            height = top + plan.goal
+        return phase, abduction, reach, height
+
+    def _waypoint(self, phase: str, abduction: float, reach: float, height: float, q: np.ndarray, now_reach: float, now_height: float) -> tuple[float, float, float]:
+        """(abduction, reach, height) to be at by the end of this step on the way to the target.
+
+        Up first; across before down; into or out of the black keys' band only high up; and
+        positioning moves in short straight steps, so the tip never dips on the way."""
+        hand, geometry, layout, tuning = self.hand, self.geometry, self.layout, self.tuning
+        rise_here = finger_ik(geometry, now_reach, hand.palm_height - height) is not None
+        if height > now_height + tuning.path_tolerance and rise_here:
+            reach = now_reach if abs(reach - now_reach) > tuning.path_tolerance else reach
+            over = layout.black_rise if now_reach > hand.palm_y - layout.black_band_y else 0.0
+            if now_height < over + tuning.clearance:
+                abduction = float(q[0])  # straight up out of the key before swinging sideways
+        elif phase != "hold" and abs(reach - now_reach) > tuning.path_tolerance:
+            across = max(height, now_height)  # (a held key stays pressed while the wrist slides)
+            if finger_ik(geometry, reach, hand.palm_height - across) is not None:
+                height = across  # else the finger, raised high (as a policy may leave it), goes there directly
+
+        band_reach = hand.palm_y - layout.black_band_y  # a tip reaching further lies over the black keys
+        crossing = (reach > band_reach) != (now_reach > band_reach)
+        safe = layout.black_rise + tuning.band_clearance
+        if crossing and now_height < safe - tuning.band_tolerance:
+            if reach < now_reach or finger_ik(geometry, now_reach, hand.palm_height - safe) is not None:
+                reach, height = now_reach, safe
+            else:  # curled too close to the palm to rise here: rise while reaching out towards the black key
+                reach, height = now_reach + min(tuning.max_move, reach - now_reach), safe
+        if phase not in ("strike", "hold"):  # positioning moves go in short straight steps, so the tip never dips
+            move = np.array([reach - now_reach, height - now_height])
+            length = float(np.hypot(*move))
+            if length > tuning.max_move:
+                reach, height = now_reach + move[0] * tuning.max_move / length, now_height + move[1] * tuning.max_move / length
+        return abduction, reach, height
+
+    def _ik(self, reach: float, drop: float, current: np.ndarray) -> np.ndarray:
+        """Flexion angles for a fingertip target; out of reach, the finger keeps its shape.
+
+        The fingertip's tilt moves towards the preferred one by at most ``tilt_step`` per
+        step: letting the IK pick any tilt can flip the finger between very different shapes
+        from one step to the next, faster than its joints follow."""
+        # a finger curled (or stretched) beyond the IK's tilts, as a policy may leave it, starts
+        # from the nearest one: from outside them no point would be in reach and it would stay so
+        tilt = float(np.clip(np.sum(current), *TILT_RANGE))
+        tilt += float(np.clip(PREFERRED_TILT - tilt, -self.tuning.tilt_step, self.tuning.tilt_step))
+        for change in (0.0, 0.002, -0.002, 0.004, -0.004, 0.008, 0.012, 0.016, 0.02):
+            q = finger_ik(self.geometry, reach, drop + change, tilt)  # the nearest height this finger can reach there
+            if q is not None:
+                return q
+        return current
+
+    def _low(self, q: np.ndarray) -> bool:
+        """True when the fingertip is over the keys and lower than their top plus the clearance (it may touch one).
+
+        A fingertip curled back beyond the keys' front, or below them, touches nothing the hand's
+        slide could drag: it does not hold the wrist (a policy may leave fingers like that)."""
+        reach, drop = lowest_point_in_finger_plane(self.geometry, q[1:])
+        over_keys = 0.0 <= self.hand.palm_y - reach * math.cos(q[0]) <= self.layout.white_length
+        height = self.hand.palm_height - drop
+        return over_keys and -self.layout.white_length * math.tan(self.layout.strike_angle) * 2 < height < self.tuning.clearance

@@ -1,0 +1,57 @@
+"""The scripted pianist's parts: reading a finger's notes, planning strikes, and its tuning."""
+
+from dataclasses import fields, replace
+
+import numpy as np
+
+from pianobot.env.piano import EnvConfig, PianoEnv
+from pianobot.music.piece import Note, Piece
+from pianobot.music.tensor import FINGER, NOTE, VELOCITY
+from pianobot.pianist.layout import KeyLayout
+from pianobot.pianist.scripted import ScriptedPianist
+from pianobot.pianist.strikes import Run, StrikePlanner, finger_runs
+from pianobot.pianist.tuning import PianistTuning
+from pianobot.sim.world import WorldConfig
+
+
+def window(notes, rows=11, keys=20, fingers=3):
+    """A score window with (key, first row, end row, velocity 0-1, slot) notes."""
+    score = np.zeros((rows, keys, FINGER + fingers), dtype=np.float32)
+    for key, start, end, velocity, slot in notes:
+        score[start:end, key, NOTE] = 1
+        score[start:end, key, VELOCITY] = velocity
+        score[start:end, key, FINGER + slot] = 1
+    return score
+
+
+def test_finger_runs_are_one_fingers_notes_in_time_order():
+    score = window([(5, 4, 6, 0.5, 1), (7, 0, 2, 1.0, 1), (9, 1, 3, 0.5, 0), (5, 8, 11, 0.25, 1)])
+    runs = finger_runs(score, 1)
+    assert runs == [Run(7, 0, 2, 127.0), Run(5, 4, 6, 63.5), Run(5, 8, 11, 31.75)]
+    assert (runs[1].key, runs[1].start, runs[1].end, runs[1].velocity) == (5, 4, 6, 63.5)
+
+
+def test_a_finger_strikes_now_holds_then_gets_ready_for_its_next_note():
+    world = WorldConfig()
+    planner = StrikePlanner(world, KeyLayout(world), PianistTuning())
+    finger = world.hand.spec.fingers[0]
+    tips = {f: 0.01 for f in world.hand.spec.fingers}
+    score = window([(5, 0, 3, 0.5, 0), (7, 8, 10, 0.5, 0)])
+    now = planner.plan(score, None, tips)[finger]
+    assert (now.phase, now.key, now.start) == ("strike", 5, 0)
+    held = planner.plan(score, score[0], tips)[finger]  # the same note, begun the step before
+    assert (held.phase, held.key, held.next_note) == ("hold", 5, Run(7, 8, 10, 63.5))
+    later = planner.plan(window([(7, 8, 10, 0.5, 0)]), None, tips)[finger]
+    assert (later.phase, later.key, later.start) == ("ready", 7, 8) and later.height > 0
+
+
+def test_the_tuning_is_one_frozen_dataclass_that_the_pianist_uses():
+    assert {f.name for f in fields(PianistTuning)} >= {"idle_height", "prepare_steps", "tilt_step"}
+    config = EnvConfig(tactile=False)
+    env = PianoEnv(piece=Piece((Note(1.0, 60, 1.5, 80, 3),), bpm=60), config=config)
+    observation, _ = env.reset(seed=0)
+    env.close()
+    default = ScriptedPianist(config).act(observation)
+    assert np.array_equal(default, ScriptedPianist(config, PianistTuning()).act(observation))
+    higher = ScriptedPianist(config, replace(PianistTuning(), idle_height=0.03)).act(observation)
+    assert higher.shape == default.shape and not np.array_equal(higher, default)  # idle fingers wait higher
