@@ -62,7 +62,7 @@ def test_interrupted_training_resumes_to_the_same_state(tmp_path):
     train_policy(PHRASE, config, straight)
     resumed = tmp_path / "resumed"
     assert train_policy(PHRASE, config, resumed, stop_after=100) == {"interrupted_at": 105}
-    assert (resumed / store.CHECKPOINT_DIR / "state.json").exists() and not store.is_trained(resumed)
+    assert store.checkpoint_state(resumed)["step"] == 70 and not store.is_trained(resumed)
     train_policy(PHRASE, config, resumed)
     a = store.load_tensors(straight / store.POLICY_FILE)
     b = store.load_tensors(resumed / store.POLICY_FILE)
@@ -348,3 +348,80 @@ def test_training_workers_end_when_their_parent_is_killed(tmp_path):
     while any(alive(p) for p in workers) and time.monotonic() < deadline:
         time.sleep(0.2)
     assert not any(alive(p) for p in workers)
+
+
+class Killed(BaseException):
+    """What a kill looks like to the code it interrupts: nothing runs after it."""
+
+
+@pytest.mark.parametrize("point", ["tensors", "buffer", "state", "before rename", "after rename"])
+def test_a_kill_at_any_point_of_a_checkpoint_write_loses_at_most_one_interval(tmp_path, monkeypatch, point):
+    """The second checkpoint's write (step 140) is cut off at each of its stages; the rerun
+    resumes from the first (step 70) or the second, never from step 0, ends bit-identical to an
+    uninterrupted run, and leaves no temporary files."""
+    from pathlib import Path
+
+    torch.set_num_threads(1)
+    config = small()
+    train_policy(PHRASE, config, tmp_path / "straight")
+    original, calls = store.save_checkpoint, []
+
+    def kill(*args, **kwargs):
+        raise Killed
+
+    def rename_then_kill(self, target):
+        Path.rename.__wrapped__(self, target)
+        raise Killed
+
+    rename_then_kill.__wrapped__ = Path.rename
+
+    def breaking(folder, tensors, state, buffer):
+        calls.append(state["step"])
+        if len(calls) < 2:
+            return original(folder, tensors, state, buffer)
+        with monkeypatch.context() as m:
+            if point == "tensors":
+                m.setattr(store, "save_tensors", kill)
+            elif point == "buffer":
+                m.setattr(buffer, "save", kill)
+            elif point == "state":
+                m.setattr(store, "atomic_write", kill)
+            elif point == "before rename":
+                m.setattr(Path, "rename", kill)
+            else:
+                rename_then_kill.__wrapped__ = Path.rename
+                m.setattr(Path, "rename", rename_then_kill)
+            original(folder, tensors, state, buffer)
+
+    monkeypatch.setattr(store, "save_checkpoint", breaking)
+    with pytest.raises(Killed):
+        train_policy(PHRASE, config, tmp_path / "killed")
+    monkeypatch.setattr(store, "save_checkpoint", original)
+    seen: list[Progress] = []
+    train_policy(PHRASE, config, tmp_path / "killed", seen.append)
+    resumed_at = [p.step for p in seen if p.resumed]
+    assert resumed_at == ([140] if point == "after rename" else [70])
+    a, b = store.load_tensors(tmp_path / "straight" / store.POLICY_FILE), store.load_tensors(tmp_path / "killed" / store.POLICY_FILE)
+    assert a.keys() == b.keys() and all(torch.equal(a[k], b[k]) for k in a)
+    assert sorted(p.name for p in (tmp_path / "killed").iterdir()) == sorted([store.LOCK_FILE, store.MANIFEST_FILE, store.POLICY_FILE])
+
+
+def test_a_due_evaluation_survives_an_interruption(tmp_path):
+    """At step 70 an evaluation is due but waits for exploration to end (step 70 is not past
+    it); a run interrupted there must still evaluate at the next episode end, as a straight run does."""
+    config = small(steps=210, eval_every=70, checkpoint_every=70, sac=replace(small().sac, exploration_steps=70))
+    straight = train_policy(PHRASE, config, tmp_path / "straight")
+    assert train_policy(PHRASE, config, tmp_path / "resumed", stop_after=70) == {"interrupted_at": 70}
+    resumed = train_policy(PHRASE, config, tmp_path / "resumed")
+    assert [e["step"] for e in resumed["evaluations"]] == [e["step"] for e in straight["evaluations"]]
+    assert straight["evaluations"][0]["step"] == 105
+
+
+def test_two_runs_cannot_train_into_one_folder(tmp_path):
+    import os
+
+    with store.training_lock(tmp_path / "m"):
+        with pytest.raises(PianobotError, match=f"is being trained by pianobot process {os.getpid()}"):
+            train_policy(PHRASE, small(), tmp_path / "m")
+    train_policy(PHRASE, small(steps=80), tmp_path / "m")  # free again once the first is done
+    assert store.is_trained(tmp_path / "m")

@@ -4,10 +4,11 @@
       <phrase hash>-<config hash>/
         policy.safetensors      actor + encoder weights (what `play` needs)
         manifest.json           phrase, config, steps, evaluation figures, package versions
-        checkpoint/             only while training: full state, so an interrupted run resumes
+        checkpoint/<step>/      only while training: full state, so an interrupted run resumes
           state.safetensors     every network, optimiser moment and RNG state
           state.json            counters and generator states
           buffer/*.npy          the replay buffer (plain arrays, read without pickle)
+        .lock                   held by the process training into the folder
 
 Files are written to a temporary name and renamed into place, so a crash never leaves a half
 written model; loading never unpickles anything; a corrupt or foreign file is a one-line error.
@@ -15,8 +16,10 @@ written model; loading never unpickles anything; a corrupt or foreign file is a 
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import json
+import os
 import shutil
 from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
@@ -43,6 +46,7 @@ reading (:func:`upgrade_manifest`), so every model a user has keeps playing.
 POLICY_FILE = "policy.safetensors"
 MANIFEST_FILE = "manifest.json"
 CHECKPOINT_DIR = "checkpoint"
+LOCK_FILE = ".lock"
 
 
 def config_hash(config) -> str:
@@ -136,33 +140,92 @@ def find_policies(root: Path, key: str) -> list[Path]:
 
 
 # -- checkpoints ------------------------------------------------------------------------------
+def _checkpoints(folder: Path) -> list[Path]:
+    """The complete checkpoints in ``folder``, oldest first (one is complete once renamed from
+    its ``.tmp`` name, which happens after everything in it was written)."""
+    root = folder / CHECKPOINT_DIR
+    if not root.is_dir():
+        return []
+    if (root / "state.json").exists():  # the single checkpoint folder of versions before 0.2
+        return [root]
+    return sorted((d for d in root.iterdir() if d.is_dir() and d.name.isdigit()), key=lambda d: int(d.name))
+
+
 def save_checkpoint(folder: Path, tensors: dict[str, torch.Tensor], state: dict, buffer) -> None:
-    """Write a complete checkpoint beside the old one, then swap it in."""
-    final = folder / CHECKPOINT_DIR
-    staging = folder / f".{CHECKPOINT_DIR}.new"
+    """Write a complete checkpoint of ``state["step"]``, then drop the older ones.
+
+    It is written under a temporary name and renamed into place in one step, and older
+    checkpoints are removed only after that: a kill at any instant leaves the newest complete
+    checkpoint to resume from, losing at most the steps since it."""
+    root = folder / CHECKPOINT_DIR
+    final = root / f"{state['step']:010d}"
+    staging = root / f"{final.name}.tmp"
     shutil.rmtree(staging, ignore_errors=True)
     staging.mkdir(parents=True)
     save_tensors(tensors, staging / "state.safetensors")
     buffer.save(staging / "buffer")
-    (staging / "state.json").write_text(json.dumps(state) + "\n")
-    old = folder / f".{CHECKPOINT_DIR}.old"
-    shutil.rmtree(old, ignore_errors=True)
-    if final.exists():
-        final.rename(old)
+    atomic_write(staging / "state.json", json.dumps(state) + "\n")
+    shutil.rmtree(final, ignore_errors=True)  # (only if a run was cut off just after writing this very step)
     staging.rename(final)
-    shutil.rmtree(old, ignore_errors=True)
+    for other in root.iterdir():
+        if other != final:
+            shutil.rmtree(other, ignore_errors=True) if other.is_dir() else other.unlink(missing_ok=True)
+
+
+def checkpoint_state(folder: Path) -> dict | None:
+    """The counters of the newest checkpoint (step, evaluations, ...), or None: cheap, reads no tensors."""
+    found = _checkpoints(folder)
+    if not found:
+        return None
+    try:
+        return json.loads((found[-1] / "state.json").read_text())
+    except (OSError, json.JSONDecodeError) as e:
+        raise PianobotError(f"checkpoint {found[-1]} is unreadable ({e}): delete it to start afresh") from None
 
 
 def load_checkpoint(folder: Path) -> tuple[dict[str, torch.Tensor], dict, Path] | None:
-    final = folder / CHECKPOINT_DIR
-    if not (final / "state.json").exists():
+    """(tensors, state, buffer folder) of the newest complete checkpoint, or None."""
+    state = checkpoint_state(folder)
+    if state is None:
         return None
-    try:
-        state = json.loads((final / "state.json").read_text())
-    except (OSError, json.JSONDecodeError) as e:
-        raise PianobotError(f"checkpoint {final} is unreadable ({e}): delete it to start afresh") from None
-    return load_tensors(final / "state.safetensors"), state, final / "buffer"
+    newest = _checkpoints(folder)[-1]
+    return load_tensors(newest / "state.safetensors"), state, newest / "buffer"
 
 
 def drop_checkpoint(folder: Path) -> None:
     shutil.rmtree(folder / CHECKPOINT_DIR, ignore_errors=True)
+
+
+def remove_temporary_files(folder: Path) -> None:
+    """Remove what an interrupted write left in ``folder`` (temporary policy and manifest files)."""
+    if folder.is_dir():
+        for leftover in folder.glob(".*.tmp*"):
+            if leftover.is_file():
+                leftover.unlink(missing_ok=True)
+
+
+@contextlib.contextmanager
+def training_lock(folder: Path):
+    """Hold ``folder`` for one training run: a second run on the same folder (another
+    ``pianobot train`` on the same models) is refused with a clear error instead of sharing its
+    checkpoint. The operating system releases the lock when the process ends, however it ends."""
+    import fcntl
+
+    folder.mkdir(parents=True, exist_ok=True)
+    with open(folder / LOCK_FILE, "a+") as lock:
+        try:
+            fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            lock.seek(0)
+            holder = lock.read().strip() or "another process"
+            raise PianobotError(f"{folder} is being trained by {holder}: wait for it to finish, or train into another --models folder") from None
+        lock.seek(0)
+        lock.truncate()
+        lock.write(f"pianobot process {os.getpid()}")
+        lock.flush()
+        try:
+            yield
+        finally:
+            lock.seek(0)
+            lock.truncate()
+            fcntl.flock(lock, fcntl.LOCK_UN)

@@ -472,6 +472,8 @@ def train(
         rows = {job.key: bar.add_task(f"phrase {job.key[:8]}" if task is None else job.key, total=steps, status="") for job in todo}
 
         def on_progress(key: str, progress) -> None:
+            if progress.resumed:
+                bar.console.print(f"{bar.tasks[rows[key]].description}: resuming from its checkpoint at step {progress.step}")
             status = bar.tasks[rows[key]].fields.get("status", "")
             if progress.episode_return is not None:
                 returns[key] = progress.episode_return

@@ -48,6 +48,8 @@ class Progress:
     episode_return: float | None = None
     eval_f1: float | None = None
     losses: dict | None = None
+    resumed: bool = False
+    """True once, when an interrupted run continues from its checkpoint at ``step``."""
 
 
 def make_env(target: Piece | str, env_config: EnvConfig) -> PianoEnv:
@@ -101,8 +103,15 @@ def train_policy(
     """Train one policy for a phrase (a Piece) or a task family (its name); store it in ``folder``.
 
     ``stop_after`` ends the run after that many steps as an interruption would (tests);
-    ``about`` goes into the manifest (piece, phrase hash, ...).
+    ``about`` goes into the manifest (piece, phrase hash, ...). One run at a time may train
+    into a folder (a second one is refused while the first holds it).
     """
+    with store.training_lock(folder):
+        store.remove_temporary_files(folder)
+        return _train(target, config, folder, report, stop_after, about)
+
+
+def _train(target, config: TrainConfig, folder: Path, report, stop_after: int | None, about: dict | None) -> dict:
     torch.manual_seed(config.seed)  # before the networks are made: their first weights come from it
     env_config = config.env
     env = make_env(target, env_config)
@@ -132,10 +141,13 @@ def train_policy(
         env.reset(seed=config.seed)  # creates the env's generator, then restore its state
         env.np_random.bit_generator.state = state["env_rng"]
         observation, _ = env.reset()
+        report(Progress(step, config.steps, resumed=True))
     else:
         observation, _ = env.reset(seed=config.seed)
+        state = {}
     explorer.reset()
-    next_eval = (step // config.eval_every + 1) * config.eval_every
+    # an evaluation that was due (but waited for exploration to end) stays due
+    next_eval = state.get("next_eval", (step // config.eval_every + 1) * config.eval_every)
     next_checkpoint = (step // config.checkpoint_every + 1) * config.checkpoint_every
     episode_return, losses, final = 0.0, None, None
     started = time.perf_counter()
@@ -178,7 +190,7 @@ def train_policy(
                 state = {
                     "step": step, "episode": episode, "update_debt": update_debt, "updates": agent.updates,
                     "evaluations": evaluations, "rng": rng.bit_generator.state, "env_rng": env.np_random.bit_generator.state,
-                    "buffer_size": buffer.size, "buffer_cursor": buffer.cursor, "best": best,
+                    "buffer_size": buffer.size, "buffer_cursor": buffer.cursor, "best": best, "next_eval": next_eval,
                     "seconds": seconds_before + time.perf_counter() - started,
                 }
                 kept = {BEST_PREFIX + k: v for k, v in (best_tensors or {}).items()}
