@@ -20,6 +20,8 @@ demo: install
 	$(BIN)/pianobot score out/twinkle.mid examples/midi/twinkle.mid --no-notes --plot out/twinkle.png
 
 test: install
+	$(BIN)/ruff check .
+	$(BIN)/ruff format --check .
 	$(BIN)/python -m pytest
 
 examples: install

@@ -60,19 +60,27 @@ def main() -> None:
     parser.add_argument("--tactile", action=argparse.BooleanOptionalAction, default=True)
     parser.add_argument("--workers", type=int, default=1)
     parser.add_argument("--store", default="/tmp/pianobot-compose", help="where the end-to-end policy is stored")
-    parser.add_argument("--models", default=None, help="model store of the phrase policies (default: STORE/seedN/phrases); "
-                        "policies `pianobot train` stored there with the same configuration are reused")
+    parser.add_argument(
+        "--models",
+        default=None,
+        help="model store of the phrase policies (default: STORE/seedN/phrases); "
+        "policies `pianobot train` stored there with the same configuration are reused",
+    )
     args = parser.parse_args()
     torch.set_num_threads(1)
 
     piece = load_piece(args.piece)
     phrases = split_phrases(piece)
     total = args.steps * len(phrases)
-    print(f"{args.piece}: {len(piece)} notes in {len(phrases)} phrases; {args.steps} steps per phrase, {total} end-to-end\n")
+    print(
+        f"{args.piece}: {len(piece)} notes in {len(phrases)} phrases; {args.steps} steps per phrase, {total} end-to-end\n"
+    )
     rows = []
     for seed in args.seeds:
         env = EnvConfig(tactile=args.tactile)
-        config = TrainConfig(steps=args.steps, seed=seed, sac=SACConfig(exploration_steps=args.exploration_steps), env=env)
+        config = TrainConfig(
+            steps=args.steps, seed=seed, sac=SACConfig(exploration_steps=args.exploration_steps), env=env
+        )
         root = Path(args.store) / f"seed{seed}"
         models = Path(args.models) if args.models else root / "phrases"
         todo, _ = plan_jobs(phrase_jobs(phrases, config, models, piece=Path(args.piece).name), force=False)
@@ -84,11 +92,17 @@ def main() -> None:
         folder = store.model_dir(root / "whole", "whole-piece", whole)
         started = time.perf_counter()
         if not store.is_trained(folder):
-            train_policy(piece.shift(-piece.notes[0].onset), whole, folder, about={"key": "whole-piece", "piece": args.piece})
+            train_policy(
+                piece.shift(-piece.notes[0].onset), whole, folder, about={"key": "whole-piece", "piece": args.piece}
+            )
         end_to_end_minutes = (time.perf_counter() - started) / 60
 
-        composed = play(piece, lambda e: CompositionalController(e, phrases, models, fallback=False), env)
-        single = play(piece, lambda e: load_policy(folder, e), env)  # sees the whole piece's score window, as trained
+        composed = play(
+            piece, lambda e, models=models: CompositionalController(e, phrases, models, fallback=False), env
+        )
+        single = play(
+            piece, lambda e, folder=folder: load_policy(folder, e), env
+        )  # the whole piece's window, as trained
         scripted = play(piece, "scripted", env)
         for name, (f1s, maes, factor), minutes in (
             ("compositional", composed, compositional_minutes),
@@ -97,11 +111,15 @@ def main() -> None:
         ):
             rows.append((name, seed, f1s, maes, factor, minutes))
 
-    print("| controller | seed | note F1 (hand starts 0, 1, 2) | mean F1 | velocity MAE | real-time factor | training minutes |")
+    print(
+        "| controller | seed | note F1 (hand starts 0, 1, 2) | mean F1 | velocity MAE | real-time factor | training minutes |"
+    )
     print("| --- | ---: | --- | ---: | ---: | ---: | ---: |")
     for name, seed, f1s, maes, factor, minutes in rows:
-        print(f"| {name} | {seed} | {', '.join(f'{f:.3f}' for f in f1s)} | {statistics.mean(f1s):.3f} | "
-              f"{statistics.mean(maes):.1f} | {factor:.1f}x | {minutes:.1f} |")
+        print(
+            f"| {name} | {seed} | {', '.join(f'{f:.3f}' for f in f1s)} | {statistics.mean(f1s):.3f} | "
+            f"{statistics.mean(maes):.1f} | {factor:.1f}x | {minutes:.1f} |"
+        )
 
 
 if __name__ == "__main__":

@@ -36,8 +36,14 @@ CHECK_FILE = "check.json"
 def run_folder(task: str, seed: int, args) -> tuple[TrainConfig, Path]:
     """The run's configuration and the folder its checkpoint and policy go to."""
     config = TrainConfig(
-        steps=args.steps, seed=seed, explore=args.explore, eval_every=args.eval_every, eval_episodes=args.eval_episodes,
-        checkpoint_every=args.eval_every, until_f1=args.until_f1, sac=SACConfig(exploration_steps=args.exploration_steps),
+        steps=args.steps,
+        seed=seed,
+        explore=args.explore,
+        eval_every=args.eval_every,
+        eval_episodes=args.eval_episodes,
+        checkpoint_every=args.eval_every,
+        until_f1=args.until_f1,
+        sac=SACConfig(exploration_steps=args.exploration_steps),
         env=EnvConfig(tactile=args.tactile, actuated=tuple(args.joints.split(","))),
     )
     return config, store.model_dir(Path(args.store), f"task-{task}-seed{seed}", config)
@@ -48,8 +54,10 @@ def run(task: str, seed: int, args) -> tuple[str, int, dict]:
 
     torch.set_num_threads(1)
     config, folder = run_folder(task, seed, args)
-    manifest = store.read_manifest(folder) if store.is_trained(folder) else train_policy(
-        task, config, folder, about={"key": f"task-{task}", "piece": f"task {task}"}
+    manifest = (
+        store.read_manifest(folder)
+        if store.is_trained(folder)
+        else train_policy(task, config, folder, about={"key": f"task-{task}", "piece": f"task {task}"})
     )
     held = check(task, folder, manifest, args.check_episodes)
     (folder / CHECK_FILE).write_text(json.dumps(held) + "\n")
@@ -85,7 +93,11 @@ def progress(task: str, seed: int, args) -> dict | None:
     _, folder = run_folder(task, seed, args)
     if store.is_trained(folder):
         held = folder / CHECK_FILE
-        return {**store.read_manifest(folder), "finished": True, **({"check": json.loads(held.read_text())} if held.exists() else {})}
+        return {
+            **store.read_manifest(folder),
+            "finished": True,
+            **({"check": json.loads(held.read_text())} if held.exists() else {}),
+        }
     state = folder / store.CHECKPOINT_DIR / "state.json"
     if state.exists():
         return {**json.loads(state.read_text()), "finished": False}
@@ -101,7 +113,9 @@ def main() -> None:
     parser.add_argument("--eval-every", type=int, default=5_000)
     parser.add_argument("--eval-episodes", type=int, default=TASK_EVAL_EPISODES)
     parser.add_argument("--explore", default=TrainConfig.explore)
-    parser.add_argument("--check-episodes", type=int, default=30, help="fresh instances the kept policy plays at the end")
+    parser.add_argument(
+        "--check-episodes", type=int, default=30, help="fresh instances the kept policy plays at the end"
+    )
     parser.add_argument("--until-f1", type=float, default=None, help="stop a run once an evaluation reaches this F1")
     parser.add_argument("--tactile", action=argparse.BooleanOptionalAction, default=True)
     parser.add_argument("--joints", default=",".join(EnvConfig.actuated), help="finger joints the policy moves")
@@ -109,7 +123,11 @@ def main() -> None:
     parser.add_argument("--store", default="/tmp/pianobot-learn")
     parser.add_argument("--plot", default=None)
     parser.add_argument("--report", action="store_true", help="train nothing: print and plot what the runs have so far")
-    parser.add_argument("--check", action="store_true", help="with --report: unfinished runs' best policies so far play the new instances too")
+    parser.add_argument(
+        "--check",
+        action="store_true",
+        help="with --report: unfinished runs' best policies so far play the new instances too",
+    )
     args = parser.parse_args()
 
     jobs = [(task, seed) for task in args.tasks for seed in args.seeds]
@@ -119,18 +137,30 @@ def main() -> None:
     with ProcessPoolExecutor(max_workers=args.workers) as pool:
         results = list(pool.map(run, *zip(*jobs), [args] * len(jobs)))
 
-    print(f"steps {args.steps}, exploration {args.explore} for {args.exploration_steps} steps, tactile {args.tactile}\n")
-    print(f"| task | seed | last note F1 | kept note F1 (step) | kept, on {args.check_episodes} new instances: note F1 | velocity MAE | minutes |")
+    print(
+        f"steps {args.steps}, exploration {args.explore} for {args.exploration_steps} steps, tactile {args.tactile}\n"
+    )
+    print(
+        f"| task | seed | last note F1 | kept note F1 (step) | kept, on {args.check_episodes} new instances: note F1 | velocity MAE | minutes |"
+    )
     print("| --- | ---: | ---: | --- | ---: | ---: | ---: |")
     for task, seed, manifest in results:
-        last, kept, held = manifest["evaluations"][-1], manifest["evaluation"], manifest["check"]  # training keeps the best evaluated policy
+        last, kept, held = (
+            manifest["evaluations"][-1],
+            manifest["evaluation"],
+            manifest["check"],
+        )  # training keeps the best evaluated policy
         mae = "n/a" if held["velocity_mae"] is None else f"{held['velocity_mae']:.1f}"
-        print(f"| {task} | {seed} | {last['f1']:.3f} | {kept['f1']:.3f} ({kept['step']}) | {held['f1']:.3f} | {mae} | {manifest['seconds'] / 60:.1f} |")
+        print(
+            f"| {task} | {seed} | {last['f1']:.3f} | {kept['f1']:.3f} ({kept['step']}) | {held['f1']:.3f} | {mae} | {manifest['seconds'] / 60:.1f} |"
+        )
 
     if args.plot:
         plot(args, results)
     Path(args.store).mkdir(parents=True, exist_ok=True)
-    (Path(args.store) / "results.json").write_text(json.dumps([{"task": t, "seed": s, **m} for t, s, m in results], default=str))
+    (Path(args.store) / "results.json").write_text(
+        json.dumps([{"task": t, "seed": s, **m} for t, s, m in results], default=str)
+    )
 
 
 def report(args, jobs: list[tuple[str, int]]) -> None:
@@ -145,7 +175,9 @@ def report(args, jobs: list[tuple[str, int]]) -> None:
             continue
         results.append((task, seed, found))
         curve = " / ".join(f"{e['f1']:.2f}" for e in found["evaluations"])
-        best = found.get("evaluation") or found.get("best")  # the kept policy's figures (training's choice, ties broken on return)
+        best = found.get("evaluation") or found.get(
+            "best"
+        )  # the kept policy's figures (training's choice, ties broken on return)
         kept = "" if best is None else f"{best['f1']:.2f} ({best['step'] // 1000}k)"
         held = f"{found['check']['f1']:.2f}" if "check" in found else ""
         if not found["finished"] and args.check and (so_far := check_so_far(task, seed, args)) is not None:
@@ -165,17 +197,25 @@ def plot(args, results: list[tuple[str, int, dict]]) -> None:
     fig, ax = plt.subplots(figsize=(7, 4))
     colours = dict(zip(args.tasks, plt.rcParams["axes.prop_cycle"].by_key()["color"]))
     labelled = set()
-    for task, seed, manifest in results:
+    for task, _, manifest in results:
         points = manifest["evaluations"]
-        ax.plot([p["step"] for p in points], [p["f1"] for p in points], color=colours[task], alpha=0.8, marker=".",
-                label=None if task in labelled else task)
+        ax.plot(
+            [p["step"] for p in points],
+            [p["f1"] for p in points],
+            color=colours[task],
+            alpha=0.8,
+            marker=".",
+            label=None if task in labelled else task,
+        )
         labelled.add(task)
     ax.axhline(0.9, color="grey", linestyle=":", linewidth=1)
     ax.set_xlabel("environment steps")
     ax.set_ylabel(f"evaluation note F1 ({args.eval_episodes} instances)")
     ax.set_ylim(-0.02, 1.02)
     ax.legend()
-    ax.set_title(f"SAC, exploration '{args.explore}', tactile {'on' if args.tactile else 'off'}, seeds {', '.join(map(str, args.seeds))}")
+    ax.set_title(
+        f"SAC, exploration '{args.explore}', tactile {'on' if args.tactile else 'off'}, seeds {', '.join(map(str, args.seeds))}"
+    )
     fig.tight_layout()
     fig.savefig(args.plot, dpi=100)
     print(f"\nplot: {args.plot}")

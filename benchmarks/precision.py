@@ -64,8 +64,12 @@ def main() -> None:
     piece = load_part(Path(args.song), LoadOptions(), HandSpec())
     env = make_env(split_phrases(piece)[0].piece(), env_config)
     pianist = ScriptedPianist(env_config)
-    print(f"{Path(args.song).name}, first phrase, {args.starts} hand starts; action noise N(0, sigma) on [-1, 1] actions\n")
-    print("| noise on | sigma | note F1 (mean) | note F1 per start | step F1 | mean onset error of matched notes (ms) |")
+    print(
+        f"{Path(args.song).name}, first phrase, {args.starts} hand starts; action noise N(0, sigma) on [-1, 1] actions\n"
+    )
+    print(
+        "| noise on | sigma | note F1 (mean) | note F1 per start | step F1 | mean onset error of matched notes (ms) |"
+    )
     print("| --- | ---: | ---: | --- | ---: | ---: |")
     for sigma in args.sigmas:
         for part in PARTS if sigma > 0 else ("all",):
@@ -74,7 +78,10 @@ def main() -> None:
             onsets = [r[2] for r in runs if r[2] is not None]
             onset = f"{1000 * np.mean(onsets):.0f}" if onsets else "n/a"
             per_start = " ".join(f"{f:.2f}" for f in f1s)
-            print(f"| {part} | {sigma:g} | {np.mean(f1s):.2f} | {per_start} | {np.mean([r[1] for r in runs]):.2f} | {onset} |", flush=True)
+            print(
+                f"| {part} | {sigma:g} | {np.mean(f1s):.2f} | {per_start} | {np.mean([r[1] for r in runs]):.2f} | {onset} |",
+                flush=True,
+            )
     env.close()
 
 

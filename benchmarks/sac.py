@@ -85,7 +85,16 @@ def stable_baselines(tactile: bool, updates: int, repeats: int, net_arch: list[i
     if not SACConfig().score_input:  # the same inputs as ours: without the score window when ours skips it
         env = FilterObservation(env, [k for k in env.observation_space.spaces if k != "score"])
     kwargs = {} if net_arch is None else {"policy_kwargs": {"net_arch": net_arch}}
-    model = SB3SAC("MultiInputPolicy", env, **kwargs, batch_size=256, learning_starts=FILL, buffer_size=FILL + 10, device="cpu", seed=0)
+    model = SB3SAC(
+        "MultiInputPolicy",
+        env,
+        **kwargs,
+        batch_size=256,
+        learning_starts=FILL,
+        buffer_size=FILL + 10,
+        device="cpu",
+        seed=0,
+    )
     model.learn(FILL)  # fills the buffer with random steps
     model.train(gradient_steps=5, batch_size=256)
     rates = []
@@ -101,14 +110,20 @@ def main() -> None:
     parser.add_argument("--repeats", type=int, default=5)
     parser.add_argument("--updates", type=int, default=60)
     parser.add_argument("--threads", type=int, default=1, help="torch threads for both")
-    parser.add_argument("--compile", action="store_true", help="compare ours with torch.compile instead of Stable-Baselines3")
+    parser.add_argument(
+        "--compile", action="store_true", help="compare ours with torch.compile instead of Stable-Baselines3"
+    )
     args = parser.parse_args()
     torch.set_num_threads(args.threads)
     if args.compile:
         compare_compile(args)
         return
-    print(f"torch {torch.__version__}, {args.threads} thread(s), batch 256, {args.updates} updates x {args.repeats} repeats\n")
-    print("| configuration | pianobot updates/s | Stable-Baselines3 updates/s, its default net | ratio | Stable-Baselines3, 4 x 256 like ours | ratio |")
+    print(
+        f"torch {torch.__version__}, {args.threads} thread(s), batch 256, {args.updates} updates x {args.repeats} repeats\n"
+    )
+    print(
+        "| configuration | pianobot updates/s | Stable-Baselines3 updates/s, its default net | ratio | Stable-Baselines3, 4 x 256 like ours | ratio |"
+    )
     print("| --- | ---: | ---: | ---: | ---: | ---: |")
 
     def cell(rates: list[float]) -> str:
@@ -120,11 +135,15 @@ def main() -> None:
         deep = stable_baselines(tactile, args.updates, args.repeats, PAPER_DEPTH)
         a = statistics.median(mine)
         label = "tactile (3 fingertips, 15x20)" if tactile else "state only"
-        print(f"| {label} | {cell(mine)} | {cell(default)} | {a / statistics.median(default):.2f}x | {cell(deep)} | {a / statistics.median(deep):.2f}x |")
+        print(
+            f"| {label} | {cell(mine)} | {cell(default)} | {a / statistics.median(default):.2f}x | {cell(deep)} | {a / statistics.median(deep):.2f}x |"
+        )
 
 
 def compare_compile(args) -> None:
-    print(f"torch {torch.__version__}, {args.threads} thread(s), batch 256, {args.updates} updates x {args.repeats} repeats\n")
+    print(
+        f"torch {torch.__version__}, {args.threads} thread(s), batch 256, {args.updates} updates x {args.repeats} repeats\n"
+    )
     print("| configuration | eager updates/s | torch.compile updates/s | ratio |")
     print("| --- | ---: | ---: | ---: |")
     for tactile in (False, True):
@@ -132,7 +151,9 @@ def compare_compile(args) -> None:
         compiled = ours(tactile, args.updates, args.repeats, compiled=True)  # compiles during its warm-up updates
         a, b = statistics.median(eager), statistics.median(compiled)
         label = "tactile (3 fingertips, 15x20)" if tactile else "state only"
-        print(f"| {label} | {a:.1f} ({', '.join(f'{x:.1f}' for x in eager)}) | {b:.1f} ({', '.join(f'{x:.1f}' for x in compiled)}) | {b / a:.2f}x |")
+        print(
+            f"| {label} | {a:.1f} ({', '.join(f'{x:.1f}' for x in eager)}) | {b:.1f} ({', '.join(f'{x:.1f}' for x in compiled)}) | {b / a:.2f}x |"
+        )
 
 
 if __name__ == "__main__":

@@ -21,10 +21,9 @@ import sys
 import time
 from pathlib import Path
 
-
-from pianobot.pianist.scripted import ScriptedPianist
 from pianobot.env.piano import EnvConfig, PianoEnv
 from pianobot.music.load import load_piece
+from pianobot.pianist.scripted import ScriptedPianist
 from pianobot.sim.tactile import TactileConfig, TactileRenderer
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -88,20 +87,26 @@ def main() -> None:
     if args.peer_python:
         run = subprocess.run(
             [args.peer_python, str(ROOT / "benchmarks" / "peer_robopianist.py"), str(len(actions)), str(args.repeats)],
-            capture_output=True, text=True, env={"MUJOCO_GL": "egl", "PATH": "/usr/bin:/bin"},
+            capture_output=True,
+            text=True,
+            env={"MUJOCO_GL": "egl", "PATH": "/usr/bin:/bin"},
         )
         if run.returncode == 0:
             figures["RoboPianist env steps/s (peer)"] = [float(x) for x in run.stdout.split()]
         else:
             print(f"peer RoboPianist did not run: {run.stderr.strip().splitlines()[-1:]}", file=sys.stderr)
 
-    print(f"{len(actions)} control steps per replay, {len(touching)} fingertip frames in contact, {args.repeats} repeats\n")
+    print(
+        f"{len(actions)} control steps per replay, {len(touching)} fingertip frames in contact, {args.repeats} repeats\n"
+    )
     print("| figure | median | runs |")
     print("| --- | ---: | --- |")
     for name, values in figures.items():
         print(f"| {name} | {statistics.median(values):.0f} | {', '.join(f'{v:.0f}' for v in values)} |")
     if "RoboPianist env steps/s (peer)" in figures:
-        ratio = statistics.median(figures["env steps/s, tactile (3 fingertips)"]) / statistics.median(figures["RoboPianist env steps/s (peer)"])
+        ratio = statistics.median(figures["env steps/s, tactile (3 fingertips)"]) / statistics.median(
+            figures["RoboPianist env steps/s (peer)"]
+        )
         print(f"\npianobot with tactile images / RoboPianist: {ratio:.2f}x")
 
 

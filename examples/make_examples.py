@@ -23,8 +23,8 @@ import mido
 import numpy as np
 
 from pianobot.music.midi_io import write_midi
-from pianobot.music.pig import write_pig
 from pianobot.music.piece import Note, Piece, parse_pitch
+from pianobot.music.pig import write_pig
 
 OUT = Path(__file__).parent / "midi"
 
@@ -62,14 +62,12 @@ TASKS = {
 MELODIES = {
     "twinkle": melody(
         90,
-        "C4:1:2 C4:1:2 G4:1:3 G4:1:3 A4:1:4 A4:1:4 G4:2:3 "
-        "F4:1:2 F4:1:2 E4:1:4 E4:1:4 D4:1:3 D4:1:3 C4:2:2",
+        "C4:1:2 C4:1:2 G4:1:3 G4:1:3 A4:1:4 A4:1:4 G4:2:3 F4:1:2 F4:1:2 E4:1:4 E4:1:4 D4:1:3 D4:1:3 C4:2:2",
         [72, 72, 84, 84, 92, 92, 86, 76, 76, 70, 70, 66, 66, 60],
     ),
     "ode-to-joy": melody(
         90,
-        "E4:1:2 E4:1:2 F4:1:3 G4:1:4 G4:1:4 F4:1:3 E4:1:2 "
-        "D4:1:3 C4:1:2 C4:1:2 D4:1:3 E4:1:4 E4:3/2:4 D4:1/2:3 D4:2:3",
+        "E4:1:2 E4:1:2 F4:1:3 G4:1:4 G4:1:4 F4:1:3 E4:1:2 D4:1:3 C4:1:2 C4:1:2 D4:1:3 E4:1:4 E4:3/2:4 D4:1/2:3 D4:2:3",
         [70, 72, 76, 84, 86, 80, 74, 70, 64, 66, 70, 80, 84, 72, 62],
     ),
     "mary": melody(
@@ -81,8 +79,7 @@ MELODIES = {
     ),
     "c-major-scale": melody(
         80,
-        "C4:1:2 D4:1:3 E4:1:4 F4:1:2 G4:1:3 A4:1:4 B4:1:2 C5:1:3 "
-        "B4:1:2 A4:1:3 G4:1:2 F4:1:4 E4:1:3 D4:1:2 C4:2:2",
+        "C4:1:2 D4:1:3 E4:1:4 F4:1:2 G4:1:3 A4:1:4 B4:1:2 C5:1:3 B4:1:2 A4:1:3 G4:1:2 F4:1:4 E4:1:3 D4:1:2 C4:2:2",
         [60, 64, 68, 72, 76, 80, 84, 90, 84, 80, 76, 72, 68, 64, 60],
     ),
 }
@@ -129,13 +126,17 @@ def performed(right: str, left: str, bpm: float, seed: int = 0) -> mido.MidiFile
                 on = max(0, round((beat + rng.normal(0, 0.02)) * tpb))
                 off = round((beat + length + rng.uniform(0.0, 0.08)) * tpb)  # legato: a little into the next note
                 velocity = int(np.clip(base + 18 * phrase + rng.normal(0, 5), 20, 120))
-                events += [(on, 1, mido.Message("note_on", note=parse_pitch(pitch), velocity=velocity)),
-                           (off, 0, mido.Message("note_off", note=parse_pitch(pitch), velocity=40))]
+                events += [
+                    (on, 1, mido.Message("note_on", note=parse_pitch(pitch), velocity=velocity)),
+                    (off, 0, mido.Message("note_off", note=parse_pitch(pitch), velocity=40)),
+                ]
             beat += length
         if name == "Right Hand":
             for bar in range(int(beat // 3) + 1):  # pedal up and down again just after each downbeat
-                events += [(bar * 3 * tpb + 30, 0, mido.Message("control_change", control=64, value=0)),
-                           (bar * 3 * tpb + 60, 1, mido.Message("control_change", control=64, value=100))]
+                events += [
+                    (bar * 3 * tpb + 30, 0, mido.Message("control_change", control=64, value=0)),
+                    (bar * 3 * tpb + 60, 1, mido.Message("control_change", control=64, value=100)),
+                ]
         track = mido.MidiTrack([mido.MetaMessage("track_name", name=name, time=0)])
         last = 0
         for tick, _, message in sorted(events, key=lambda e: (e[0], e[1])):

@@ -97,8 +97,13 @@ def test_thumb_option_enables_finger_one(tmp_path):
 def test_track_option(tmp_path):
     midi = mido.MidiFile(type=1)
     for name, pitch in (("right", 72), ("left", 48)):
-        track = mido.MidiTrack([mido.MetaMessage("track_name", name=name), mido.Message("note_on", note=pitch, velocity=80),
-                                mido.Message("note_off", note=pitch, time=480)])
+        track = mido.MidiTrack(
+            [
+                mido.MetaMessage("track_name", name=name),
+                mido.Message("note_on", note=pitch, velocity=80),
+                mido.Message("note_off", note=pitch, time=480),
+            ]
+        )
         midi.tracks.append(track)
     midi.save(tmp_path / "two.mid")
     assert_one_line_error(run("inspect", tmp_path / "two.mid"), "outside the keyboard", "C3")
@@ -118,8 +123,12 @@ def test_bad_files_answer_with_one_line(tmp_path, scale_file, command):
     truncated = write_bytes(tmp_path, "t.mid", scale_file.read_bytes()[:30])
     empty = tmp_path / "empty.mid"
     mido.MidiFile(tracks=[mido.MidiTrack([mido.MetaMessage("track_name", name="x")])]).save(empty)
-    for bad, words in ((not_midi, "not a MIDI file"), (truncated, "truncated"), (empty, "no notes"),
-                       (tmp_path / "missing.mid", "no such file")):
+    for bad, words in (
+        (not_midi, "not a MIDI file"),
+        (truncated, "truncated"),
+        (empty, "no notes"),
+        (tmp_path / "missing.mid", "no such file"),
+    ):
         args = ("inspect", bad) if command == "inspect" else ("score", scale_file, bad)
         assert_one_line_error(run(*args), str(bad.name) if words != "no such file" else "missing.mid", words)
 
@@ -144,8 +153,14 @@ def test_sidecar_problems(tmp_path, scale):
 def test_overlaps_are_a_warning_not_an_error(tmp_path):
     midi = mido.MidiFile(type=1)
     for _ in range(2):
-        midi.tracks.append(mido.MidiTrack([mido.Message("note_on", note=60, velocity=80, time=0 if not midi.tracks else 240),
-                                           mido.Message("note_off", note=60, time=480)]))
+        midi.tracks.append(
+            mido.MidiTrack(
+                [
+                    mido.Message("note_on", note=60, velocity=80, time=0 if not midi.tracks else 240),
+                    mido.Message("note_off", note=60, time=480),
+                ]
+            )
+        )
     midi.save(tmp_path / "overlap.mid")
     result = run("inspect", tmp_path / "overlap.mid")
     assert result.exit_code == 0, result.output
@@ -167,7 +182,18 @@ def test_version():
 
 def test_play_scripted_writes_a_performance_that_scores_well(tmp_path):
     out = tmp_path / "out.mid"
-    result = run("play", EXAMPLES / "three-note.mid", "-o", out, "--controller", "scripted", "--video", tmp_path / "out.mp4", "--wav", tmp_path / "out.wav")
+    result = run(
+        "play",
+        EXAMPLES / "three-note.mid",
+        "-o",
+        out,
+        "--controller",
+        "scripted",
+        "--video",
+        tmp_path / "out.mp4",
+        "--wav",
+        tmp_path / "out.wav",
+    )
     assert result.exit_code == 0, result.output
     report = json.loads((tmp_path / "out.report.json").read_text())
     assert report["f1"] >= 0.95 and report["velocity_mae"] <= 10 and report["controller"] == "scripted"
@@ -179,7 +205,6 @@ def test_play_scripted_writes_a_performance_that_scores_well(tmp_path):
     scored = run("score", out, EXAMPLES / "three-note.mid", "--json", tmp_path / "s.json")
     assert json.loads((tmp_path / "s.json").read_text())["f1"] == report["f1"]
     import imageio.v2 as imageio
-
     from scipy.io import wavfile
 
     rate, audio = wavfile.read(tmp_path / "out.wav")
@@ -197,7 +222,9 @@ def test_play_bad_requests_answer_with_one_line(tmp_path, scale):
     assert_one_line_error(run("play", song, "-o", tmp_path / "x.mid", "--controller", "robot"), "--controller robot")
     assert_one_line_error(run("play", song, "-o", tmp_path / "x.mid", "--video", tmp_path / "v.gif"), "*.mp4")
     assert_one_line_error(run("play", song, "-o", tmp_path / "x.mid", "--wav", tmp_path / "a.mp3"), "*.wav")
-    assert_one_line_error(run("play", song, "-o", tmp_path / "x.mid", "--hand", "right", "--track", "0"), "--track or --hand")
+    assert_one_line_error(
+        run("play", song, "-o", tmp_path / "x.mid", "--hand", "right", "--track", "0"), "--track or --hand"
+    )
     assert_one_line_error(run("play", song, "-o", tmp_path / "x.mid", "--quantize", "eighth"), "--quantize eighth")
     assert not (tmp_path / "x.mid").exists()
 
@@ -229,14 +256,30 @@ def test_train_bad_requests_answer_with_one_line(tmp_path):
 
 
 def test_train_then_skip(tmp_path):
-    args = ("train", EXAMPLES / "one-note.mid", "--steps", "80", "--exploration-steps", "40", "--no-tactile", "--models", tmp_path)
+    args = (
+        "train",
+        EXAMPLES / "one-note.mid",
+        "--steps",
+        "80",
+        "--exploration-steps",
+        "40",
+        "--no-tactile",
+        "--models",
+        tmp_path,
+    )
     first = run(*args)
     assert first.exit_code == 0, first.output
     folders = [d for d in tmp_path.iterdir() if d.is_dir()]
     assert len(folders) == 1 and (folders[0] / "policy.safetensors").exists()
     manifest = json.loads((folders[0] / "manifest.json").read_text())
-    assert manifest["piece"] == "one-note.mid" and manifest["steps"] == 80 and manifest["config"]["env"]["tactile"] is False
-    assert manifest["evaluation"]["step"] == 80 and "kept" in first.output  # the summary says which evaluation's policy was kept
+    assert (
+        manifest["piece"] == "one-note.mid"
+        and manifest["steps"] == 80
+        and manifest["config"]["env"]["tactile"] is False
+    )
+    assert (
+        manifest["evaluation"]["step"] == 80 and "kept" in first.output
+    )  # the summary says which evaluation's policy was kept
     second = run(*args)
     assert second.exit_code == 0 and "already trained" in second.output and "training 0 policies" in second.output
     third = run(*args, "--force")
@@ -247,7 +290,18 @@ def test_train_a_task_family_evaluates_on_many_instances(tmp_path):
     """A task's instances all differ: its evaluation plays TASK_EVAL_EPISODES of them, not a phrase's 3."""
     from pianobot.learn.train import TASK_EVAL_EPISODES
 
-    result = run("train", "--task", "one-note", "--steps", "60", "--exploration-steps", "30", "--no-tactile", "--models", tmp_path)
+    result = run(
+        "train",
+        "--task",
+        "one-note",
+        "--steps",
+        "60",
+        "--exploration-steps",
+        "30",
+        "--no-tactile",
+        "--models",
+        tmp_path,
+    )
     assert result.exit_code == 0, result.output
     (folder,) = [d for d in tmp_path.iterdir() if d.is_dir()]
     manifest = json.loads((folder / "manifest.json").read_text())
@@ -258,18 +312,33 @@ def test_train_a_task_family_evaluates_on_many_instances(tmp_path):
 def test_play_sac_without_policies_names_the_phrase_and_the_train_command(tmp_path):
     """The trained policies play by default: without them, one line says how to get them or what else to do."""
     result = run("play", EXAMPLES / "three-note.mid", "-o", tmp_path / "x.mid", "--models", tmp_path)
-    assert_one_line_error(result, "phrase 0 (C4 D4 E4)", "pianobot train", "--fallback scripted", "--controller scripted")
+    assert_one_line_error(
+        result, "phrase 0 (C4 D4 E4)", "pianobot train", "--fallback scripted", "--controller scripted"
+    )
     assert not (tmp_path / "x.mid").exists()
 
 
 def test_play_sac_composes_trained_and_fallback_phrases(tmp_path):
     """Phrase 0 has a (barely) trained policy, phrase 1 none: --fallback scripted plays it and says so."""
     one = EXAMPLES / "one-note.mid"
-    trained = run("train", one, "--steps", "60", "--exploration-steps", "30", "--no-tactile", "--models", tmp_path / "models")
+    trained = run(
+        "train", one, "--steps", "60", "--exploration-steps", "30", "--no-tactile", "--models", tmp_path / "models"
+    )
     assert trained.exit_code == 0, trained.output
     note = Piece((Note(0.0, 64, 1.0, 80, 3), Note(3.0, 67, 4.0, 70, 4)), bpm=60)  # phrase 0 = one-note.mid
     song = write_midi(note, tmp_path / "song.mid")
-    args = ("play", song, "-o", tmp_path / "out.mid", "--controller", "sac", "--models", tmp_path / "models", "--phrase-notes", "1")
+    args = (
+        "play",
+        song,
+        "-o",
+        tmp_path / "out.mid",
+        "--controller",
+        "sac",
+        "--models",
+        tmp_path / "models",
+        "--phrase-notes",
+        "1",
+    )
     assert_one_line_error(run(*args), "phrase 1 (G4)")
     result = run(*args, "--fallback", "scripted")
     assert result.exit_code == 0, result.output
@@ -288,13 +357,18 @@ def test_play_composes_policies_with_different_agent_settings(tmp_path):
     from pianobot.agent import store
     from pianobot.agent.config import SACConfig
     from pianobot.env.piano import EnvConfig
-    from pianobot.music.phrases import split_phrases
     from pianobot.learn.config import TrainConfig
     from pianobot.learn.train import train_policy
+    from pianobot.music.phrases import split_phrases
 
     piece = Piece((Note(0.0, 64, 1.0, 80, 3), Note(3.0, 67, 4.0, 70, 4)), bpm=60)
     song = write_midi(piece, tmp_path / "song.mid")
-    base = TrainConfig(steps=40, eval_episodes=1, sac=SACConfig(exploration_steps=20, batch_size=16, hidden=16), env=EnvConfig(tactile=False))
+    base = TrainConfig(
+        steps=40,
+        eval_episodes=1,
+        sac=SACConfig(exploration_steps=20, batch_size=16, hidden=16),
+        env=EnvConfig(tactile=False),
+    )
     for phrase, reads_score in zip(split_phrases(piece, 1), (True, False)):
         config = replace(base, sac=replace(base.sac, score_input=reads_score))
         train_policy(phrase.piece(), config, store.model_dir(tmp_path / "models", phrase.hash, config))
@@ -311,9 +385,9 @@ def read_played(path):
 
 
 def test_sections_hand_over_after_the_last_strike():
-    from pianobot.perform.compose import CompositionalController
     from pianobot.env.piano import EnvConfig, PianoEnv
     from pianobot.music.phrases import split_phrases
+    from pianobot.perform.compose import CompositionalController
 
     piece = Piece((Note(0.0, 60, 0.5, 80, 2), Note(0.5, 62, 1.0, 80, 3), Note(1.0, 64, 1.5, 80, 4)), bpm=60)
     phrases = split_phrases(piece, 1)
@@ -334,9 +408,28 @@ def test_sections_hand_over_after_the_last_strike():
 
 
 def test_train_options_reach_the_stored_configuration(tmp_path):
-    result = run("train", EXAMPLES / "one-note.mid", "--steps", "50", "--exploration-steps", "25", "--no-tactile",
-                 "--control", "torque", "--reward", "wasserstein", "--no-fingering-gate", "--joints", "mcp,pip",
-                 "--explore", "uniform", "--seed", "3", "--models", tmp_path)
+    result = run(
+        "train",
+        EXAMPLES / "one-note.mid",
+        "--steps",
+        "50",
+        "--exploration-steps",
+        "25",
+        "--no-tactile",
+        "--control",
+        "torque",
+        "--reward",
+        "wasserstein",
+        "--no-fingering-gate",
+        "--joints",
+        "mcp,pip",
+        "--explore",
+        "uniform",
+        "--seed",
+        "3",
+        "--models",
+        tmp_path,
+    )
     assert result.exit_code == 0, result.output
     config = json.loads(next(tmp_path.glob("*/manifest.json")).read_text())["config"]
     assert config["seed"] == 3 and config["explore"] == "uniform" and config["sac"]["exploration_steps"] == 25
@@ -352,19 +445,46 @@ def test_train_fingering_options_are_distinct(tmp_path):
     piece = Piece((Note(0.0, 64, 1.0, 80, None),), bpm=60)
     song = write_midi(piece, tmp_path / "song.mid")
     pig = write_pig(Piece((Note(0.0, 64, 1.0, 80, 4),), bpm=60), tmp_path / "fingers.txt")
-    result = run("train", song, "--fingering", pig, "--no-fingering-gate", "--steps", "40", "--exploration-steps", "20",
-                 "--no-tactile", "--models", tmp_path / "m")
+    result = run(
+        "train",
+        song,
+        "--fingering",
+        pig,
+        "--no-fingering-gate",
+        "--steps",
+        "40",
+        "--exploration-steps",
+        "20",
+        "--no-tactile",
+        "--models",
+        tmp_path / "m",
+    )
     assert result.exit_code == 0, result.output
     manifest = json.loads(next((tmp_path / "m").glob("*/manifest.json")).read_text())
-    assert [n["finger"] for n in manifest["target"]] == [4] and manifest["config"]["env"]["reward"]["fingering_gate"] is False
+    assert [n["finger"] for n in manifest["target"]] == [4] and manifest["config"]["env"]["reward"][
+        "fingering_gate"
+    ] is False
     help_text = run("train", "--help").output
     assert help_text.count("--fingering ") == 1 and "--fingering-gate" in help_text
 
 
 def test_train_workers_train_phrases_in_parallel(tmp_path):
     song = write_midi(Piece((Note(0.0, 60, 0.5, 80, 2), Note(2.0, 67, 2.5, 70, 4)), bpm=60), tmp_path / "two.mid")
-    result = run("train", song, "--phrase-notes", "1", "--steps", "40", "--exploration-steps", "20", "--no-tactile",
-                 "--workers", "2", "--models", tmp_path / "models")
+    result = run(
+        "train",
+        song,
+        "--phrase-notes",
+        "1",
+        "--steps",
+        "40",
+        "--exploration-steps",
+        "20",
+        "--no-tactile",
+        "--workers",
+        "2",
+        "--models",
+        tmp_path / "models",
+    )
     assert result.exit_code == 0, result.output
     manifests = [json.loads(p.read_text()) for p in (tmp_path / "models").glob("*/manifest.json")]
     assert sorted(m["phrases"] for m in manifests) == [[0], [1]] and all(m["steps"] == 40 for m in manifests)
@@ -381,15 +501,20 @@ MODELS = Path(__file__).parent.parent / "models"
 
 def _committed_examples() -> list[Path]:
     """Examples whose every phrase has a policy committed in models/."""
-    from pianobot.perform.compose import missing_phrases, trained_split
     from pianobot.music.load import load_piece
+    from pianobot.perform.compose import missing_phrases, trained_split
 
-    return [p for p in sorted(EXAMPLES.glob("*.mid")) if "performed" not in p.stem
-            and not missing_phrases(MODELS, trained_split(MODELS, load_piece(p), None))]
+    return [
+        p
+        for p in sorted(EXAMPLES.glob("*.mid"))
+        if "performed" not in p.stem and not missing_phrases(MODELS, trained_split(MODELS, load_piece(p), None))
+    ]
 
 
 def test_the_committed_policies_cover_the_papers_five_tasks_and_a_melody():
-    assert {"one-note", "three-note", "six-note", "rhythmic", "chord", "twinkle"} <= {p.stem for p in _committed_examples()}
+    assert {"one-note", "three-note", "six-note", "rhythmic", "chord", "twinkle"} <= {
+        p.stem for p in _committed_examples()
+    }
 
 
 @pytest.mark.parametrize("song", _committed_examples(), ids=lambda p: p.stem)

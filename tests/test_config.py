@@ -27,7 +27,9 @@ def unusual() -> TrainConfig:
     """Every kind of field away from its default: nested dataclasses, tuples, tuples of tuples, None."""
     world = WorldConfig(control="torque", hand=HandConfig(spec=HandSpec((1, 2, 3, 4))))
     env = EnvConfig(world=world, reward=RewardConfig(kind="squared"), actuated=("mcp", "pip"), tactile_pool=None)
-    return TrainConfig(steps=123_456, seed=7, explore="prior", until_f1=0.5, sac=SACConfig(log_std_bounds=(-4.0, 1.0)), env=env)
+    return TrainConfig(
+        steps=123_456, seed=7, explore="prior", until_f1=0.5, sac=SACConfig(log_std_bounds=(-4.0, 1.0)), env=env
+    )
 
 
 def test_a_configuration_survives_the_json_round_trip_exactly():
@@ -42,16 +44,19 @@ def test_fields_left_out_take_their_defaults():
     assert from_dict(TrainConfig, {"steps": 99_999}) == TrainConfig(steps=99_999)
 
 
-@pytest.mark.parametrize("path, value, message", [
-    (("sac", "hidden"), "256", r"config\.sac\.hidden: expected a whole number, got str '256'"),
-    (("sac", "hidden"), True, r"config\.sac\.hidden: expected a whole number"),
-    (("sac", "learning_rate"), float("inf"), r"config\.sac\.learning_rate: expected a finite number"),
-    (("env", "tactile"), 1, r"config\.env\.tactile: expected true or false"),
-    (("env", "tactile_pool"), [15], r"config\.env\.tactile_pool: expected 2 values, got 1"),
-    (("env", "world", "control"), "position", r"config\.env\.world: control must be one of velocity, torque"),
-    (("env", "world", "hand"), [], r"config\.env\.world\.hand: expected a mapping"),
-    (("env", "colour"), 1, r"config\.env\.colour: not a field of EnvConfig"),
-])
+@pytest.mark.parametrize(
+    "path, value, message",
+    [
+        (("sac", "hidden"), "256", r"config\.sac\.hidden: expected a whole number, got str '256'"),
+        (("sac", "hidden"), True, r"config\.sac\.hidden: expected a whole number"),
+        (("sac", "learning_rate"), float("inf"), r"config\.sac\.learning_rate: expected a finite number"),
+        (("env", "tactile"), 1, r"config\.env\.tactile: expected true or false"),
+        (("env", "tactile_pool"), [15], r"config\.env\.tactile_pool: expected 2 values, got 1"),
+        (("env", "world", "control"), "position", r"config\.env\.world: control must be one of velocity, torque"),
+        (("env", "world", "hand"), [], r"config\.env\.world\.hand: expected a mapping"),
+        (("env", "colour"), 1, r"config\.env\.colour: not a field of EnvConfig"),
+    ],
+)
 def test_a_value_that_does_not_fit_names_its_field(path, value, message):
     data = to_dict(TrainConfig())
     node = data
@@ -77,8 +82,11 @@ def test_a_format_1_manifest_is_upgraded_to_what_it_meant(tmp_path):
     rebuilt = from_dict(TrainConfig, manifest["config"])
     assert rebuilt.env.tactile_pool == (30, 40) and not rebuilt.env.target_velocity and not rebuilt.env.target_onsets
     assert rebuilt.sac.score_input is True
-    assert rebuilt == replace(TrainConfig(), env=replace(TrainConfig().env, tactile_pool=(30, 40), target_velocity=False,
-                                                         target_onsets=False), sac=replace(TrainConfig().sac, score_input=True))
+    assert rebuilt == replace(
+        TrainConfig(),
+        env=replace(TrainConfig().env, tactile_pool=(30, 40), target_velocity=False, target_onsets=False),
+        sac=replace(TrainConfig().sac, score_input=True),
+    )
 
 
 def test_committed_models_are_in_the_current_format_and_named_by_their_configuration():

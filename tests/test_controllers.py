@@ -6,17 +6,17 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from pianobot.perform.controllers import RandomController
-from pianobot.perform.rollout import rollout
-from pianobot.pianist.scripted import ScriptedPianist
 from pianobot.env.piano import EnvConfig
-from pianobot.music.metrics import compare
 from pianobot.errors import PianobotWarning
-from pianobot.pianist.fingering import ensure_fingering
 from pianobot.music.instrument import HandSpec, KeyboardSpec
 from pianobot.music.load import LoadOptions, load_part, load_piece
+from pianobot.music.metrics import compare
 from pianobot.music.tasks import TASKS, make_task
+from pianobot.perform.controllers import RandomController
 from pianobot.perform.perform import perform
+from pianobot.perform.rollout import rollout
+from pianobot.pianist.fingering import ensure_fingering
+from pianobot.pianist.scripted import ScriptedPianist
 from pianobot.sim.world import WorldConfig
 
 EXAMPLES = sorted((Path(__file__).parent.parent / "examples" / "midi").glob("*.mid"))
@@ -70,8 +70,8 @@ def test_scripted_pianist_needs_velocity_control():
 def test_scripted_pianist_plays_a_phrase_from_every_hand_start():
     """As the teacher of training it meets random wrist starts and finger shapes; start 10001 once
     left a fingertip hovering for ever a hair under the height for crossing out of the black keys' band."""
-    from pianobot.music.phrases import split_phrases
     from pianobot.learn.train import EVAL_SEED, make_env
+    from pianobot.music.phrases import split_phrases
 
     phrase = split_phrases(load_piece(Path(__file__).parent.parent / "examples" / "midi" / "three-note.mid"))[0]
     config = EnvConfig(tactile=False)
@@ -85,8 +85,8 @@ def test_scripted_pianist_strikes_in_the_step_of_each_onset():
     """Control steps are centred on the score's rows, and the reward compares a step's keys with
     its row: a key played on time must sound in the step of its onset's row, not the one before
     (before the steps were centred, the on-time strike fell in the row before and was penalised)."""
-    from pianobot.music.phrases import split_phrases
     from pianobot.learn.train import EVAL_SEED, make_env
+    from pianobot.music.phrases import split_phrases
 
     phrase = split_phrases(load_piece(Path(__file__).parent.parent / "examples" / "midi" / "rhythmic.mid"))[0]
     config = EnvConfig(tactile=False)

@@ -6,9 +6,9 @@ import pytest
 from gymnasium.utils.env_checker import check_env
 
 from pianobot.env.piano import EnvConfig, PianoEnv, finger_targets
+from pianobot.env.rewards import RewardConfig
 from pianobot.music.piece import Note, Piece
 from pianobot.music.tensor import FINGER, NOTE, VELOCITY
-from pianobot.env.rewards import RewardConfig
 
 PHRASE = Piece((Note(0.0, 60, 0.5, 70, 2), Note(0.5, 62, 1.0, 90, 3)), bpm=60)
 
@@ -56,7 +56,7 @@ def test_the_score_window_slides_one_step_per_step():
     observation, _ = env.reset(seed=0)
     lead = env.lead_steps
     assert lead == 20  # 1 s lead-in at 20 Hz
-    assert observation["score"][lead - 10:, 0, 0].sum() == 0  # C4 lies beyond the 10-step lookahead
+    assert observation["score"][lead - 10 :, 0, 0].sum() == 0  # C4 lies beyond the 10-step lookahead
     for _ in range(lead - 10):
         observation, *_ = env.step(np.zeros(13))
     assert observation["score"][10, 0, 0] == 1  # C4's onset has just come into view
@@ -126,7 +126,9 @@ def test_registered_ids():
     observation, _ = env.reset(seed=0)
     assert observation["score"].shape == (11, 24, 5)
     assert gym.make("pianobot/Piano-v0", piece=PHRASE).unwrapped.piece == PHRASE
-    assert {"pianobot/ThreeNote-v0", "pianobot/SixNote-v0", "pianobot/Rhythmic-v0", "pianobot/Chord-v0"} <= set(gym.registry)
+    assert {"pianobot/ThreeNote-v0", "pianobot/SixNote-v0", "pianobot/Rhythmic-v0", "pianobot/Chord-v0"} <= set(
+        gym.registry
+    )
 
 
 def test_unplayable_phrase_is_refused():
@@ -192,7 +194,9 @@ def test_finger_targets_point_from_each_fingertip_to_its_next_key():
     assert targets[0, 4] == pytest.approx(PHRASE.notes[0].velocity / 127)  # how loud
     assert targets[0, 5] == 0  # holds nothing
     assert not targets[1].any() and not targets[2].any()
-    older = PianoEnv(piece=PHRASE, config=EnvConfig(tactile=False, target_velocity=False, target_onsets=False))  # as policies before them
+    older = PianoEnv(
+        piece=PHRASE, config=EnvConfig(tactile=False, target_velocity=False, target_onsets=False)
+    )  # as policies before them
     assert older.reset(seed=3)[0]["targets"].shape == (3, 4)
     without = PianoEnv(piece=PHRASE, config=EnvConfig(tactile=False, target_observations=False))
     assert "targets" not in without.reset(seed=0)[0]

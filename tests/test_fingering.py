@@ -5,26 +5,27 @@ import math
 import mido
 import numpy as np
 import pytest
+from conftest import midi_file
 from typer.testing import CliRunner
 
 from pianobot.cli.app import app
 from pianobot.errors import PianobotError
-from pianobot.pianist.fingering import Planner, ensure_fingering, plan_fingering
-from pianobot.music.metrics import compare
 from pianobot.music.instrument import HandSpec, KeyboardSpec
 from pianobot.music.load import LoadOptions, load_part, load_piece, thin_chords
+from pianobot.music.metrics import compare
 from pianobot.music.midi_io import read_midi, write_midi
 from pianobot.music.piece import Note, Piece, parse_pitch
 from pianobot.perform.perform import perform
+from pianobot.pianist.fingering import Planner, ensure_fingering, plan_fingering
 from pianobot.sim.hand import FINGER_BASE_X
-
-from conftest import midi_file
 
 MAJOR = [0, 2, 4, 5, 7, 9, 11]
 
 
 def melody(names: str, beat: float = 0.5, velocity: int = 80) -> Piece:
-    return Piece(tuple(Note(i * beat, parse_pitch(n), (i + 1) * beat, velocity) for i, n in enumerate(names.split())), bpm=120)
+    return Piece(
+        tuple(Note(i * beat, parse_pitch(n), (i + 1) * beat, velocity) for i, n in enumerate(names.split())), bpm=120
+    )
 
 
 def tune(rng: np.random.Generator, notes: int = 14) -> Piece:
@@ -100,8 +101,14 @@ def test_a_chord_wider_than_the_hand_is_a_clear_error():
 
 
 def test_ensure_fingering_keeps_given_fingering_unless_asked():
-    piece = melody("C4 D4 E4").with_fingers([4, 3, 2]) if False else Piece(tuple(
-        Note(i * 0.5, p, i * 0.5 + 0.5, 80, f) for i, (p, f) in enumerate([(60, 2), (62, 2), (64, 2)])), bpm=120)
+    piece = (
+        melody("C4 D4 E4").with_fingers([4, 3, 2])
+        if False
+        else Piece(
+            tuple(Note(i * 0.5, p, i * 0.5 + 0.5, 80, f) for i, (p, f) in enumerate([(60, 2), (62, 2), (64, 2)])),
+            bpm=120,
+        )
+    )
     kept, plan = ensure_fingering(piece, KeyboardSpec(), HandSpec())
     assert kept is piece and plan is None
     refingered, plan = ensure_fingering(piece, KeyboardSpec(), HandSpec(), refinger=True)
@@ -122,10 +129,21 @@ def test_scripted_pianist_plays_planner_fingered_tunes():
 def _recording(path, names=("Right Hand", "Left Hand"), jitter=0):
     on = lambda p, v=80: mido.Message("note_on", note=p, velocity=v)  # noqa: E731
     off = lambda p: mido.Message("note_off", note=p, velocity=0)  # noqa: E731
-    pedal = [(0, mido.Message("control_change", control=64, value=127)), (1900, mido.Message("control_change", control=64, value=0))]
+    pedal = [
+        (0, mido.Message("control_change", control=64, value=127)),
+        (1900, mido.Message("control_change", control=64, value=0)),
+    ]
     right = [(0, on(72, 90)), (500, off(72)), (480 + jitter, on(74, 70)), (960, off(74))]
-    right += [(960, on(67)), (960 + jitter, on(71)), (960 + 2 * jitter, on(74)), (960 + 3 * jitter, on(79)), (1900, off(67)),
-              (1900, off(71)), (1900, off(74)), (1900, off(79))]
+    right += [
+        (960, on(67)),
+        (960 + jitter, on(71)),
+        (960 + 2 * jitter, on(74)),
+        (960 + 3 * jitter, on(79)),
+        (1900, off(67)),
+        (1900, off(71)),
+        (1900, off(74)),
+        (1900, off(79)),
+    ]
     left = [(0, on(48)), (900, off(48)), (960, on(43)), (1900, off(43))]
     return midi_file(path, [(names[0], right + pedal), (names[1], left)])
 

@@ -36,14 +36,16 @@ def test_random_bytes_never_crash(tmp_path, data):
 @FUZZ
 @given(tail=st.binary(max_size=300), fmt=st.integers(0, 3), ntracks=st.integers(0, 3), tpb=st.integers(0, 0xFFFF))
 def test_random_bytes_after_a_valid_header_never_crash(tmp_path, tail, fmt, ntracks, tpb):
-    header = b"MThd" + (6).to_bytes(4, "big") + fmt.to_bytes(2, "big") + ntracks.to_bytes(2, "big") + tpb.to_bytes(2, "big")
+    header = (
+        b"MThd" + (6).to_bytes(4, "big") + fmt.to_bytes(2, "big") + ntracks.to_bytes(2, "big") + tpb.to_bytes(2, "big")
+    )
     read_bytes(tmp_path, header + b"MTrk" + len(tail).to_bytes(4, "big") + tail)
 
 
 @FUZZ
 @given(data=st.data())
 def test_corrupting_a_valid_file_never_crashes(tmp_path, data):
-    good = (tmp_path / "seed.mid")
+    good = tmp_path / "seed.mid"
     from conftest import midi_file, off, on
 
     midi_file(good, [("m", [(0, on(60)), (480, off(60)), (480, on(64)), (960, off(64))])])

@@ -25,7 +25,9 @@ def test_key_layout_is_two_octaves_of_real_sized_keys():
     white = [b for b in boxes if not b.black]
     assert np.allclose(np.diff([b.center[0] for b in white]), 0.0235)
     black = [b for b in boxes if b.black]
-    assert all(b.half[0] * 2 == pytest.approx(0.0137) and b.center[2] + b.half[2] == pytest.approx(0.0127) for b in black)
+    assert all(
+        b.half[0] * 2 == pytest.approx(0.0137) and b.center[2] + b.half[2] == pytest.approx(0.0127) for b in black
+    )
     # C#4 lies between C4 and D4
     assert white[0].center[0] < boxes[1].center[0] < white[1].center[0]
     assert not any(b.black for b in key_boxes(KeyboardConfig(spec=KeyboardSpec(62, 1))))
@@ -49,8 +51,8 @@ def test_key_sensor_sends_note_on_with_velocity_and_note_off_with_hysteresis():
 
 def test_slow_press_is_soft_and_fast_press_is_loud():
     """A finger pressing a key through the physics: the key's speed sets the velocity."""
-    from pianobot.sim.world import PianoWorld, WorldConfig
     from pianobot.env.piano import idle_pose
+    from pianobot.sim.world import PianoWorld, WorldConfig
 
     world = PianoWorld(WorldConfig())
     velocities = []

@@ -60,7 +60,9 @@ def test_figures_agree_with_mir_eval_called_directly(reference):
         )
 
     (ri, rp, rv), (ei, ep, ev) = arrays(reference), arrays(played)
-    p, r, f, _ = mir_eval.transcription.precision_recall_f1_overlap(ri, rp, ei, ep, onset_tolerance=0.02, offset_ratio=None)
+    p, r, f, _ = mir_eval.transcription.precision_recall_f1_overlap(
+        ri, rp, ei, ep, onset_tolerance=0.02, offset_ratio=None
+    )
     assert (report.precision, report.recall, report.f1) == pytest.approx((p, r, f))
     _, _, f_off, _ = mir_eval.transcription.precision_recall_f1_overlap(ri, rp, ei, ep, onset_tolerance=0.02)
     assert report.f1_with_offsets == pytest.approx(f_off)

@@ -2,8 +2,8 @@ import warnings
 
 import mido
 import pytest
-
 from conftest import lyric, midi_file, off, on
+
 from pianobot.errors import PianobotError, PianobotWarning
 from pianobot.music.midi_io import parse_finger_text, read_midi, write_midi
 from pianobot.music.piece import Note, Piece
@@ -62,8 +62,21 @@ def test_tracks_are_merged_or_chosen_by_index_or_name(tmp_path):
 def test_fingering_from_lyrics_with_chord_rule(tmp_path):
     path = midi_file(
         tmp_path / "f.mid",
-        [("m", [(0, lyric("4 2")), (0, on(67)), (0, on(60)), (480, off(60)), (480, off(67)),
-                (480, mido.MetaMessage("text", text="la")), (480, on(62)), (960, off(62))])],
+        [
+            (
+                "m",
+                [
+                    (0, lyric("4 2")),
+                    (0, on(67)),
+                    (0, on(60)),
+                    (480, off(60)),
+                    (480, off(67)),
+                    (480, mido.MetaMessage("text", text="la")),
+                    (480, on(62)),
+                    (960, off(62)),
+                ],
+            )
+        ],
     )
     piece = read_midi(path)
     # fingers are listed lowest pitch first, whatever order the note-ons come in
@@ -71,7 +84,9 @@ def test_fingering_from_lyrics_with_chord_rule(tmp_path):
 
 
 def test_fingering_count_must_match_the_chord(tmp_path):
-    path = midi_file(tmp_path / "f.mid", [("m", [(0, lyric("2 3 4")), (0, on(60)), (0, on(64)), (480, off(60)), (480, off(64))])])
+    path = midi_file(
+        tmp_path / "f.mid", [("m", [(0, lyric("2 3 4")), (0, on(60)), (0, on(64)), (480, off(60)), (480, off(64))])]
+    )
     with pytest.raises(PianobotError, match="3 finger\\(s\\) for 2 note\\(s\\).*lowest pitch first"):
         read_midi(path)
 

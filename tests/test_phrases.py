@@ -26,7 +26,15 @@ def test_breaks_prefer_rests():
 
 
 def test_breaks_prefer_long_notes():
-    notes = [Note(0, 60, 1), Note(1, 62, 2), Note(2, 64, 5), Note(5, 62, 6), Note(6, 60, 7), Note(7, 62, 8), Note(8, 64, 9)]
+    notes = [
+        Note(0, 60, 1),
+        Note(1, 62, 2),
+        Note(2, 64, 5),
+        Note(5, 62, 6),
+        Note(6, 60, 7),
+        Note(7, 62, 8),
+        Note(8, 64, 9),
+    ]
     assert [len(p.notes) for p in split_phrases(Piece(tuple(notes)), 6)] == [3, 4]
 
 

@@ -1,7 +1,14 @@
 import numpy as np
 import pytest
 
-from pianobot.env.rewards import RewardConfig, gate, linear_distance, reward_terms, squared_distance, wasserstein_distance
+from pianobot.env.rewards import (
+    RewardConfig,
+    gate,
+    linear_distance,
+    reward_terms,
+    squared_distance,
+    wasserstein_distance,
+)
 
 L = 6
 
@@ -95,13 +102,15 @@ def test_closeness_bonus_rewards_fingertips_near_their_keys():
     config = RewardConfig(closeness_weight=0.5)
     terms = reward_terms(config, vec(), np.zeros(L, int), vec(), np.zeros(L, int), np.array([0.0]))
     assert terms["closeness"] == pytest.approx(0.5)
-    assert "closeness" not in reward_terms(RewardConfig(closeness_weight=0), vec(), np.zeros(L, int), vec(), np.zeros(L, int), np.array([0.0]))
+    assert "closeness" not in reward_terms(
+        RewardConfig(closeness_weight=0), vec(), np.zeros(L, int), vec(), np.zeros(L, int), np.array([0.0])
+    )
 
 
 def test_the_scripted_pianist_earns_more_than_an_idle_hand():
-    from pianobot.pianist.scripted import ScriptedPianist
     from pianobot.env.piano import EnvConfig, PianoEnv
     from pianobot.music.piece import Note, Piece
+    from pianobot.pianist.scripted import ScriptedPianist
 
     config = EnvConfig(tactile=False)
     env = PianoEnv(piece=Piece((Note(0.0, 64, 1.0, 80, 3),), bpm=60), config=config)

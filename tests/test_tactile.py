@@ -3,9 +3,9 @@
 import numpy as np
 import pytest
 
-from pianobot.pianist.scripted import ScriptedPianist
 from pianobot.env.piano import EnvConfig, PianoEnv
 from pianobot.music.piece import Note, Piece
+from pianobot.pianist.scripted import ScriptedPianist
 from pianobot.sim.bullet import p
 from pianobot.sim.tactile import TactileConfig, TactileRenderer, pool, to_uint8
 

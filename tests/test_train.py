@@ -9,15 +9,15 @@ import torch
 
 from pianobot.agent import store
 from pianobot.agent.config import SACConfig
+from pianobot.agent.policy import load_policy, make_agent
 from pianobot.env.piano import EnvConfig
 from pianobot.errors import PianobotError
-from pianobot.learn.explore import Explorer
-from pianobot.music.phrases import split_phrases
-from pianobot.music.piece import Note, Piece
-from pianobot.agent.policy import load_policy, make_agent
 from pianobot.learn.config import TrainConfig
+from pianobot.learn.explore import Explorer
 from pianobot.learn.jobs import phrase_jobs, plan_jobs
 from pianobot.learn.train import Progress, make_env, train_policy
+from pianobot.music.phrases import split_phrases
+from pianobot.music.piece import Note, Piece
 from pianobot.perform.rollout import rollout
 
 PHRASE = Piece((Note(0.0, 64, 0.5, 80, 3),), bpm=60)  # a one-note phrase: 35 steps an episode
@@ -25,8 +25,9 @@ PHRASE = Piece((Note(0.0, 64, 0.5, 80, 3),), bpm=60)  # a one-note phrase: 35 st
 
 def small(**changes) -> TrainConfig:
     sac = SACConfig(exploration_steps=60, batch_size=32, buffer_size=1000, hidden=32, score_features=16)
-    config = TrainConfig(steps=200, eval_every=10_000, eval_episodes=1, checkpoint_every=70, sac=sac,
-                         env=EnvConfig(tactile=True))
+    config = TrainConfig(
+        steps=200, eval_every=10_000, eval_episodes=1, checkpoint_every=70, sac=sac, env=EnvConfig(tactile=True)
+    )
     return replace(config, **changes)
 
 
@@ -35,7 +36,7 @@ def test_training_runs_real_updates_with_finite_losses(tmp_path):
     manifest = train_policy(PHRASE, small(), tmp_path / "m", seen.append, about={"key": "k", "piece": "p"})
     assert manifest["steps"] == 200 and manifest["updates"] == 140  # one update per step after exploration
     losses = [p.losses for p in seen if p.losses]
-    assert losses and all(np.isfinite(v) for l in losses for v in l.values())
+    assert losses and all(np.isfinite(v) for step in losses for v in step.values())
     assert 0.0 <= manifest["evaluation"]["f1"] <= 1.0 and manifest["key"] == "k"
     assert store.is_trained(tmp_path / "m") and not (tmp_path / "m" / store.CHECKPOINT_DIR).exists()
     stored = json.loads((tmp_path / "m" / store.MANIFEST_FILE).read_text())
@@ -67,7 +68,10 @@ def test_interrupted_training_resumes_to_the_same_state(tmp_path):
     a = store.load_tensors(straight / store.POLICY_FILE)
     b = store.load_tensors(resumed / store.POLICY_FILE)
     assert a.keys() == b.keys() and all(torch.equal(a[k], b[k]) for k in a)
-    assert json.loads((straight / "manifest.json").read_text())["evaluation"] == json.loads((resumed / "manifest.json").read_text())["evaluation"]
+    assert (
+        json.loads((straight / "manifest.json").read_text())["evaluation"]
+        == json.loads((resumed / "manifest.json").read_text())["evaluation"]
+    )
 
 
 def test_skip_if_trained_and_identical_phrases_share_a_policy(tmp_path):
@@ -139,13 +143,16 @@ def test_policy_with_bad_values_is_refused(tmp_path):
             load_policy(tmp_path / "m", env)
 
 
-@pytest.mark.parametrize("field, value, message", [
-    ("hidden", "256", "expected a whole number, got str '256'"),
-    ("hidden", 2_000_000, "hidden 2000000 must be between 1 and 4096"),
-    ("hidden", -5, "hidden -5 must be between 1 and 4096"),
-    ("discount", float("nan"), "expected a finite number"),
-    ("colour", 1, "not a field of SACConfig"),
-])
+@pytest.mark.parametrize(
+    "field, value, message",
+    [
+        ("hidden", "256", "expected a whole number, got str '256'"),
+        ("hidden", 2_000_000, "hidden 2000000 must be between 1 and 4096"),
+        ("hidden", -5, "hidden -5 must be between 1 and 4096"),
+        ("discount", float("nan"), "expected a finite number"),
+        ("colour", 1, "not a field of SACConfig"),
+    ],
+)
 def test_manifest_values_that_do_not_fit_are_one_line_errors(tmp_path, field, value, message):
     config = small(env=EnvConfig(tactile=False))
     train_policy(PHRASE, config, tmp_path / "m")
@@ -198,7 +205,9 @@ def test_an_agent_that_does_not_read_the_score_window_does_not_store_it(tmp_path
         vector, _ = agent.split(observation)
         assert vector.size == vector_size(space, reads) == vector_size(space) - (0 if reads else score_size(space))
         assert agent.sample(vector, None).shape == agent.act(observation).shape == (13,)
-    manifest = train_policy(PHRASE, small(env=EnvConfig(tactile=False), steps=80, checkpoint_every=40), tmp_path / "m", stop_after=45)
+    manifest = train_policy(
+        PHRASE, small(env=EnvConfig(tactile=False), steps=80, checkpoint_every=40), tmp_path / "m", stop_after=45
+    )
     assert "interrupted_at" in manifest  # (at the first episode end after 45 steps)
     stored = np.load(next((tmp_path / "m" / store.CHECKPOINT_DIR).rglob("*vector*.npy")), mmap_mode="r")
     assert stored.shape[-1] == vector_size(space, False)
@@ -223,7 +232,9 @@ def _agent_and_batch(demo_weight: float, demo: float):
 
     torch.manual_seed(0)
     env = make_env(PHRASE, EnvConfig(tactile=False))
-    config = SACConfig(batch_size=64, hidden=32, score_features=16, demo_weight=demo_weight, learning_rate=1e-3)  # the mechanism, quickly
+    config = SACConfig(
+        batch_size=64, hidden=32, score_features=16, demo_weight=demo_weight, learning_rate=1e-3
+    )  # the mechanism, quickly
     from pianobot.agent.sac import score_size, vector_size
 
     space, score = env.observation_space, config.score_input
@@ -234,8 +245,13 @@ def _agent_and_batch(demo_weight: float, demo: float):
     batch = {
         "vector": torch.from_numpy(rng.normal(size=(n, dim)).astype(np.float32)),
         "next_vector": torch.from_numpy(rng.normal(size=(n, dim)).astype(np.float32)),
-        "action": torch.from_numpy(target), "reward": torch.zeros(n), "terminated": torch.zeros(n),
-        "demo": torch.full((n,), demo), "expert": torch.from_numpy(target), "tactile": None, "next_tactile": None,
+        "action": torch.from_numpy(target),
+        "reward": torch.zeros(n),
+        "terminated": torch.zeros(n),
+        "demo": torch.full((n,), demo),
+        "expert": torch.from_numpy(target),
+        "tactile": None,
+        "next_tactile": None,
     }
     return agent, batch, target
 
@@ -243,6 +259,7 @@ def _agent_and_batch(demo_weight: float, demo: float):
 def test_behaviour_cloning_pulls_the_actor_towards_demonstrations():
     """With demonstrations in the batch the actor's mean action moves to the demonstrated one;
     without (demo flags 0, or demo_weight 0) it does not."""
+
     def error_after_updates(demo_weight, demo):
         agent, batch, target = _agent_and_batch(demo_weight, demo)
         for _ in range(150):
@@ -290,7 +307,11 @@ def test_the_best_evaluated_policy_is_kept_across_an_interruption(tmp_path, monk
     seen: list = []
     monkeypatch.setattr(train, "evaluate", scripted(seen))
     manifest = train_policy(PHRASE, config, tmp_path / "straight")
-    assert len(seen) == 4 and manifest["evaluation"]["f1"] == 0.9 and manifest["evaluation"]["step"] == manifest["evaluations"][1]["step"]
+    assert (
+        len(seen) == 4
+        and manifest["evaluation"]["f1"] == 0.9
+        and manifest["evaluation"]["step"] == manifest["evaluations"][1]["step"]
+    )
     assert [e["f1"] for e in manifest["evaluations"]] == [0.2, 0.9, 0.4, 0.3]
     stored = store.load_tensors(tmp_path / "straight" / store.POLICY_FILE)
     assert all(torch.equal(stored[k], seen[1][1][k]) for k in stored)
@@ -303,7 +324,9 @@ def test_the_best_evaluated_policy_is_kept_across_an_interruption(tmp_path, monk
     assert len(first) == 2
     rest: list = []
     scores = iter([0.4, 0.3])
-    monkeypatch.setattr(train, "evaluate", lambda *a: (rest.append(1), {"f1": next(scores), "velocity_mae": 1.0, "return": 0.0})[1])
+    monkeypatch.setattr(
+        train, "evaluate", lambda *a: (rest.append(1), {"f1": next(scores), "velocity_mae": 1.0, "return": 0.0})[1]
+    )
     resumed = train_policy(PHRASE, config, tmp_path / "resumed")
     assert len(rest) == 2 and resumed["evaluation"] == manifest["evaluation"]
     kept = store.load_tensors(tmp_path / "resumed" / store.POLICY_FILE)
@@ -401,9 +424,14 @@ def test_a_kill_at_any_point_of_a_checkpoint_write_loses_at_most_one_interval(tm
     train_policy(PHRASE, config, tmp_path / "killed", seen.append)
     resumed_at = [p.step for p in seen if p.resumed]
     assert resumed_at == ([140] if point == "after rename" else [70])
-    a, b = store.load_tensors(tmp_path / "straight" / store.POLICY_FILE), store.load_tensors(tmp_path / "killed" / store.POLICY_FILE)
+    a, b = (
+        store.load_tensors(tmp_path / "straight" / store.POLICY_FILE),
+        store.load_tensors(tmp_path / "killed" / store.POLICY_FILE),
+    )
     assert a.keys() == b.keys() and all(torch.equal(a[k], b[k]) for k in a)
-    assert sorted(p.name for p in (tmp_path / "killed").iterdir()) == sorted([store.LOCK_FILE, store.MANIFEST_FILE, store.POLICY_FILE])
+    assert sorted(p.name for p in (tmp_path / "killed").iterdir()) == sorted(
+        [store.LOCK_FILE, store.MANIFEST_FILE, store.POLICY_FILE]
+    )
 
 
 def test_a_due_evaluation_survives_an_interruption(tmp_path):

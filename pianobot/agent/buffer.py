@@ -61,8 +61,12 @@ class ReplayBuffer:
             try:
                 data = np.load(folder / f"{name}.npy", allow_pickle=False)
             except (OSError, ValueError) as e:
-                raise PianobotError(f"checkpoint buffer {folder / (name + '.npy')} is unreadable ({e}): delete the checkpoint folder to start afresh") from None
+                raise PianobotError(
+                    f"checkpoint buffer {folder / (name + '.npy')} is unreadable ({e}): delete the checkpoint folder to start afresh"
+                ) from None
             if data.shape[1:] != array.shape[1:] or len(data) != size:
-                raise PianobotError(f"checkpoint buffer {folder} does not fit this configuration: delete it to start afresh")
+                raise PianobotError(
+                    f"checkpoint buffer {folder} does not fit this configuration: delete it to start afresh"
+                )
             array[:size] = data
         self.size, self.cursor = size, cursor

@@ -54,14 +54,22 @@ class SACConfig:
     log_std_bounds: tuple[float, float] = (-5.0, 2.0)
 
     def __post_init__(self) -> None:
-        for name, most in (("batch_size", 1 << 16), ("hidden", 4096), ("score_features", 4096), ("tactile_channels", 256),
-                           ("tactile_features", 1024), ("buffer_size", 10_000_000)):
+        for name, most in (
+            ("batch_size", 1 << 16),
+            ("hidden", 4096),
+            ("score_features", 4096),
+            ("tactile_channels", 256),
+            ("tactile_features", 1024),
+            ("buffer_size", 10_000_000),
+        ):
             value = getattr(self, name)
             if not 1 <= value <= most:
                 raise ValueError(f"{name} {value} must be between 1 and {most}")
         if not (0 <= self.discount <= 1 and 0 < self.tau <= 1 and self.learning_rate > 0 and self.update_ratio > 0):
             raise ValueError("discount must lie in [0, 1], tau in (0, 1], learning_rate and update_ratio above 0")
         if self.exploration_steps < 0 or self.initial_alpha <= 0 or self.demo_weight < 0 or self.demo_q_weight < 0:
-            raise ValueError("exploration_steps, demo_weight and demo_q_weight cannot be negative, initial_alpha must be above 0")
+            raise ValueError(
+                "exploration_steps, demo_weight and demo_q_weight cannot be negative, initial_alpha must be above 0"
+            )
         if not self.log_std_bounds[0] < self.log_std_bounds[1]:
             raise ValueError(f"log_std_bounds {self.log_std_bounds} must rise")

@@ -30,7 +30,9 @@ def policy_configs(folder: Path) -> tuple[EnvConfig, SACConfig]:
     """The environment and agent configurations the policy in ``folder`` was trained with."""
     manifest = store.read_manifest(folder)
     try:
-        return from_dict(EnvConfig, manifest["config"]["env"], "config.env"), from_dict(SACConfig, manifest["config"]["sac"], "config.sac")
+        return from_dict(EnvConfig, manifest["config"]["env"], "config.env"), from_dict(
+            SACConfig, manifest["config"]["sac"], "config.sac"
+        )
     except ConfigError as e:
         raise PianobotError(f"{folder / store.MANIFEST_FILE}: {e}: retrain the phrase with --force") from None
 
@@ -44,5 +46,7 @@ def load_policy(folder: Path, env: PianoEnv) -> SAC:
     try:
         agent.load_tensors(tensors, with_training_state=False)
     except ValueError as e:
-        raise PianobotError(f"{folder / store.POLICY_FILE} does not fit its manifest's configuration ({e}): retrain the phrase with --force") from None
+        raise PianobotError(
+            f"{folder / store.POLICY_FILE} does not fit its manifest's configuration ({e}): retrain the phrase with --force"
+        ) from None
     return agent

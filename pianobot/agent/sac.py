@@ -22,7 +22,6 @@ from torch.nn import functional as F
 
 from pianobot.agent.config import SACConfig
 
-
 # -- observation layout -----------------------------------------------------------------------
 VECTOR_KEYS = ("score", "wrist", "joints", "joint_velocities", "targets", "keys", "key_velocities")
 
@@ -59,16 +58,26 @@ class Encoder(nn.Module):
         # the score window is large and sparse (L keys x 5 x steps): a narrow first layer for it
         # keeps the MLP's cost down; the joint and wrist values join it in the second layer.
         # Without score input the vector's first score_dim values are skipped.
-        self.score = nn.Sequential(nn.Linear(score_dim, config.score_features), nn.ReLU()) if config.score_input else None
+        self.score = (
+            nn.Sequential(nn.Linear(score_dim, config.score_features), nn.ReLU()) if config.score_input else None
+        )
         score_width = config.score_features if config.score_input else 0
-        self.vector = nn.Sequential(nn.Linear(score_width + vector_dim - score_dim, h), nn.ReLU(), nn.Linear(h, h), nn.ReLU())
+        self.vector = nn.Sequential(
+            nn.Linear(score_width + vector_dim - score_dim, h), nn.ReLU(), nn.Linear(h, h), nn.ReLU()
+        )
         self.out_dim = h
         self.tactile = None
         if tactile_shape is not None:
             history, fingers, rows, cols = tactile_shape
             c = config.tactile_channels
             conv = nn.Sequential(
-                nn.Conv2d(history, c, 3, stride=2), nn.ReLU(), nn.Conv2d(c, c, 3), nn.ReLU(), nn.Conv2d(c, c, 3), nn.ReLU(), nn.Flatten()
+                nn.Conv2d(history, c, 3, stride=2),
+                nn.ReLU(),
+                nn.Conv2d(c, c, 3),
+                nn.ReLU(),
+                nn.Conv2d(c, c, 3),
+                nn.ReLU(),
+                nn.Flatten(),
             )
             with torch.no_grad():
                 flat = conv(torch.zeros(1, history, rows, cols)).shape[1]
@@ -77,7 +86,9 @@ class Encoder(nn.Module):
 
     def forward(self, vector: torch.Tensor, tactile: torch.Tensor | None) -> torch.Tensor:
         rest = vector[:, self.score_dim :]
-        features = self.vector(rest if self.score is None else torch.cat([self.score(vector[:, : self.score_dim]), rest], dim=1))
+        features = self.vector(
+            rest if self.score is None else torch.cat([self.score(vector[:, : self.score_dim]), rest], dim=1)
+        )
         if self.tactile is None:
             return features
         batch, history, fingers, rows, cols = tactile.shape
@@ -125,7 +136,9 @@ class Actor(nn.Module):
     def __init__(self, feature_dim: int, action_dim: int, config: SACConfig):
         super().__init__()
         h = config.hidden
-        self.net = nn.Sequential(nn.Linear(feature_dim, h), nn.ReLU(), nn.Linear(h, h), nn.ReLU(), nn.Linear(h, 2 * action_dim))
+        self.net = nn.Sequential(
+            nn.Linear(feature_dim, h), nn.ReLU(), nn.Linear(h, h), nn.ReLU(), nn.Linear(h, 2 * action_dim)
+        )
         self.log_std_bounds = config.log_std_bounds
 
     def forward(self, features: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
@@ -159,7 +172,9 @@ def _load_checked(module: nn.Module, state: dict[str, torch.Tensor], prefix: str
             raise ValueError(f"tensor {prefix}{name} is not part of this agent")
         tensor, own = state[name], expected[name]
         if tuple(tensor.shape) != tuple(own.shape):
-            raise ValueError(f"tensor {prefix}{name} has shape {tuple(tensor.shape)}, this agent's is {tuple(own.shape)}")
+            raise ValueError(
+                f"tensor {prefix}{name} has shape {tuple(tensor.shape)}, this agent's is {tuple(own.shape)}"
+            )
         if tensor.dtype != own.dtype:
             raise ValueError(f"tensor {prefix}{name} is {tensor.dtype}, this agent's is {own.dtype}")
         if not bool(torch.isfinite(tensor).all()):
@@ -171,7 +186,9 @@ def _load_checked(module: nn.Module, state: dict[str, torch.Tensor], prefix: str
 class SAC:
     """Actor, twin critic with targets, learned temperature; :meth:`update` is one gradient step."""
 
-    def __init__(self, vector_dim: int, score_dim: int, tactile_shape, action_dim: int, config: SACConfig = SACConfig()):
+    def __init__(
+        self, vector_dim: int, score_dim: int, tactile_shape, action_dim: int, config: SACConfig = SACConfig()
+    ):
         self.config = config
         self.critic = Critic(vector_dim, score_dim, tactile_shape, action_dim, config)
         self.target = Critic(vector_dim, score_dim, tactile_shape, action_dim, config)

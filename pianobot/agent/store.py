@@ -85,7 +85,9 @@ def load_tensors(path: Path) -> dict[str, torch.Tensor]:
     except FileNotFoundError:
         raise PianobotError(f"model file {path} is missing: retrain the phrase with --force") from None
     except (SafetensorError, OSError, ValueError) as e:
-        raise PianobotError(f"model file {path} is not a readable safetensors file ({e}): retrain with --force") from None
+        raise PianobotError(
+            f"model file {path} is not a readable safetensors file ({e}): retrain with --force"
+        ) from None
 
 
 def save_policy(folder: Path, tensors: dict[str, torch.Tensor], manifest: dict) -> None:
@@ -120,9 +122,15 @@ def read_manifest(folder: Path) -> dict:
     except (OSError, UnicodeDecodeError, json.JSONDecodeError) as e:
         raise PianobotError(f"{path} is not a readable manifest ({e}): retrain the phrase with --force") from None
     if not isinstance(manifest, dict) or manifest.get("format") not in range(1, FORMAT + 1):
-        raise PianobotError(f"{path} is not a pianobot model manifest (formats 1 to {FORMAT}): retrain the phrase with --force")
-    if not isinstance(manifest.get("config"), dict) or not all(isinstance(manifest["config"].get(k), dict) for k in ("env", "sac")):
-        raise PianobotError(f"{path} does not record the configuration its policy was trained with: retrain the phrase with --force")
+        raise PianobotError(
+            f"{path} is not a pianobot model manifest (formats 1 to {FORMAT}): retrain the phrase with --force"
+        )
+    if not isinstance(manifest.get("config"), dict) or not all(
+        isinstance(manifest["config"].get(k), dict) for k in ("env", "sac")
+    ):
+        raise PianobotError(
+            f"{path} does not record the configuration its policy was trained with: retrain the phrase with --force"
+        )
     return upgrade_manifest(manifest)
 
 
@@ -218,7 +226,9 @@ def training_lock(folder: Path):
         except BlockingIOError:
             lock.seek(0)
             holder = lock.read().strip() or "another process"
-            raise PianobotError(f"{folder} is being trained by {holder}: wait for it to finish, or train into another --models folder") from None
+            raise PianobotError(
+                f"{folder} is being trained by {holder}: wait for it to finish, or train into another --models folder"
+            ) from None
         lock.seek(0)
         lock.truncate()
         lock.write(f"pianobot process {os.getpid()}")

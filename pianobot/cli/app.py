@@ -22,12 +22,12 @@ from rich.console import Console
 
 from pianobot import __version__
 from pianobot.agent.config import SACConfig
+from pianobot.env.piano import EnvConfig
+from pianobot.env.rewards import RewardConfig
 from pianobot.errors import PianobotError, PianobotWarning
 from pianobot.files import atomic_write, check_writable
 from pianobot.learn.config import TrainConfig
 from pianobot.learn.explore import EXPLORATIONS
-from pianobot.env.piano import EnvConfig
-from pianobot.env.rewards import RewardConfig
 from pianobot.music.instrument import HandSpec, KeyboardSpec
 from pianobot.music.load import LoadOptions
 from pianobot.music.metrics import DEFAULT_ONSET_TOLERANCE
@@ -87,7 +87,9 @@ Track = typer.Option(None, "--track", help="Read only this track (index or name)
 Tempo = typer.Option(None, "--tempo", help="Re-time the piece at this constant tempo in bpm (the paper uses 60).")
 Transpose = typer.Option(LoadOptions.transpose, "--transpose", help="Shift every note by this many semitones.")
 Fingering = typer.Option(
-    None, "--fingering", help="PIG fingering file for the notes (default: <song>_fingering.txt beside the .mid, if any)."
+    None,
+    "--fingering",
+    help="PIG fingering file for the notes (default: <song>_fingering.txt beside the .mid, if any).",
 )
 LowestNote = typer.Option(
     pitch_name(KeyboardSpec.lowest), "--lowest-note", help="Lowest key of the keyboard (name like C4, or MIDI number)."
@@ -96,18 +98,44 @@ Keys = typer.Option(KeyboardSpec.count, "--keys", help="Number of keys on the ke
 Thumb = typer.Option(False, "--thumb", help="Let the hand use its thumb (finger 1) too.")
 PhraseNotes = typer.Option(DEFAULT_MAX_NOTES, "--phrase-notes", help="Most notes in one phrase (one policy each).")
 PlayPhraseNotes = typer.Option(
-    None, "--phrase-notes", help=f"Most notes in one phrase (default: the longest phrases, up to {DEFAULT_MAX_NOTES} notes, whose policies are all trained)."
+    None,
+    "--phrase-notes",
+    help=f"Most notes in one phrase (default: the longest phrases, up to {DEFAULT_MAX_NOTES} notes, whose policies are all trained).",
 )
-Hand = typer.Option(None, "--hand", help="Play one hand's part of a two-hand piece: right or left (tracks named for it, else split by pitch).")
-Split = typer.Option(pitch_name(LoadOptions.split), "--split", help="With --hand and no track named for it: lowest note of the right hand's part.")
-Quantize = typer.Option(None, "--quantize", help="Move onsets and offsets to a grid, e.g. 1/16 (for recordings of human players).")
-Refinger = typer.Option(LoadOptions.refinger, "--refinger", help="Replace the file's fingering with the planner's (e.g. human fingering for five fingers).")
+Hand = typer.Option(
+    None,
+    "--hand",
+    help="Play one hand's part of a two-hand piece: right or left (tracks named for it, else split by pitch).",
+)
+Split = typer.Option(
+    pitch_name(LoadOptions.split),
+    "--split",
+    help="With --hand and no track named for it: lowest note of the right hand's part.",
+)
+Quantize = typer.Option(
+    None, "--quantize", help="Move onsets and offsets to a grid, e.g. 1/16 (for recordings of human players)."
+)
+Refinger = typer.Option(
+    LoadOptions.refinger,
+    "--refinger",
+    help="Replace the file's fingering with the planner's (e.g. human fingering for five fingers).",
+)
 
 
-def make_options(track, tempo, transpose, fingering, hand=None, split=None, quantize=None, refinger=False) -> LoadOptions:
+def make_options(
+    track, tempo, transpose, fingering, hand=None, split=None, quantize=None, refinger=False
+) -> LoadOptions:
     split = LoadOptions.split if split is None else parse_pitch(split)
-    return LoadOptions(track=track, tempo=tempo, transpose=transpose, fingering=fingering, hand=hand,
-                       split=split, quantize=quantize, refinger=refinger)
+    return LoadOptions(
+        track=track,
+        tempo=tempo,
+        transpose=transpose,
+        fingering=fingering,
+        hand=hand,
+        split=split,
+        quantize=quantize,
+        refinger=refinger,
+    )
 
 
 def check_midi_output(output: Path, song: Path, what: str) -> None:
@@ -128,10 +156,12 @@ def read_song(song: Path, options: LoadOptions, keyboard: KeyboardSpec, hand: Ha
     piece, plan = ensure_fingering(piece, keyboard, hand, options.refinger)
     if plan is not None:
         why = "--refinger" if options.refinger else "it has notes without fingering"
-        warnings.warn(PianobotWarning(
-            f"{song.name}: fingering planned for fingers {', '.join(map(str, hand.fingers))} ({why}): "
-            f"wrist travel {plan.travel * 100:.1f} cm in {plan.moves} moves; `pianobot finger` writes it to a file"
-        ))
+        warnings.warn(
+            PianobotWarning(
+                f"{song.name}: fingering planned for fingers {', '.join(map(str, hand.fingers))} ({why}): "
+                f"wrist travel {plan.travel * 100:.1f} cm in {plan.moves} moves; `pianobot finger` writes it to a file"
+            )
+        )
         for problem in plan.problems:
             warnings.warn(PianobotWarning(problem))
     check_playable(piece, keyboard, hand)
@@ -160,7 +190,9 @@ def inspect(
     keys: int = Keys,
     thumb: bool = Thumb,
     phrase_notes: Optional[int] = PlayPhraseNotes,
-    models: Path = typer.Option(Path("models"), "--models", help="Model store whose trained phrase split to show (as play uses it)."),
+    models: Path = typer.Option(
+        Path("models"), "--models", help="Model store whose trained phrase split to show (as play uses it)."
+    ),
 ):
     """Explain what a file holds (tracks, hands, pedal, range, polyphony, fingering) and whether the hand can play it."""
     from pianobot.cli import display
@@ -181,7 +213,11 @@ def inspect(
         out.print(
             f"{len(with_notes)} track(s) with notes"
             + (f"; named for hands: {', '.join(f'{i} {h}' for i, h in sorted(hands.items()))}" if hands else "")
-            + (f"; sustain pedal pressed {pedal} times (ignored: a note sounds while its key is down)" if pedal else "; no sustain pedal")
+            + (
+                f"; sustain pedal pressed {pedal} times (ignored: a note sounds while its key is down)"
+                if pedal
+                else "; no sustain pedal"
+            )
         )
         if len(with_notes) > 1 and track is None and hand_part is None:
             out.print("[yellow]several tracks are merged; play one part with --track N or --hand right|left[/yellow]")
@@ -197,7 +233,9 @@ def inspect(
     )
     piece, plan = ensure_fingering(piece, keyboard, hand_spec, refinger)
     if plan is not None:
-        out.print(f"fingering planned for fingers {hand_spec.describe()}: wrist travel {plan.travel * 100:.1f} cm in {plan.moves} moves")
+        out.print(
+            f"fingering planned for fingers {hand_spec.describe()}: wrist travel {plan.travel * 100:.1f} cm in {plan.moves} moves"
+        )
         for problem in plan.problems:
             out.print(f"[yellow]{problem}[/yellow]")
     phrases = trained_split(models, piece, phrase_notes)
@@ -254,8 +292,12 @@ def score(
     onset_tolerance: float = typer.Option(
         DEFAULT_ONSET_TOLERANCE, "--onset-tolerance", help="Seconds within which a played onset matches the reference."
     ),
-    json_path: Optional[Path] = typer.Option(None, "--json", help="Also write every figure and the per-note table to this JSON file."),
-    plot: Optional[Path] = typer.Option(None, "--plot", help="Draw both piano rolls with the errors marked to this PNG file."),
+    json_path: Optional[Path] = typer.Option(
+        None, "--json", help="Also write every figure and the per-note table to this JSON file."
+    ),
+    plot: Optional[Path] = typer.Option(
+        None, "--plot", help="Draw both piano rolls with the errors marked to this PNG file."
+    ),
     notes: bool = typer.Option(True, "--notes/--no-notes", help="Print the per-note table."),
 ):
     """Compare a performance with its reference: note F1, velocity and timing errors, fingering."""
@@ -288,12 +330,22 @@ def score(
 @friendly
 def play(
     song: Path = typer.Argument(..., help="The piece to play, a .mid file with fingering."),
-    output: Path = typer.Option(..., "--output", "-o", help="Write what the simulated piano sounded to this .mid file."),
-    controller: str = typer.Option(CONTROLLERS[0], "--controller", help="Who plays: 'sac' (the trained phrase policies), 'scripted' (the hand-written pianist) or 'random'."),
+    output: Path = typer.Option(
+        ..., "--output", "-o", help="Write what the simulated piano sounded to this .mid file."
+    ),
+    controller: str = typer.Option(
+        CONTROLLERS[0],
+        "--controller",
+        help="Who plays: 'sac' (the trained phrase policies), 'scripted' (the hand-written pianist) or 'random'.",
+    ),
     models: Path = typer.Option(Path("models"), "--models", help="Folder of the model store (for --controller sac)."),
-    fallback: Optional[str] = typer.Option(None, "--fallback", help="'scripted': play phrases that have no trained policy with the scripted pianist."),
+    fallback: Optional[str] = typer.Option(
+        None, "--fallback", help="'scripted': play phrases that have no trained policy with the scripted pianist."
+    ),
     phrase_notes: Optional[int] = PlayPhraseNotes,
-    seed: int = typer.Option(0, "--seed", help="Seed of the simulation (the hand's start position) and of the random controller."),
+    seed: int = typer.Option(
+        0, "--seed", help="Seed of the simulation (the hand's start position) and of the random controller."
+    ),
     video: Optional[Path] = typer.Option(None, "--video", help="Also record the performance to this .mp4 file."),
     wav: Optional[Path] = typer.Option(None, "--wav", help="Also synthesise what was played to this .wav file."),
     gui: bool = typer.Option(False, "--gui", help="Show the simulation in a PyBullet window (needs a display)."),
@@ -337,7 +389,9 @@ def play(
     if fallback not in (None, "scripted"):
         raise PianobotError(f"--fallback {fallback}: the only fallback is 'scripted'")
     keyboard, hand = make_instrument(lowest_note, keys, thumb)
-    piece = read_song(song, make_options(track, tempo, transpose, fingering, hand_part, split, quantize, refinger), keyboard, hand)
+    piece = read_song(
+        song, make_options(track, tempo, transpose, fingering, hand_part, split, quantize, refinger), keyboard, hand
+    )
     world = WorldConfig(keyboard=KeyboardConfig(spec=keyboard), hand=HandConfig(spec=hand), gui=gui)
     config = replace(PLAY_CONFIG, world=world)
     sources: dict = {}
@@ -350,7 +404,9 @@ def play(
         missing = missing_phrases(models, phrases)
         if phrase_notes is None and phrases != split_phrases(piece, DEFAULT_MAX_NOTES):
             most = max(len(p.notes) for p in phrases)
-            out.print(f"[dim]{len(phrases)} phrases of at most {most} note{'s' * (most > 1)}: the split the policies in {models} were trained for[/dim]")
+            out.print(
+                f"[dim]{len(phrases)} phrases of at most {most} note{'s' * (most > 1)}: the split the policies in {models} were trained for[/dim]"
+            )
         if missing and not fallback:
             first = missing[0]
             raise PianobotError(
@@ -362,7 +418,9 @@ def play(
         if trained is not None:
             config = replace(trained, world=replace(trained.world, gui=gui))
             if trained.world.keyboard.spec != keyboard or trained.world.hand.spec != hand:
-                raise PianobotError(f"the policies in {models} were trained for another keyboard or hand: use the same --lowest-note/--keys/--thumb")
+                raise PianobotError(
+                    f"the policies in {models} were trained for another keyboard or hand: use the same --lowest-note/--keys/--thumb"
+                )
         if missing and config.world.control != "velocity":
             raise PianobotError("--fallback scripted needs policies trained with --control velocity")
 
@@ -370,17 +428,30 @@ def play(
             composed = CompositionalController(env, phrases, models, fallback is not None)
             sources.update({s.phrase.index: s.source for s in composed.sections})
             return composed
-    with Progress(TextColumn("{task.description}"), BarColumn(), TimeRemainingColumn(), console=err, transient=True) as bar:
+
+    with Progress(
+        TextColumn("{task.description}"), BarColumn(), TimeRemainingColumn(), console=err, transient=True
+    ) as bar:
         task = bar.add_task(f"playing {song.name}", total=None)
-        result = perform(piece, who, config, seed=seed, video=video is not None,
-                         on_step=lambda done, total: bar.update(task, completed=done, total=total))
+        result = perform(
+            piece,
+            who,
+            config,
+            seed=seed,
+            video=video is not None,
+            on_step=lambda done, total: bar.update(task, completed=done, total=total),
+        )
     report = result.report()
     write_midi(result.played, output, name=f"pianobot {controller}: {song.stem}")
     extra = {"phrases": {str(k): v for k, v in sources.items()}} if sources else {}
-    atomic_write(report_path, json.dumps({"controller": controller, "seed": seed, **extra, **report.to_dict()}, indent=2) + "\n")
+    atomic_write(
+        report_path, json.dumps({"controller": controller, "seed": seed, **extra, **report.to_dict()}, indent=2) + "\n"
+    )
     fallbacks = [k for k, v in sources.items() if "fallback" in v]
     if fallbacks:
-        out.print(f"[yellow]phrases {', '.join(map(str, fallbacks))} had no trained policy and were played by the scripted pianist[/yellow]")
+        out.print(
+            f"[yellow]phrases {', '.join(map(str, fallbacks))} had no trained policy and were played by the scripted pianist[/yellow]"
+        )
     display.print_all(out, display.report_tables(report))
     out.print(f"performance written to {output}, report to {report_path}")
     if video is not None:
@@ -395,19 +466,43 @@ def play(
 @friendly
 def train(
     song: Optional[Path] = typer.Argument(None, help="A .mid file with fingering; leave out with --task."),
-    task: Optional[str] = typer.Option(None, "--task", help=f"Train on one of the paper's task families instead: {', '.join(TASKS)}."),
+    task: Optional[str] = typer.Option(
+        None, "--task", help=f"Train on one of the paper's task families instead: {', '.join(TASKS)}."
+    ),
     steps: int = typer.Option(TrainConfig.steps, "--steps", help="Environment steps per phrase, exploration included."),
-    seed: int = typer.Option(TrainConfig.seed, "--seed", help="Seed of the simulation, the exploration and the networks."),
-    until_f1: Optional[float] = typer.Option(TrainConfig.until_f1, "--until-f1", help="Stop a phrase early once an evaluation reaches this note F1 (e.g. 0.95)."),
+    seed: int = typer.Option(
+        TrainConfig.seed, "--seed", help="Seed of the simulation, the exploration and the networks."
+    ),
+    until_f1: Optional[float] = typer.Option(
+        TrainConfig.until_f1,
+        "--until-f1",
+        help="Stop a phrase early once an evaluation reaches this note F1 (e.g. 0.95).",
+    ),
     workers: int = typer.Option(1, "--workers", help="Train this many phrases at once, in separate processes."),
-    threads: int = typer.Option(1, "--threads", help="Torch threads per training process (workers x threads should not exceed the cores)."),
+    threads: int = typer.Option(
+        1, "--threads", help="Torch threads per training process (workers x threads should not exceed the cores)."
+    ),
     control: str = typer.Option(WorldConfig.control, "--control", help="Finger control: velocity or torque."),
     reward: str = typer.Option(RewardConfig.kind, "--reward", help="Reward: linear, squared or wasserstein."),
-    explore: str = typer.Option(TrainConfig.explore, "--explore", help=f"Exploration before learning: {', '.join(EXPLORATIONS)}."),
-    exploration_steps: int = typer.Option(SACConfig.exploration_steps, "--exploration-steps", help="Steps of exploration before learning starts."),
-    tactile: bool = typer.Option(EnvConfig.tactile, "--tactile/--no-tactile", help="Observe the fingertips' tactile images."),
-    joints: str = typer.Option(",".join(EnvConfig.actuated), "--joints", help="Finger joints the policy moves, from abd,mcp,pip,dip; the others hold still."),
-    fingering_gate: bool = typer.Option(RewardConfig.fingering_gate, "--fingering-gate/--no-fingering-gate", help="Reward a key only when the score's finger pressed it (the paper's fingering indicator)."),
+    explore: str = typer.Option(
+        TrainConfig.explore, "--explore", help=f"Exploration before learning: {', '.join(EXPLORATIONS)}."
+    ),
+    exploration_steps: int = typer.Option(
+        SACConfig.exploration_steps, "--exploration-steps", help="Steps of exploration before learning starts."
+    ),
+    tactile: bool = typer.Option(
+        EnvConfig.tactile, "--tactile/--no-tactile", help="Observe the fingertips' tactile images."
+    ),
+    joints: str = typer.Option(
+        ",".join(EnvConfig.actuated),
+        "--joints",
+        help="Finger joints the policy moves, from abd,mcp,pip,dip; the others hold still.",
+    ),
+    fingering_gate: bool = typer.Option(
+        RewardConfig.fingering_gate,
+        "--fingering-gate/--no-fingering-gate",
+        help="Reward a key only when the score's finger pressed it (the paper's fingering indicator).",
+    ),
     force: bool = typer.Option(False, "--force", help="Retrain phrases that already have a stored policy."),
     models: Path = typer.Option(Path("models"), "--models", help="Folder of the model store."),
     track: Optional[str] = Track,
@@ -448,32 +543,59 @@ def train(
     with option("--reward", reward):
         rewards = RewardConfig(kind=reward, fingering_gate=fingering_gate)
     with option("--joints", joints):
-        env = EnvConfig(world=world, reward=rewards, tactile=tactile, actuated=tuple(j.strip() for j in joints.split(",") if j.strip()))
+        env = EnvConfig(
+            world=world,
+            reward=rewards,
+            tactile=tactile,
+            actuated=tuple(j.strip() for j in joints.split(",") if j.strip()),
+        )
     with option("--exploration-steps", exploration_steps):
         sac = SACConfig(exploration_steps=exploration_steps)
     with option():
-        config = TrainConfig(steps=steps, seed=seed, explore=explore, until_f1=until_f1, sac=sac, env=env,
-                             eval_episodes=TASK_EVAL_EPISODES if task is not None else TrainConfig.eval_episodes)
+        config = TrainConfig(
+            steps=steps,
+            seed=seed,
+            explore=explore,
+            until_f1=until_f1,
+            sac=sac,
+            env=env,
+            eval_episodes=TASK_EVAL_EPISODES if task is not None else TrainConfig.eval_episodes,
+        )
     if task is not None:
         todo, done = plan_jobs([task_job(task, config, models)], force)
         label = f"task {task}"
     else:
-        piece = read_song(song, make_options(track, tempo, transpose, fingering, hand_part, split, quantize, refinger), keyboard, hand)
+        piece = read_song(
+            song, make_options(track, tempo, transpose, fingering, hand_part, split, quantize, refinger), keyboard, hand
+        )
         phrases = split_phrases(piece, phrase_notes)
         todo, done = plan_jobs(phrase_jobs(phrases, config, models, piece=song.name), force)
         label = f"{song.name}: {len(phrases)} phrases"
     models.mkdir(parents=True, exist_ok=True)
     for job in done:
-        out.print(f"phrase {job.key} ({', '.join(map(str, job.phrases))}) already trained in {job.folder}: skipped (--force retrains)")
+        out.print(
+            f"phrase {job.key} ({', '.join(map(str, job.phrases))}) already trained in {job.folder}: skipped (--force retrains)"
+        )
     out.print(f"training {len(todo)} polic{'y' if len(todo) == 1 else 'ies'} for {label}, {steps} steps each")
     returns: dict[str, float] = {}
-    with Progress(TextColumn("{task.description}"), BarColumn(), TextColumn("{task.completed}/{task.total} steps"),
-                  TextColumn("{task.fields[status]}"), TimeRemainingColumn(), console=out) as bar:
-        rows = {job.key: bar.add_task(f"phrase {job.key[:8]}" if task is None else job.key, total=steps, status="") for job in todo}
+    with Progress(
+        TextColumn("{task.description}"),
+        BarColumn(),
+        TextColumn("{task.completed}/{task.total} steps"),
+        TextColumn("{task.fields[status]}"),
+        TimeRemainingColumn(),
+        console=out,
+    ) as bar:
+        rows = {
+            job.key: bar.add_task(f"phrase {job.key[:8]}" if task is None else job.key, total=steps, status="")
+            for job in todo
+        }
 
         def on_progress(key: str, progress) -> None:
             if progress.resumed:
-                bar.console.print(f"{bar.tasks[rows[key]].description}: resuming from its checkpoint at step {progress.step}")
+                bar.console.print(
+                    f"{bar.tasks[rows[key]].description}: resuming from its checkpoint at step {progress.step}"
+                )
             status = bar.tasks[rows[key]].fields.get("status", "")
             if progress.episode_return is not None:
                 returns[key] = progress.episode_return
@@ -484,7 +606,9 @@ def train(
             bar.update(rows[key], completed=progress.step, status=status)
 
         results = run_jobs(todo, config, workers, on_progress, threads=threads)
-    table = display.training_table([(job, results.get(job.key) or store.read_manifest(job.folder)) for job in done + todo])
+    table = display.training_table(
+        [(job, results.get(job.key) or store.read_manifest(job.folder)) for job in done + todo]
+    )
     out.print(table)
 
 
@@ -496,7 +620,9 @@ def _version(value: bool):
 
 @app.callback()
 def main(
-    version: bool = typer.Option(False, "--version", callback=_version, is_eager=True, help="Show the version and exit."),
+    version: bool = typer.Option(
+        False, "--version", callback=_version, is_eager=True, help="Show the version and exit."
+    ),
 ):
     """pianobot: teach a simulated robot hand to play the piano from MIDI files."""
 

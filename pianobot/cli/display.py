@@ -26,8 +26,15 @@ def tracks_table(tracks: list[TrackInfo], hands: dict[int, str] | None = None) -
         table.add_column(column)
     for t in tracks:
         span = f"{pitch_name(t.low)}-{pitch_name(t.high)}" if t.notes else "-"
-        table.add_row(str(t.index), t.name or "-", str(t.notes), span, ",".join(map(str, t.channels)) or "-",
-                      str(t.pedal) if t.pedal else "-", (hands or {}).get(t.index, "-"))
+        table.add_row(
+            str(t.index),
+            t.name or "-",
+            str(t.notes),
+            span,
+            ",".join(map(str, t.channels)) or "-",
+            str(t.pedal) if t.pedal else "-",
+            (hands or {}).get(t.index, "-"),
+        )
     return table
 
 
@@ -38,7 +45,12 @@ def notes_table(piece: Piece, phrases: list[Phrase]) -> Table:
         table.add_column(column, justify="right" if column != "finger" else "left")
     for i, n in enumerate(piece.notes):
         table.add_row(
-            str(i), f"{n.onset:.3f}", n.name, f"{n.duration:.3f}", str(n.velocity), _finger(n.finger),
+            str(i),
+            f"{n.onset:.3f}",
+            n.name,
+            f"{n.duration:.3f}",
+            str(n.velocity),
+            _finger(n.finger),
             str(phrase_of.get(id(n), "-")),
         )
     return table
@@ -51,7 +63,14 @@ def phrases_table(phrases: list[Phrase], trained: set[int] | None = None) -> Tab
     for column in columns:
         table.add_column(column)
     for p in phrases:
-        row = [str(p.index), p.hash, str(len(p.notes)), f"{p.start:.3f}", f"{p.end:.3f}", " ".join(n.name for n in p.notes)]
+        row = [
+            str(p.index),
+            p.hash,
+            str(len(p.notes)),
+            f"{p.start:.3f}",
+            f"{p.end:.3f}",
+            " ".join(n.name for n in p.notes),
+        ]
         if trained is not None:
             row.append("trained" if p.index in trained else "[yellow]none[/yellow]")
         table.add_row(*row)
@@ -63,7 +82,10 @@ def report_tables(report: Report) -> list[Table]:
     summary.add_column("figure")
     summary.add_column("value", justify="right")
     rows = [
-        ("notes (reference / played / matched)", f"{report.reference_notes} / {report.played_notes} / {report.matched_notes}"),
+        (
+            "notes (reference / played / matched)",
+            f"{report.reference_notes} / {report.played_notes} / {report.matched_notes}",
+        ),
         ("note precision", f"{report.precision:.3f}"),
         ("note recall", f"{report.recall:.3f}"),
         ("note F1", f"{report.f1:.3f}"),
@@ -71,8 +93,14 @@ def report_tables(report: Report) -> list[Table]:
         ("velocity-aware note F1 (mir_eval)", f"{report.velocity_f1:.3f}"),
         ("velocity mean abs. error (MIDI)", _opt(report.velocity_mae, ".2f")),
         ("velocity max error (MIDI)", _opt(report.velocity_max_error, "d")),
-        ("onset error mean (ms)", _opt(None if report.onset_error_mean is None else report.onset_error_mean * 1000, ".1f")),
-        ("onset error max (ms)", _opt(None if report.onset_error_max is None else report.onset_error_max * 1000, ".1f")),
+        (
+            "onset error mean (ms)",
+            _opt(None if report.onset_error_mean is None else report.onset_error_mean * 1000, ".1f"),
+        ),
+        (
+            "onset error max (ms)",
+            _opt(None if report.onset_error_max is None else report.onset_error_max * 1000, ".1f"),
+        ),
         ("key-press F1 per step (RoboPianist)", f"{report.step_f1:.3f}"),
         ("fingering accuracy", _opt(report.fingering_accuracy, ".3f")),
         ("onset tolerance (ms)", f"{report.onset_tolerance * 1000:.0f}"),
@@ -81,7 +109,16 @@ def report_tables(report: Report) -> list[Table]:
         summary.add_row(name, value)
 
     notes = Table(title="per note")
-    for column in ("pitch", "target onset", "played onset", "target vel", "played vel", "vel error", "finger", "status"):
+    for column in (
+        "pitch",
+        "target onset",
+        "played onset",
+        "target vel",
+        "played vel",
+        "vel error",
+        "finger",
+        "status",
+    ):
         notes.add_column(column)
     for row in report.rows:
         ref, out = row.reference, row.played
@@ -114,8 +151,13 @@ def training_table(rows) -> Table:
     for job, manifest in rows:
         evaluation = manifest.get("evaluation", {})  # the kept (best evaluated) policy's figures
         table.add_row(
-            job.key, ", ".join(map(str, job.phrases)), str(manifest.get("steps", "-")), str(evaluation.get("step", "-")),
-            _opt(evaluation.get("f1"), ".3f"), _opt(evaluation.get("velocity_mae"), ".1f"),
-            _opt(manifest.get("seconds", 0) / 60 if manifest.get("seconds") is not None else None, ".1f"), str(job.folder),
+            job.key,
+            ", ".join(map(str, job.phrases)),
+            str(manifest.get("steps", "-")),
+            str(evaluation.get("step", "-")),
+            _opt(evaluation.get("f1"), ".3f"),
+            _opt(evaluation.get("velocity_mae"), ".1f"),
+            _opt(manifest.get("seconds", 0) / 60 if manifest.get("seconds") is not None else None, ".1f"),
+            str(job.folder),
         )
     return table

@@ -31,14 +31,14 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
+from pianobot.env.rewards import RewardConfig, reward_terms
 from pianobot.music.instrument import check_playable
 from pianobot.music.piece import Piece
 from pianobot.music.tasks import TASKS, make_task
 from pianobot.music.tensor import FINGER, NOTE, VELOCITY, ScoreSpec, score_tensor, steps_for
-from pianobot.env.rewards import RewardConfig, reward_terms
 from pianobot.sim.hand import finger_ik, joint_names
-from pianobot.sim.tactile import TactileConfig, TactileRenderer, pool, to_uint8
 from pianobot.sim.keyboard import strike_points
+from pianobot.sim.tactile import TactileConfig, TactileRenderer, pool, to_uint8
 from pianobot.sim.world import PianoWorld, WorldConfig
 
 JOINT_KINDS = ("abd", "mcp", "pip", "dip")
@@ -158,13 +158,17 @@ class EnvConfig:
 
     def __post_init__(self) -> None:
         if not self.actuated or set(self.actuated) - set(JOINT_KINDS) or len(set(self.actuated)) < len(self.actuated):
-            raise ValueError(f"actuated joints must be distinct names from {', '.join(JOINT_KINDS)}; got {', '.join(self.actuated) or 'none'}")
+            raise ValueError(
+                f"actuated joints must be distinct names from {', '.join(JOINT_KINDS)}; got {', '.join(self.actuated) or 'none'}"
+            )
         if self.lookahead < 0 or self.lead_in < 0 or self.tail < 0:
             raise ValueError("lookahead, lead_in and tail cannot be negative")
         if self.tactile_pool is not None:
             (rows, cols), sensor = self.tactile_pool, self.tactile_sensor
             if not (rows >= 1 and cols >= 1 and sensor.rows % rows == 0 and sensor.cols % cols == 0):
-                raise ValueError(f"tactile_pool {rows} x {cols} must divide the sensor's {sensor.rows} x {sensor.cols} images")
+                raise ValueError(
+                    f"tactile_pool {rows} x {cols} must divide the sensor's {sensor.rows} x {sensor.cols} images"
+                )
 
     @property
     def score_spec(self) -> ScoreSpec:
@@ -201,7 +205,9 @@ class PianoEnv(gym.Env):
         self.lead_steps = steps_for(config.lead_in, self.spec_score)
         self.strike_points = strike_points(config.world.keyboard)
         self.tactile = (
-            TactileRenderer(config.tactile_sensor, config.world.hand.geometry, self.world.boxes) if config.tactile else None
+            TactileRenderer(config.tactile_sensor, config.world.hand.geometry, self.world.boxes)
+            if config.tactile
+            else None
         )
 
         obs = {
@@ -286,7 +292,11 @@ class PianoEnv(gym.Env):
         target_row = self.score[self.t]
         played = result.pressed_velocity / 127.0
         terms = reward_terms(
-            self.config.reward, played, self.key_finger, target_row[:, VELOCITY] * target_row[:, NOTE], self.target_finger[self.t],
+            self.config.reward,
+            played,
+            self.key_finger,
+            target_row[:, VELOCITY] * target_row[:, NOTE],
+            self.target_finger[self.t],
             self._fingertip_distances() if self.config.reward.closeness_weight else None,
         )
         reward = float(sum(terms.values()))

@@ -83,8 +83,8 @@ def wasserstein_distance(played: np.ndarray, target: np.ndarray, sigma: float, k
     cost = np.zeros((n, n))
     move = key_cost * np.abs(s[:, None] - t[None, :]) + np.abs(played[s][:, None] - target[t][None, :])
     cost[: len(s), : len(t)] = move
-    cost[: len(s), len(t):] = sigma  # remove a played key
-    cost[len(s):, : len(t)] = sigma  # add a target key
+    cost[: len(s), len(t) :] = sigma  # remove a played key
+    cost[len(s) :, : len(t)] = sigma  # add a target key
     from scipy.optimize import linear_sum_assignment  # only this reward needs scipy, slow to import
 
     rows, cols = linear_sum_assignment(cost)

@@ -34,7 +34,9 @@ class TrainConfig:
         if self.explore == "scripted" and self.env.world.control != "velocity":
             raise ValueError("scripted exploration needs velocity control (the scripted pianist drives joint speeds)")
         if not 0 <= self.sac.exploration_steps < self.steps:
-            raise ValueError(f"{self.steps} steps must exceed the {self.sac.exploration_steps} exploration steps, or nothing is learnt")
+            raise ValueError(
+                f"{self.steps} steps must exceed the {self.sac.exploration_steps} exploration steps, or nothing is learnt"
+            )
         if self.until_f1 is not None and not 0.0 < self.until_f1 <= 1.0:
             raise ValueError(f"the note F1 to stop at must lie in (0, 1]; got {self.until_f1}")
         if min(self.eval_every, self.eval_episodes, self.checkpoint_every) < 1:

@@ -15,8 +15,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from pianobot.pianist.scripted import ScriptedPianist
 from pianobot.env.piano import EnvConfig
+from pianobot.pianist.scripted import ScriptedPianist
 
 EXPLORATIONS = ("uniform", "repeat", "prior", "scripted")
 REPEAT_PROBABILITY = 0.8
@@ -53,7 +53,9 @@ class Explorer:
     def act(self, observation: dict, taught: np.ndarray | None = None) -> np.ndarray:
         """An exploration action; ``taught`` is this step's :meth:`teach` result, if already asked."""
         if self.kind == "scripted":
-            action = (taught if taught is not None else self.teach(observation)) + self.rng.normal(0.0, self.noise, self.size)
+            action = (taught if taught is not None else self.teach(observation)) + self.rng.normal(
+                0.0, self.noise, self.size
+            )
             return np.clip(action, -1.0, 1.0).astype(np.float32)
         action = self.rng.uniform(-1.0, 1.0, self.size).astype(np.float32)
         if self.kind in ("repeat", "prior") and self.previous is not None and self.rng.random() < REPEAT_PROBABILITY:

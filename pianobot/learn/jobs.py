@@ -94,7 +94,11 @@ def plan_jobs(jobs: list[PhraseJob], force: bool) -> tuple[list[PhraseJob], list
 
 
 def run_jobs(
-    jobs: list[PhraseJob], config: TrainConfig, workers: int, on_progress: Callable[[str, Progress], None], threads: int = 1
+    jobs: list[PhraseJob],
+    config: TrainConfig,
+    workers: int,
+    on_progress: Callable[[str, Progress], None],
+    threads: int = 1,
 ) -> dict[str, dict]:
     """Train every job, ``workers`` at a time in separate processes (1: in this process), each with
     ``threads`` torch threads (more threads than cores makes torch's thread pools spin against each other)."""
@@ -102,14 +106,18 @@ def run_jobs(
     if workers <= 1 or len(jobs) <= 1:
         torch.set_num_threads(threads)
         for job in jobs:
-            results[job.key] = train_policy(job.target, config, job.folder, lambda p, key=job.key: on_progress(key, p), about=job.about())
+            results[job.key] = train_policy(
+                job.target, config, job.folder, lambda p, key=job.key: on_progress(key, p), about=job.about()
+            )
         return results
     import multiprocessing
 
     manager = multiprocessing.Manager()
     queue = manager.Queue()
     context = multiprocessing.get_context("spawn")
-    with ProcessPoolExecutor(max_workers=workers, mp_context=context, initializer=_exit_with_parent, initargs=(os.getpid(),)) as pool:
+    with ProcessPoolExecutor(
+        max_workers=workers, mp_context=context, initializer=_exit_with_parent, initargs=(os.getpid(),)
+    ) as pool:
         futures = {pool.submit(_run_job, job, config, queue, threads): job for job in jobs}
         pending = set(futures)
         while pending:

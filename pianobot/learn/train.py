@@ -39,6 +39,7 @@ TASK_EVAL_EPISODES = 20
 """Evaluation episodes when training on a task family: every instance differs, and 3 or 5 of
 them stopped runs on a lucky evaluation (5 instances at F1 0.90 played 30 others at 0.58)."""
 
+
 @dataclass
 class Progress:
     """What the loop reports to whoever displays it."""
@@ -53,10 +54,16 @@ class Progress:
 
 
 def make_env(target: Piece | str, env_config: EnvConfig) -> PianoEnv:
-    return PianoEnv(task=target, config=env_config) if isinstance(target, str) else PianoEnv(piece=target, config=env_config)
+    return (
+        PianoEnv(task=target, config=env_config)
+        if isinstance(target, str)
+        else PianoEnv(piece=target, config=env_config)
+    )
 
 
-def evaluate(agent: SAC, target: Piece | str, env_config: EnvConfig, episodes: int, first_seed: int = EVAL_SEED) -> dict:
+def evaluate(
+    agent: SAC, target: Piece | str, env_config: EnvConfig, episodes: int, first_seed: int = EVAL_SEED
+) -> dict:
     """Deterministic policy on fixed hand starts (and task instances), seeds ``first_seed``,
     ``first_seed + 1``, ...: mean note F1, velocity error and return."""
     env = make_env(target, env_config)
@@ -118,7 +125,12 @@ def _train(target, config: TrainConfig, folder: Path, report, stop_after: int | 
     agent = make_agent(env, config.sac)
     space = env.observation_space
     tactile_shape = space["tactile"].shape if "tactile" in space.spaces else None
-    buffer = ReplayBuffer(min(config.sac.buffer_size, config.steps), vector_size(space, config.sac.score_input), tactile_shape, env.action_space.shape[0])
+    buffer = ReplayBuffer(
+        min(config.sac.buffer_size, config.steps),
+        vector_size(space, config.sac.score_input),
+        tactile_shape,
+        env.action_space.shape[0],
+    )
     rng = np.random.default_rng(config.seed)
     explorer = Explorer(config.explore, env.action_space.shape[0], env_config, rng)
     step, episode, update_debt, evaluations = 0, 0, 0.0, []
@@ -135,7 +147,12 @@ def _train(target, config: TrainConfig, folder: Path, report, stop_after: int | 
         torch.set_rng_state(tensors["torch_rng"])
         buffer.load(buffer_folder, state["buffer_size"], state["buffer_cursor"])
         rng.bit_generator.state = state["rng"]
-        step, episode, update_debt, evaluations = state["step"], state["episode"], state["update_debt"], state["evaluations"]
+        step, episode, update_debt, evaluations = (
+            state["step"],
+            state["episode"],
+            state["update_debt"],
+            state["evaluations"],
+        )
         agent.updates = state["updates"]
         seconds_before = state.get("seconds", 0.0)
         env.reset(seed=config.seed)  # creates the env's generator, then restore its state
@@ -188,13 +205,23 @@ def _train(target, config: TrainConfig, folder: Path, report, stop_after: int | 
                     break
             if step >= next_checkpoint and step < config.steps:
                 state = {
-                    "step": step, "episode": episode, "update_debt": update_debt, "updates": agent.updates,
-                    "evaluations": evaluations, "rng": rng.bit_generator.state, "env_rng": env.np_random.bit_generator.state,
-                    "buffer_size": buffer.size, "buffer_cursor": buffer.cursor, "best": best, "next_eval": next_eval,
+                    "step": step,
+                    "episode": episode,
+                    "update_debt": update_debt,
+                    "updates": agent.updates,
+                    "evaluations": evaluations,
+                    "rng": rng.bit_generator.state,
+                    "env_rng": env.np_random.bit_generator.state,
+                    "buffer_size": buffer.size,
+                    "buffer_cursor": buffer.cursor,
+                    "best": best,
+                    "next_eval": next_eval,
                     "seconds": seconds_before + time.perf_counter() - started,
                 }
                 kept = {BEST_PREFIX + k: v for k, v in (best_tensors or {}).items()}
-                store.save_checkpoint(folder, {**agent.tensors(), "torch_rng": torch.get_rng_state(), **kept}, state, buffer)
+                store.save_checkpoint(
+                    folder, {**agent.tensors(), "torch_rng": torch.get_rng_state(), **kept}, state, buffer
+                )
                 next_checkpoint = (step // config.checkpoint_every + 1) * config.checkpoint_every
             if stop_after is not None and step >= stop_after:
                 env.close()

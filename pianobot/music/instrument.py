@@ -103,9 +103,7 @@ def check_playable(piece: Piece, keyboard: KeyboardSpec, hand: HandSpec) -> None
     if outside:
         names = ", ".join(n.describe() for n in outside[:4]) + (" ..." if len(outside) > 4 else "")
         shift = suggest_transpose(piece, keyboard)
-        fix = (
-            f"use --transpose {shift}" if shift is not None else "the piece spans more than the keyboard"
-        )
+        fix = f"use --transpose {shift}" if shift is not None else "the piece spans more than the keyboard"
         raise PianobotError(
             f"{len(outside)} note(s) outside the keyboard {keyboard.describe()}: {names}; "
             f"{fix}, or widen the keyboard with --lowest-note / --keys"

@@ -45,7 +45,11 @@ _HAND_NAMES = {
 
 def hand_tracks(tracks: list[midi_io.TrackInfo], hand: str) -> list[int]:
     """Tracks with notes whose names say they hold ``hand``'s part ('Right Hand', 'RH', 'Treble'...)."""
-    return [t.index for t in tracks if t.notes and _HAND_NAMES[hand].search(t.name) and not _HAND_NAMES[_other(hand)].search(t.name)]
+    return [
+        t.index
+        for t in tracks
+        if t.notes and _HAND_NAMES[hand].search(t.name) and not _HAND_NAMES[_other(hand)].search(t.name)
+    ]
 
 
 def _other(hand: str) -> str:
@@ -88,7 +92,9 @@ def thin_chords(piece: Piece, fingers: int) -> tuple[Piece, int]:
         for i, n in enumerate(out):  # a legato overlap is a player's habit, not a voice: it ends here
             if onset < n.offset <= onset + LEGATO_OVERLAP:
                 out[i] = replace(n, offset=onset)
-        sounding = sorted((i for i, n in enumerate(out) if n.offset > onset), key=lambda i: (out[i].onset, out[i].pitch))
+        sounding = sorted(
+            (i for i, n in enumerate(out) if n.offset > onset), key=lambda i: (out[i].onset, out[i].pitch)
+        )
         for i in sounding[: max(0, len(sounding) + len(kept) - fingers)]:
             out[i] = replace(out[i], offset=onset)
         out.extend(kept)
@@ -111,17 +117,27 @@ def _read_midi(path: Path, options: LoadOptions, bpm: float | None = None) -> Pi
     if len(parts) == 2:  # two unnamed parts: the higher one is the right hand's
         high, low = sorted(parts, key=lambda t: t.low + t.high, reverse=True)
         chosen = high if options.hand == "right" else low
-        warnings.warn(PianobotWarning(f"no track is named for a hand: took track {chosen.index} (the {'higher' if chosen is high else 'lower'} of two) as the {options.hand} hand"))
+        warnings.warn(
+            PianobotWarning(
+                f"no track is named for a hand: took track {chosen.index} (the {'higher' if chosen is high else 'lower'} of two) as the {options.hand} hand"
+            )
+        )
         return midi_io.read_midi(path, tracks=[chosen.index], bpm=bpm, grid=grid)
-    warnings.warn(PianobotWarning(f"no track is named for a hand: took the notes {'at or above' if options.hand == 'right' else 'below'} {pitch_name(options.split)} (--split)"))
+    warnings.warn(
+        PianobotWarning(
+            f"no track is named for a hand: took the notes {'at or above' if options.hand == 'right' else 'below'} {pitch_name(options.split)} (--split)"
+        )
+    )
     piece = midi_io.read_midi(path, bpm=bpm, grid=grid)
     if options.hand == "right":
         notes = [n for n in piece.notes if n.pitch >= options.split]
     else:
         notes = [n for n in piece.notes if n.pitch < options.split]
     if not notes:
-        raise PianobotError(f"{path.name} has no notes {'at or above' if options.hand == 'right' else 'below'} "
-                            f"{pitch_name(options.split)} for the {options.hand} hand: move the split with --split")
+        raise PianobotError(
+            f"{path.name} has no notes {'at or above' if options.hand == 'right' else 'below'} "
+            f"{pitch_name(options.split)} for the {options.hand} hand: move the split with --split"
+        )
     return Piece(tuple(notes), bpm=piece.bpm)
 
 
@@ -143,7 +159,9 @@ def load_piece(path: str | Path, options: LoadOptions = LoadOptions()) -> Piece:
             embedded = any(n.finger is not None for n in piece.notes)
             piece = pig.apply_fingering(piece, sidecar)
             if embedded:
-                warnings.warn(PianobotWarning(f"fingering from {sidecar.name} replaces the fingering inside {path.name}"))
+                warnings.warn(
+                    PianobotWarning(f"fingering from {sidecar.name} replaces the fingering inside {path.name}")
+                )
         if options.tempo is not None:
             # re-read with the new tempo, then carry the fingering over note by note
             fingers = [n.finger for n in piece.notes]
@@ -162,8 +180,10 @@ def load_part(path: str | Path, options: LoadOptions, hand: HandSpec) -> Piece:
     if options.hand is not None:
         piece, dropped = thin_chords(piece, len(hand.fingers))
         if dropped:
-            warnings.warn(PianobotWarning(
-                f"the {options.hand} hand's part has chords of more than {len(hand.fingers)} notes: "
-                f"kept the highest {len(hand.fingers)}, dropped {dropped} note(s)"
-            ))
+            warnings.warn(
+                PianobotWarning(
+                    f"the {options.hand} hand's part has chords of more than {len(hand.fingers)} notes: "
+                    f"kept the highest {len(hand.fingers)}, dropped {dropped} note(s)"
+                )
+            )
     return piece

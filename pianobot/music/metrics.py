@@ -104,7 +104,9 @@ def _arrays(piece: Piece) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return intervals, pitches, velocities
 
 
-def key_press_f1(reference: Piece, played: Piece, control_hz: float = ScoreSpec.control_hz) -> tuple[float, float, float]:
+def key_press_f1(
+    reference: Piece, played: Piece, control_hz: float = ScoreSpec.control_hz
+) -> tuple[float, float, float]:
     """RoboPianist's per-step key-press precision, recall and F1, averaged over control steps."""
     spec = ScoreSpec(control_hz=control_hz)
     spans = {"ref": note_steps(reference, spec), "out": note_steps(played, spec)}
@@ -149,9 +151,13 @@ def compare(
         _, _, velocity_f1, _ = mir_eval.transcription_velocity.precision_recall_f1_overlap(
             ref_int, ref_hz, ref_vel, out_int, out_hz, out_vel, onset_tolerance=onset_tolerance, offset_ratio=None
         )
-        pairs = transcription.match_notes(
-            ref_int, ref_hz, out_int, out_hz, onset_tolerance=onset_tolerance, offset_ratio=None
-        ) if len(reference) and len(played) else []
+        pairs = (
+            transcription.match_notes(
+                ref_int, ref_hz, out_int, out_hz, onset_tolerance=onset_tolerance, offset_ratio=None
+            )
+            if len(reference) and len(played)
+            else []
+        )
 
     matched = {r: p for r, p in pairs}
     rows = [NoteRow(n, played.notes[matched[i]] if i in matched else None) for i, n in enumerate(reference.notes)]
@@ -181,9 +187,7 @@ def compare(
         step_recall=step_r,
         step_f1=step_f1,
         fingering_accuracy=(
-            sum(r.reference.finger == r.played.finger for r in fingered) / len(fingered)
-            if fingered
-            else None
+            sum(r.reference.finger == r.played.finger for r in fingered) / len(fingered) if fingered else None
         ),
         onset_tolerance=onset_tolerance,
         rows=tuple(rows),
@@ -223,9 +227,12 @@ def plot_report(reference: Piece, played: Piece, report: Report, path) -> None:
             )
     axes[1].set_xlabel("time (s)")
     axes[0].legend(
-        handles=[Patch(color=colours["matched"], label="matched (shade = velocity)"),
-                 Patch(color=colours["missed"], label="missed / extra")],
-        loc="upper right", fontsize=8,
+        handles=[
+            Patch(color=colours["matched"], label="matched (shade = velocity)"),
+            Patch(color=colours["missed"], label="missed / extra"),
+        ],
+        loc="upper right",
+        fontsize=8,
     )
     mae = "n/a" if report.velocity_mae is None else f"{report.velocity_mae:.1f}"
     fig.suptitle(f"note F1 {report.f1:.3f}   velocity MAE {mae}")

@@ -116,9 +116,7 @@ class _TempoMap:
     """Ticks to seconds through a file's set_tempo events (default 120 bpm)."""
 
     def __init__(self, midi: mido.MidiFile):
-        changes = sorted(
-            (t, m.tempo) for track in midi.tracks for t, m in _absolute(track) if m.type == "set_tempo"
-        )
+        changes = sorted((t, m.tempo) for track in midi.tracks for t, m in _absolute(track) if m.type == "set_tempo")
         self.tpb = midi.ticks_per_beat
         self.points: list[tuple[int, float, int]] = []  # (tick, seconds at tick, tempo from there)
         tick, seconds, tempo = 0, 0.0, 500_000
@@ -145,8 +143,17 @@ def list_tracks(midi: mido.MidiFile) -> list[TrackInfo]:
         ons = [m for m in track if m.type == "note_on" and m.velocity > 0]
         pedal = sum(1 for m in track if m.type == "control_change" and m.control == 64 and m.value >= 64)
         pitches = [m.note for m in ons]
-        infos.append(TrackInfo(i, name, len(ons), tuple(sorted({m.channel for m in ons})), pedal,
-                               min(pitches, default=None), max(pitches, default=None)))
+        infos.append(
+            TrackInfo(
+                i,
+                name,
+                len(ons),
+                tuple(sorted({m.channel for m in ons})),
+                pedal,
+                min(pitches, default=None),
+                max(pitches, default=None),
+            )
+        )
     return infos
 
 
@@ -213,7 +220,11 @@ def _track_notes(
 
 
 def read_midi(
-    path: str | Path, *, track: str | int | None = None, bpm: float | None = None, grid: float | None = None,
+    path: str | Path,
+    *,
+    track: str | int | None = None,
+    bpm: float | None = None,
+    grid: float | None = None,
     tracks: list[int] | None = None,
 ) -> Piece:
     """Read a .mid file into a :class:`Piece`, with fingering from lyric/text events.
@@ -271,9 +282,7 @@ def read_midi(
             finger = fingers[starting.index((on, off, pitch, vel))] if fingers else None
             onset, offset = seconds(on), seconds(off)
             if round(offset, 3) <= round(onset, 3):
-                warnings.warn(
-                    PianobotWarning(f"{pitch_name(pitch)} at {onset:.3f} s lasts under 1 ms; dropped")
-                )
+                warnings.warn(PianobotWarning(f"{pitch_name(pitch)} at {onset:.3f} s lasts under 1 ms; dropped"))
                 continue
             notes.append(Note(onset=onset, pitch=pitch, offset=offset, velocity=vel, finger=finger))
     return Piece(tuple(_resolve_overlaps(notes)), bpm=nominal)
@@ -286,9 +295,7 @@ def _resolve_overlaps(notes: list[Note]) -> list[Note]:
         previous = by_pitch[note.pitch][-1] if by_pitch[note.pitch] else None
         if previous is not None and note.onset < previous.offset:
             if note.onset == previous.onset:
-                warnings.warn(
-                    PianobotWarning(f"{note.describe()} appears twice at once; the louder one is kept")
-                )
+                warnings.warn(PianobotWarning(f"{note.describe()} appears twice at once; the louder one is kept"))
                 if note.offset > previous.offset:
                     by_pitch[note.pitch][-1] = replace(previous, offset=note.offset)
                 continue

@@ -102,7 +102,4 @@ def split_phrases(piece: Piece, max_notes: int = DEFAULT_MAX_NOTES) -> list[Phra
         bounds.append((cut[j], j))
         j = cut[j]
     bounds.reverse()
-    return [
-        Phrase(index=k, notes=tuple(n for chord in chords[i:j] for n in chord))
-        for k, (i, j) in enumerate(bounds)
-    ]
+    return [Phrase(index=k, notes=tuple(n for chord in chords[i:j] for n in chord)) for k, (i, j) in enumerate(bounds)]

@@ -93,8 +93,16 @@ def pig_text(piece: Piece) -> str:
             raise PianobotError(f"{note.describe()} has no finger: a PIG file needs a finger for every note")
         lines.append(
             "\t".join(
-                [str(i), f"{note.onset:.6f}", f"{note.offset:.6f}", pitch_name(note.pitch),
-                 str(note.velocity), "80", "0", str(note.finger)]
+                [
+                    str(i),
+                    f"{note.onset:.6f}",
+                    f"{note.offset:.6f}",
+                    pitch_name(note.pitch),
+                    str(note.velocity),
+                    "80",
+                    "0",
+                    str(note.finger),
+                ]
             )
         )
     return "\n".join(lines) + "\n"
@@ -135,4 +143,3 @@ def apply_fingering(piece: Piece, pig_path: str | Path) -> Piece:
         used[best[1]] = True
         fingers.append(rows[best[1]][0].finger)
     return piece.with_fingers(fingers)
-

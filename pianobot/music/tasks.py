@@ -71,6 +71,9 @@ def make_task(name: str, rng: np.random.Generator, keyboard: KeyboardSpec = Keyb
         for i in range(3):
             base = _position(rng, len(whites), base)
             velocity = _velocity(rng)
-            notes += [Note(float(i), whites[base], i + 1.0, velocity, 2), Note(float(i), whites[base + 2], i + 1.0, velocity, 4)]
+            notes += [
+                Note(float(i), whites[base], i + 1.0, velocity, 2),
+                Note(float(i), whites[base + 2], i + 1.0, velocity, 4),
+            ]
         return Piece(tuple(notes), bpm=BPM)
     raise ValueError(f"unknown task {name!r}: choose one of {', '.join(TASKS)}")

@@ -37,7 +37,9 @@ def synthesize(piece: Piece, sample_rate: int = SAMPLE_RATE) -> tuple[np.ndarray
     font = soundfont()
     if font is not None:
         return midi.fluidsynth(fs=sample_rate, sf2_path=str(font)), f"FluidSynth with {font.name}"
-    return midi.synthesize(fs=sample_rate), "sine waves (pretty_midi; install fluid-soundfont-gm and pyfluidsynth for a piano)"
+    return midi.synthesize(
+        fs=sample_rate
+    ), "sine waves (pretty_midi; install fluid-soundfont-gm and pyfluidsynth for a piano)"
 
 
 def write_wav(piece: Piece, path: str | Path, sample_rate: int = SAMPLE_RATE) -> str:

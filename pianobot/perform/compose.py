@@ -77,7 +77,9 @@ def shared_env_config(models: Path, phrases: list[Phrase]) -> EnvConfig | None:
     folders = [find_policy(models, phrase) for phrase in phrases]
     configs = {policy_configs(folder)[0] for folder in folders if folder is not None}
     if len(configs) > 1:
-        raise PianobotError(f"the policies in {models} for this piece were trained with different environments: retrain them with one set of options")
+        raise PianobotError(
+            f"the policies in {models} for this piece were trained with different environments: retrain them with one set of options"
+        )
     return configs.pop() if configs else None
 
 

@@ -50,7 +50,9 @@ def write_video(frames: list[np.ndarray], path: str | Path, fps: float) -> Path:
     path = check_writable(path)
     tmp = temporary_beside(path)
     try:
-        with imageio.get_writer(tmp, format="FFMPEG", fps=fps, codec="libx264", quality=7, macro_block_size=16) as writer:
+        with imageio.get_writer(
+            tmp, format="FFMPEG", fps=fps, codec="libx264", quality=7, macro_block_size=16
+        ) as writer:
             for frame in frames:
                 writer.append_data(frame)
         move_into_place(tmp, path)

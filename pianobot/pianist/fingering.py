@@ -86,7 +86,9 @@ class Planner:
         # slanted fingertip easily slips off their narrow tops
         forward = hand.palm_y - strike_points(keyboard)[:, 1].max()
         self.black = np.array([b.black for b in key_boxes(keyboard)])
-        self.reach = REACH_FRACTION * forward * math.tan(hand.geometry.abduction_limit) * np.where(self.black, BLACK_REACH, 1.0)
+        self.reach = (
+            REACH_FRACTION * forward * math.tan(hand.geometry.abduction_limit) * np.where(self.black, BLACK_REACH, 1.0)
+        )
         self.pitch = keyboard.geometry.white_pitch
         self.grid = np.arange(0.0, keyboard_width(keyboard) + 1e-9, self.pitch / GRID)
 
@@ -103,7 +105,9 @@ class Planner:
                 cost[a] += np.where(np.abs(offset) <= 1.0, STRETCH_COST * offset**2, _INFEASIBLE)
         return assignments, keys, cost
 
-    def _transition(self, prev: tuple, chord: tuple, fingers_prev: tuple, fingers: tuple, held: list[bool], time: float) -> np.ndarray:
+    def _transition(
+        self, prev: tuple, chord: tuple, fingers_prev: tuple, fingers: tuple, held: list[bool], time: float
+    ) -> np.ndarray:
         """Cost (W_prev x W) of going from one state's fingers to the next's, for every pair of wrist positions."""
         (_, prev_keys), (_, keys) = prev, chord
         move = self.grid[None, :] - self.grid[:, None]  # wrist displacement, rows: from, columns: to
@@ -156,7 +160,9 @@ class Planner:
                 blocks = np.empty((len(p_assign), len(self.grid), len(assignments), len(self.grid)))
                 for a_p, f_p in enumerate(p_assign):
                     for a, f in enumerate(assignments):
-                        blocks[a_p, :, a, :] = self._transition((prev_chord, p_keys), (chord, keys), f_p, f, held, time) + too_fast
+                        blocks[a_p, :, a, :] = (
+                            self._transition((prev_chord, p_keys), (chord, keys), f_p, f, held, time) + too_fast
+                        )
                 step = totals[-1][:, None] + blocks.reshape(len(totals[-1]), -1)
                 best = np.argmin(step, axis=0)
                 total = step[best, np.arange(step.shape[1])] + local.ravel()
@@ -195,10 +201,14 @@ class Planner:
                 )
         moves = np.abs(np.diff(wrist)) > 1e-9
         fingered = piece.with_fingers(fingers)
-        return FingeringPlan(fingered, tuple(wrist), float(np.abs(np.diff(wrist)).sum()), int(moves.sum()), tuple(problems))
+        return FingeringPlan(
+            fingered, tuple(wrist), float(np.abs(np.diff(wrist)).sum()), int(moves.sum()), tuple(problems)
+        )
 
 
-def ensure_fingering(piece: Piece, keyboard: KeyboardSpec, hand: HandSpec, refinger: bool = False) -> tuple[Piece, FingeringPlan | None]:
+def ensure_fingering(
+    piece: Piece, keyboard: KeyboardSpec, hand: HandSpec, refinger: bool = False
+) -> tuple[Piece, FingeringPlan | None]:
     """``piece`` as it is when every note has a finger (and not ``refinger``), else fingered by
     the planner; the plan is returned too, or None when the piece kept its fingering."""
     if piece.has_fingering and not refinger:
@@ -208,6 +218,8 @@ def ensure_fingering(piece: Piece, keyboard: KeyboardSpec, hand: HandSpec, refin
     return plan.piece, plan
 
 
-def plan_fingering(piece: Piece, keyboard: KeyboardConfig = KeyboardConfig(), hand: HandConfig = HandConfig()) -> FingeringPlan:
+def plan_fingering(
+    piece: Piece, keyboard: KeyboardConfig = KeyboardConfig(), hand: HandConfig = HandConfig()
+) -> FingeringPlan:
     """The lowest-cost fingering of ``piece`` for ``hand`` on ``keyboard`` (see the module's notes)."""
     return Planner(keyboard, hand).plan(piece)

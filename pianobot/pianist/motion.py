@@ -68,7 +68,11 @@ class Motion:
                 low = max(max(holds) - tuning.hold_reach, wrist - tuning.hold_slide)
                 high = min(min(holds) + tuning.hold_reach, wrist + tuning.hold_slide)
                 target = float(np.clip(target, low, high)) if low <= high else wrist
-        if any(self._low(joints[slot]) for slot, f in enumerate(self.fingers) if f not in plans or plans[f].phase == "ready"):
+        if any(
+            self._low(joints[slot])
+            for slot, f in enumerate(self.fingers)
+            if f not in plans or plans[f].phase == "ready"
+        ):
             target = wrist  # a finger that lets go of a key rises before the hand moves
         return target
 
@@ -82,7 +86,9 @@ class Motion:
         desired = np.concatenate([[abduction], flexion])
         return np.clip((desired - q) / (self.hand.max_joint_speed * self.dt), -1.0, 1.0)
 
-    def _target(self, finger: int, plan: Plan | None, now_reach: float, wrist_next: float) -> tuple[str, float, float, float]:
+    def _target(
+        self, finger: int, plan: Plan | None, now_reach: float, wrist_next: float
+    ) -> tuple[str, float, float, float]:
         """(phase, abduction, reach, height): where the fingertip goes, and what it does there.
 
         The abduction aims the fingertip at the key's strike point; the reach (m from the
@@ -111,7 +117,16 @@ class Motion:
             height = top + plan.goal
         return phase, abduction, reach, height
 
-    def _waypoint(self, phase: str, abduction: float, reach: float, height: float, q: np.ndarray, now_reach: float, now_height: float) -> tuple[float, float, float]:
+    def _waypoint(
+        self,
+        phase: str,
+        abduction: float,
+        reach: float,
+        height: float,
+        q: np.ndarray,
+        now_reach: float,
+        now_height: float,
+    ) -> tuple[float, float, float]:
         """(abduction, reach, height) to be at by the end of this step on the way to the target.
 
         Up first; across before down; into or out of the black keys' band only high up; and
@@ -140,7 +155,10 @@ class Motion:
             move = np.array([reach - now_reach, height - now_height])
             length = float(np.hypot(*move))
             if length > tuning.max_move:
-                reach, height = now_reach + move[0] * tuning.max_move / length, now_height + move[1] * tuning.max_move / length
+                reach, height = (
+                    now_reach + move[0] * tuning.max_move / length,
+                    now_height + move[1] * tuning.max_move / length,
+                )
         return abduction, reach, height
 
     def _ik(self, reach: float, drop: float, current: np.ndarray) -> np.ndarray:
@@ -167,4 +185,7 @@ class Motion:
         reach, drop = lowest_point_in_finger_plane(self.geometry, q[1:])
         over_keys = 0.0 <= self.hand.palm_y - reach * math.cos(q[0]) <= self.layout.white_length
         height = self.hand.palm_height - drop
-        return over_keys and -self.layout.white_length * math.tan(self.layout.strike_angle) * 2 < height < self.tuning.clearance
+        return (
+            over_keys
+            and -self.layout.white_length * math.tan(self.layout.strike_angle) * 2 < height < self.tuning.clearance
+        )

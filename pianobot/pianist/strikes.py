@@ -144,7 +144,9 @@ class StrikePlanner:
         if current is None:
             return self._approach(upcoming, tip) if upcoming is not None else None
         key = current.key
-        began_earlier = previous_row is not None and (previous_row[key, NOTE] > 0.5 and previous_row[key, FINGER + slot] > 0.5)
+        began_earlier = previous_row is not None and (
+            previous_row[key, NOTE] > 0.5 and previous_row[key, FINGER + slot] > 0.5
+        )
         if not began_earlier:
             return self._approach(current, tip)  # the onset step itself: strike now
         tip_height = tip - self.layout.key_top[key]
@@ -168,7 +170,11 @@ class StrikePlanner:
         # closed loop: after this step the fingertip should be where constant-speed travel passes
         # the strike depth at the strike point of the onset's step, (start - 1 + point) steps on
         tip_height = tip - self.layout.key_top[key]
-        goal = tip_height - speed * self.dt if start == 0 else -depth - self.overshoot(speed) + speed * self.dt * (start - 1 + point)
+        goal = (
+            tip_height - speed * self.dt
+            if start == 0
+            else -depth - self.overshoot(speed) + speed * self.dt * (start - 1 + point)
+        )
         floor = -depth - self.tuning.hold_depth_margin
         return Plan(key, "strike", height=height, goal=float(np.clip(goal, floor, tip_height)), start=start, lead=steps)
 
@@ -189,7 +195,11 @@ class StrikePlanner:
                 plans[finger] = self._approach(upcoming, tips[finger])
 
         for finger, plan in list(plans.items()):
-            if plan.phase == "hold" and plan.next_note is not None and plan.next_note.start - plan.next_lead - tuning.prepare_steps <= 0:
+            if (
+                plan.phase == "hold"
+                and plan.next_note is not None
+                and plan.next_note.start - plan.next_lead - tuning.prepare_steps <= 0
+            ):
                 release(finger)
         holds = {f: p for f, p in plans.items() if p.phase == "hold"}
         if not holds:
@@ -197,7 +207,9 @@ class StrikePlanner:
         low = max(layout.wrist_for(f, p.key) for f, p in holds.items()) - tuning.hold_reach
         high = min(layout.wrist_for(f, p.key) for f, p in holds.items()) + tuning.hold_reach
         strikes = [(f, p.key, p.start, p.lead) for f, p in plans.items() if p.phase != "hold"]
-        strikes += [(f, p.next_note.key, p.next_note.start, p.next_lead) for f, p in holds.items() if p.next_note is not None]
+        strikes += [
+            (f, p.next_note.key, p.next_note.start, p.next_lead) for f, p in holds.items() if p.next_note is not None
+        ]
         for finger, key, start, lead in strikes:
             wanted = layout.wrist_for(finger, key)
             travel = max(0.0, low - wanted, wanted - high)

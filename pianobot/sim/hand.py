@@ -126,7 +126,9 @@ def hand_urdf(config: HandConfig, rail: tuple[float, float]) -> str:
     rejects a URDF written as one long line)."""
     g = config.geometry
     parts = ['<?xml version="1.0"?>', '<robot name="allegro_like_right_hand">']
-    parts.append('<link name="rail"><inertial><mass value="0"/><inertia ixx="0" iyy="0" izz="0" ixy="0" ixz="0" iyz="0"/></inertial></link>')
+    parts.append(
+        '<link name="rail"><inertial><mass value="0"/><inertia ixx="0" iyy="0" izz="0" ixy="0" ixz="0" iyz="0"/></inertial></link>'
+    )
     palm_size = (0.13, 0.05, 0.012)
     parts.append(
         "\n".join(
@@ -144,15 +146,24 @@ def hand_urdf(config: HandConfig, rail: tuple[float, float]) -> str:
         prefix = f"f{f}"
         parts.append(_link(f"{prefix}_base", config.finger_mass, g.base_to_mcp, g.link_radius, "finger"))
         parts.append(
-            _joint(f"{prefix}_abd", "revolute", "palm", f"{prefix}_base",
-                   (FINGER_BASE_X[f], FINGER_BASE_Y[f], 0.0), "0 0 1", (-g.abduction_limit, g.abduction_limit))
+            _joint(
+                f"{prefix}_abd",
+                "revolute",
+                "palm",
+                f"{prefix}_base",
+                (FINGER_BASE_X[f], FINGER_BASE_Y[f], 0.0),
+                "0 0 1",
+                (-g.abduction_limit, g.abduction_limit),
+            )
         )
         chain = [("mcp", "proximal", g.proximal), ("pip", "middle", g.middle), ("dip", "distal", g.distal)]
         parent, offset = f"{prefix}_base", g.base_to_mcp
         for (joint, link, length), limits in zip(chain, g.flexion_limits):
             tip = g.tip_radius if link == "distal" else 0.0
             parts.append(_link(f"{prefix}_{link}", config.finger_mass, length, g.link_radius, "finger", tip))
-            parts.append(_joint(f"{prefix}_{joint}", "revolute", parent, f"{prefix}_{link}", (0, -offset, 0), "1 0 0", limits))
+            parts.append(
+                _joint(f"{prefix}_{joint}", "revolute", parent, f"{prefix}_{link}", (0, -offset, 0), "1 0 0", limits)
+            )
             parent, offset = f"{prefix}_{link}", length
     parts.append("</robot>")
     return "\n".join(parts) + "\n"
@@ -195,7 +206,9 @@ def finger_ik(geometry: FingerGeometry, reach: float, drop: float, tilt: float =
         if abs(cosine) > 1:
             continue
         pip = math.acos(cosine)
-        mcp = math.atan2(z, x) - math.atan2(geometry.middle * math.sin(pip), geometry.proximal + geometry.middle * math.cos(pip))
+        mcp = math.atan2(z, x) - math.atan2(
+            geometry.middle * math.sin(pip), geometry.proximal + geometry.middle * math.cos(pip)
+        )
         q = np.array([mcp, pip, phi - mcp - pip])
         if all(lo <= a <= hi for a, (lo, hi) in zip(q, limits)):
             return q

@@ -153,14 +153,22 @@ def key_boxes(config: KeyboardConfig) -> list[KeyBox]:
         if KeyboardSpec.is_black(pitch):
             x = white_index * g.white_pitch  # on the boundary with the previous white key
             boxes.append(
-                KeyBox(pitch, True, (x, g.black_length / 2, g.black_rise - g.black_height / 2),
-                       (g.black_width / 2, g.black_length / 2, g.black_height / 2))
+                KeyBox(
+                    pitch,
+                    True,
+                    (x, g.black_length / 2, g.black_rise - g.black_height / 2),
+                    (g.black_width / 2, g.black_length / 2, g.black_height / 2),
+                )
             )
         else:
             x = (white_index + 0.5) * g.white_pitch
             boxes.append(
-                KeyBox(pitch, False, (x, g.white_length / 2, -g.white_height / 2),
-                       (g.white_width / 2, g.white_length / 2, g.white_height / 2))
+                KeyBox(
+                    pitch,
+                    False,
+                    (x, g.white_length / 2, -g.white_height / 2),
+                    (g.white_width / 2, g.white_length / 2, g.white_height / 2),
+                )
             )
             white_index += 1
     return boxes
@@ -181,7 +189,9 @@ def keyboard_urdf(config: KeyboardConfig) -> str:
     fully pressed), one element per line."""
     g = config.geometry
     parts = ['<?xml version="1.0"?>', '<robot name="keyboard">']
-    parts.append('<link name="frame"><inertial><mass value="0"/><inertia ixx="0" iyy="0" izz="0" ixy="0" ixz="0" iyz="0"/></inertial></link>')
+    parts.append(
+        '<link name="frame"><inertial><mass value="0"/><inertia ixx="0" iyy="0" izz="0" ixy="0" ixz="0" iyz="0"/></inertial></link>'
+    )
     for box in key_boxes(config):
         name = f"key_{box.pitch}"
         size = " ".join(f"{2 * h:.5f}" for h in box.half)

@@ -93,7 +93,9 @@ class TactileRenderer:
         local = np.stack([np.full(len(key_angles), point[0]), y[:, 0], z[:, 0]], axis=1)
         return np.linalg.norm(np.maximum(np.abs(local - self.centers) - self.halves, 0.0), axis=1)
 
-    def distances(self, position: np.ndarray, rotation: np.ndarray, key_angles: np.ndarray, max_range: float) -> np.ndarray:
+    def distances(
+        self, position: np.ndarray, rotation: np.ndarray, key_angles: np.ndarray, max_range: float
+    ) -> np.ndarray:
         """Distance along the gel normal from each gel pixel to the nearest key (inf where none within range)."""
         rows, cols = self.config.rows, self.config.cols
         out = np.full(rows * cols, np.inf, dtype=np.float32)
@@ -109,7 +111,11 @@ class TactileRenderer:
         lo, hi = self.centers[near] - self.halves[near], self.centers[near] + self.halves[near]
         t_near = np.zeros((len(near), len(points)), dtype=np.float32)
         t_far = np.full_like(t_near, np.inf)
-        for axis, coordinate, direction in ((0, points[None, :, 0], np.full((len(near), 1), normal[0])), (1, y, dy), (2, z, dz)):
+        for axis, coordinate, direction in (
+            (0, points[None, :, 0], np.full((len(near), 1), normal[0])),
+            (1, y, dy),
+            (2, z, dz),
+        ):
             direction = np.where(np.abs(direction) < 1e-12, 1e-12, direction)  # parallel to a face: no NaNs
             inverse = (1.0 / direction).astype(np.float32)
             t1 = (lo[:, axis : axis + 1] - coordinate) * inverse

@@ -13,9 +13,9 @@ import tempfile
 from dataclasses import dataclass, field
 
 import numpy as np
+
 from pianobot.music.tensor import ScoreSpec
 from pianobot.sim.bullet import p
-
 from pianobot.sim.hand import HandConfig, hand_urdf, joint_names
 from pianobot.sim.keyboard import KeyboardConfig, KeyEvent, KeySensor, key_boxes, keyboard_urdf, keyboard_width
 
@@ -118,7 +118,10 @@ class PianoWorld:
     def _build_hand(self) -> tuple[int, int, list[int], dict[int, int]]:
         c, hand = self.client, self.config.hand
         body = self._load_urdf(hand_urdf(hand, rail=(0.0, self.width)), [0, hand.palm_y, hand.palm_height])
-        index = {p.getJointInfo(body, j, physicsClientId=c)[1].decode(): j for j in range(p.getNumJoints(body, physicsClientId=c))}
+        index = {
+            p.getJointInfo(body, j, physicsClientId=c)[1].decode(): j
+            for j in range(p.getNumJoints(body, physicsClientId=c))
+        }
         fingers = [index[name] for name in joint_names(hand.spec)]
         g = hand.geometry
         per_finger = [(-g.abduction_limit, g.abduction_limit), *g.flexion_limits]
@@ -148,10 +151,21 @@ class PianoWorld:
     def _hold(self, finger_angles: np.ndarray, wrist: float) -> None:
         """Motors hold the current pose until the first action arrives."""
         c, hand = self.client, self.config.hand
-        p.setJointMotorControl2(self.hand, self.wrist_joint, p.POSITION_CONTROL, targetPosition=wrist, force=hand.wrist_force, physicsClientId=c)
+        p.setJointMotorControl2(
+            self.hand,
+            self.wrist_joint,
+            p.POSITION_CONTROL,
+            targetPosition=wrist,
+            force=hand.wrist_force,
+            physicsClientId=c,
+        )
         p.setJointMotorControlArray(
-            self.hand, self.finger_joints, p.VELOCITY_CONTROL, targetVelocities=[0.0] * len(self.finger_joints),
-            forces=[hand.joint_force] * len(self.finger_joints), physicsClientId=c,
+            self.hand,
+            self.finger_joints,
+            p.VELOCITY_CONTROL,
+            targetVelocities=[0.0] * len(self.finger_joints),
+            forces=[hand.joint_force] * len(self.finger_joints),
+            physicsClientId=c,
         )
 
     def key_state(self) -> tuple[np.ndarray, np.ndarray]:
@@ -183,7 +197,9 @@ class PianoWorld:
         points = {}
         for finger, link in self.tip_links.items():
             position, rotation = self.link_pose(link)
-            points[finger] = position + rotation @ np.array([0.0, -(g.distal - g.tip_radius), 0.0]) - np.array([0, 0, g.tip_radius])
+            points[finger] = (
+                position + rotation @ np.array([0.0, -(g.distal - g.tip_radius), 0.0]) - np.array([0, 0, g.tip_radius])
+            )
         return points
 
     def tip_forces(self) -> dict[int, float]:
@@ -209,8 +225,13 @@ class PianoWorld:
         depth = np.clip(angles / kb.geometry.max_angle, 0.0, 1.0)
         torque = kb.spring_torque + (kb.spring_torque_pressed - kb.spring_torque) * depth**2
         p.setJointMotorControlArray(
-            self.keyboard, self.key_joints, p.POSITION_CONTROL, targetPositions=[0.0] * len(self.key_joints),
-            positionGains=[kb.spring_gain] * len(self.key_joints), forces=torque.tolist(), physicsClientId=self.client,
+            self.keyboard,
+            self.key_joints,
+            p.POSITION_CONTROL,
+            targetPositions=[0.0] * len(self.key_joints),
+            positionGains=[kb.spring_gain] * len(self.key_joints),
+            forces=torque.tolist(),
+            physicsClientId=self.client,
         )
 
     def _apply_action(self, action: np.ndarray) -> None:
@@ -225,14 +246,29 @@ class PianoWorld:
             self._finger_command = fingers * hand.max_joint_speed
         else:
             self._finger_command = fingers * hand.max_joint_torque
-            p.setJointMotorControlArray(self.hand, self.finger_joints, p.VELOCITY_CONTROL, forces=[0.0] * n, physicsClientId=c)
+            p.setJointMotorControlArray(
+                self.hand, self.finger_joints, p.VELOCITY_CONTROL, forces=[0.0] * n, physicsClientId=c
+            )
         if cfg.discrete_wrist:
             target = self.discrete_wrist_position(wrist)
-            p.setJointMotorControl2(self.hand, self.wrist_joint, p.POSITION_CONTROL, targetPosition=target,
-                                    maxVelocity=hand.max_wrist_speed, force=hand.wrist_force, physicsClientId=c)
+            p.setJointMotorControl2(
+                self.hand,
+                self.wrist_joint,
+                p.POSITION_CONTROL,
+                targetPosition=target,
+                maxVelocity=hand.max_wrist_speed,
+                force=hand.wrist_force,
+                physicsClientId=c,
+            )
         else:
-            p.setJointMotorControl2(self.hand, self.wrist_joint, p.VELOCITY_CONTROL, targetVelocity=wrist * hand.max_wrist_speed,
-                                    force=hand.wrist_force, physicsClientId=c)
+            p.setJointMotorControl2(
+                self.hand,
+                self.wrist_joint,
+                p.VELOCITY_CONTROL,
+                targetVelocity=wrist * hand.max_wrist_speed,
+                force=hand.wrist_force,
+                physicsClientId=c,
+            )
 
     def _drive_fingers(self, torque: bool) -> None:
         """Apply the finger command for one physics step, never driving a joint past its limit.
@@ -249,18 +285,35 @@ class PianoWorld:
         slowest, fastest = (low - q) / self.dt, (high - q) / self.dt
         if not torque:
             speed = np.clip(self._finger_command, slowest, fastest)
-            p.setJointMotorControlArray(self.hand, self.finger_joints, p.VELOCITY_CONTROL, targetVelocities=speed.tolist(),
-                                        forces=[hand.joint_force] * len(q), physicsClientId=c)
+            p.setJointMotorControlArray(
+                self.hand,
+                self.finger_joints,
+                p.VELOCITY_CONTROL,
+                targetVelocities=speed.tolist(),
+                forces=[hand.joint_force] * len(q),
+                physicsClientId=c,
+            )
             return
         # torque control, except for joints that would pass a limit within this step: a motor holds those at it
         velocity = np.array([s[1] for s in states])
         tau = self._finger_command
         guard = (velocity > fastest) | (velocity < slowest) | ((q >= high) & (tau > 0)) | ((q <= low) & (tau < 0))
         speed = np.clip(0.0, slowest, fastest)
-        p.setJointMotorControlArray(self.hand, self.finger_joints, p.VELOCITY_CONTROL, targetVelocities=speed.tolist(),
-                                    forces=np.where(guard, LIMIT_STOP_TORQUE, 0.0).tolist(), physicsClientId=c)
-        p.setJointMotorControlArray(self.hand, self.finger_joints, p.TORQUE_CONTROL,
-                                    forces=np.where(guard, 0.0, tau).tolist(), physicsClientId=c)
+        p.setJointMotorControlArray(
+            self.hand,
+            self.finger_joints,
+            p.VELOCITY_CONTROL,
+            targetVelocities=speed.tolist(),
+            forces=np.where(guard, LIMIT_STOP_TORQUE, 0.0).tolist(),
+            physicsClientId=c,
+        )
+        p.setJointMotorControlArray(
+            self.hand,
+            self.finger_joints,
+            p.TORQUE_CONTROL,
+            forces=np.where(guard, 0.0, tau).tolist(),
+            physicsClientId=c,
+        )
 
     def discrete_wrist_position(self, action: float) -> float:
         """The white-key position that a wrist action in [-1, 1] selects."""
@@ -320,7 +373,9 @@ class PianoWorld:
         target = [self.width / 2, 0.11, 0.0]
         view = p.computeViewMatrixFromYawPitchRoll(target, 0.42, 180, -68, 0, 2, physicsClientId=c)
         projection = p.computeProjectionMatrixFOV(45, width / height, 0.01, 2.0, physicsClientId=c)
-        _, _, rgba, _, _ = p.getCameraImage(width, height, view, projection, renderer=p.ER_TINY_RENDERER, physicsClientId=c)
+        _, _, rgba, _, _ = p.getCameraImage(
+            width, height, view, projection, renderer=p.ER_TINY_RENDERER, physicsClientId=c
+        )
         frame = np.asarray(rgba, dtype=np.uint8).reshape(height, width, 4)[:, :, :3]
         return np.ascontiguousarray(frame[:, ::-1])
 
