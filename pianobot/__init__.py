@@ -1,3 +1,48 @@
-"""pianobot: teach a simulated dexterous robot hand to play the piano from real MIDI files."""
+"""pianobot: teach a simulated dexterous robot hand to play the piano from real MIDI files.
+
+The Python API (docs/api.md): the names below are imported on first use, so ``import pianobot``
+stays quick (it registers the gymnasium ids ``pianobot/Piano-v0``, ``pianobot/OneNote-v0``, ...).
+
+- :func:`load_piece` -- a ``.mid`` (or PIG) file as a validated :class:`Piece`;
+- :class:`PianoEnv`, :class:`EnvConfig` -- the gymnasium environment;
+- :func:`load_policy`, :func:`policy_configs` -- a stored policy and the environment it was trained in;
+- :class:`ScriptedPianist` -- the hand-written pianist; :func:`play` -- a whole piece in one simulation;
+- :func:`compare` -- note F1, velocity and timing errors of a performance against its score.
+"""
+
+from __future__ import annotations
+
+import importlib
+
+import pianobot.env  # noqa: F401  (registers the gymnasium ids)
 
 __version__ = "0.1.0"
+
+_API = {
+    "Note": "pianobot.music.piece",
+    "Piece": "pianobot.music.piece",
+    "LoadOptions": "pianobot.music.load",
+    "load_piece": "pianobot.music.load",
+    "split_phrases": "pianobot.music.phrases",
+    "compare": "pianobot.music.metrics",
+    "PianoEnv": "pianobot.env.piano",
+    "EnvConfig": "pianobot.env.piano",
+    "ScriptedPianist": "pianobot.pianist.scripted",
+    "load_policy": "pianobot.agent.policy",
+    "policy_configs": "pianobot.agent.policy",
+    "rollout": "pianobot.perform.rollout",
+}
+__all__ = ["__version__", *_API]
+
+
+_RENAMED = {"play": ("pianobot.perform.perform", "perform")}  # (pianobot.perform is the package)
+__all__ += list(_RENAMED)
+
+
+def __getattr__(name: str):
+    if name in _API:
+        return getattr(importlib.import_module(_API[name]), name)
+    if name in _RENAMED:
+        module, attribute = _RENAMED[name]
+        return getattr(importlib.import_module(module), attribute)
+    raise AttributeError(f"module 'pianobot' has no attribute {name!r}")

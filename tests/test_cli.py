@@ -398,8 +398,10 @@ def test_sections_hand_over_after_the_last_strike():
     # control passes 2 steps after that note's onset step (lead-in 20 steps, notes 10 steps apart)
     assert firsts == [0, 22, 32]
     assert composed.section_at(21).phrase.index == 0 and composed.section_at(22).phrase.index == 1
-    window = composed.sections[1].score[30]
-    assert window[:, 0].nonzero()[0].tolist() == [2]  # phrase 1 sees only its own note (D4)
+    window = composed.sections[1].rows(0, env.horizon)
+    assert window[30][:, 0].nonzero()[0].tolist() == [2]  # phrase 1 sees only its own note (D4)
+    assert window[:, :, 0].nonzero()[0].tolist() == list(range(30, 40))  # in its own steps only
+    assert composed.sections[1].tensor.shape[0] <= 12  # its memory is its own length, not the piece's
 
     fast = Piece((Note(0.0, 60, 0.1, 80, 2), Note(0.1, 62, 0.2, 80, 3)), bpm=60)  # onsets 2 steps apart
     env = PianoEnv(piece=fast, config=EnvConfig(tactile=False))

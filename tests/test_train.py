@@ -15,6 +15,7 @@ from pianobot.errors import PianobotError
 from pianobot.learn.config import TrainConfig
 from pianobot.learn.explore import Explorer
 from pianobot.learn.jobs import phrase_jobs, plan_jobs
+from pianobot.learn.log import LOG_FILE, PLOT_FILE
 from pianobot.learn.train import Progress, make_env, train_policy
 from pianobot.music.phrases import split_phrases
 from pianobot.music.piece import Note, Piece
@@ -373,6 +374,24 @@ def test_training_workers_end_when_their_parent_is_killed(tmp_path):
     assert not any(alive(p) for p in workers)
 
 
+def _log_without_time(folder):
+    import csv
+
+    with open(folder / LOG_FILE, newline="") as log:
+        return [{k: v for k, v in row.items() if k != "seconds"} for row in csv.DictReader(log)]
+
+
+def test_training_logs_every_episode_and_draws_its_curves(tmp_path):
+    config = small(steps=210, eval_every=70)
+    manifest = train_policy(PHRASE, config, tmp_path / "m")
+    rows = _log_without_time(tmp_path / "m")
+    assert [int(r["step"]) for r in rows] == list(range(35, 211, 35))  # one row per 35-step episode
+    evaluated = [r for r in rows if r["eval_f1"]]
+    assert [int(r["step"]) for r in evaluated] == [e["step"] for e in manifest["evaluations"]][: len(evaluated)]
+    assert all(r["critic_loss"] for r in rows if int(r["step"]) > 60) and not rows[0]["critic_loss"]  # learning from 60
+    assert (tmp_path / "m" / PLOT_FILE).read_bytes()[:4] == b"\x89PNG"
+
+
 class Killed(BaseException):
     """What a kill looks like to the code it interrupts: nothing runs after it."""
 
@@ -429,9 +448,9 @@ def test_a_kill_at_any_point_of_a_checkpoint_write_loses_at_most_one_interval(tm
         store.load_tensors(tmp_path / "killed" / store.POLICY_FILE),
     )
     assert a.keys() == b.keys() and all(torch.equal(a[k], b[k]) for k in a)
-    assert sorted(p.name for p in (tmp_path / "killed").iterdir()) == sorted(
-        [store.LOCK_FILE, store.MANIFEST_FILE, store.POLICY_FILE]
-    )
+    left = sorted(p.name for p in (tmp_path / "killed").iterdir())
+    assert left == sorted([store.LOCK_FILE, store.MANIFEST_FILE, store.POLICY_FILE, LOG_FILE, PLOT_FILE])
+    assert _log_without_time(tmp_path / "killed") == _log_without_time(tmp_path / "straight")  # as one run
 
 
 def test_a_due_evaluation_survives_an_interruption(tmp_path):

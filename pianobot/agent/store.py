@@ -138,6 +138,15 @@ def is_trained(folder: Path) -> bool:
     return (folder / MANIFEST_FILE).exists() and (folder / POLICY_FILE).exists()
 
 
+def trained_keys(root: Path) -> set[str]:
+    """The phrase hashes (and task keys) that have a trained policy in ``root``: one listing of the
+    folder, for asking about many phrases at once."""
+    root = Path(root)
+    if not root.is_dir():
+        return set()
+    return {d.name.rsplit("-", 1)[0] for d in root.iterdir() if d.is_dir() and "-" in d.name and is_trained(d)}
+
+
 def find_policies(root: Path, key: str) -> list[Path]:
     """Trained policy folders for a phrase hash (or task key), newest first."""
     root = Path(root)

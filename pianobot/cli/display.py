@@ -38,12 +38,26 @@ def tracks_table(tracks: list[TrackInfo], hands: dict[int, str] | None = None) -
     return table
 
 
-def notes_table(piece: Piece, phrases: list[Phrase]) -> Table:
+ROWS = 100
+"""Rows a table shows by default: a long piece's tables would take longer to draw than to compute."""
+
+
+def _shown(table: Table, total: int, rows: int | None, what: str) -> int:
+    """How many of ``total`` rows to show; says in the caption when some are left out."""
+    if rows is None or total <= rows:
+        return total
+    table.caption = f"the first {rows} of {total} {what}; --all shows every one"
+    return rows
+
+
+def notes_table(piece: Piece, phrases: list[Phrase], rows: int | None = ROWS) -> Table:
+    """The notes with their fingers and phrases (the first ``rows``; None: all)."""
     phrase_of = {id(n): p.index for p in phrases for n in p.notes}
     table = Table(title=f"{len(piece)} notes")
     for column in ("#", "onset s", "pitch", "duration s", "velocity", "finger", "phrase"):
         table.add_column(column, justify="right" if column != "finger" else "left")
-    for i, n in enumerate(piece.notes):
+    shown = _shown(table, len(piece), rows, "notes")
+    for i, n in enumerate(piece.notes[:shown]):
         table.add_row(
             str(i),
             f"{n.onset:.3f}",
@@ -56,13 +70,14 @@ def notes_table(piece: Piece, phrases: list[Phrase]) -> Table:
     return table
 
 
-def phrases_table(phrases: list[Phrase], trained: set[int] | None = None) -> Table:
-    """The phrases; with ``trained`` (indices of the phrases with a stored policy), a column saying which are trained."""
+def phrases_table(phrases: list[Phrase], trained: set[int] | None = None, rows: int | None = ROWS) -> Table:
+    """The phrases (the first ``rows``; None: all); with ``trained`` (indices of the phrases with
+    a stored policy), a column saying which are trained."""
     table = Table(title=f"{len(phrases)} phrase{'s' * (len(phrases) != 1)}")
     columns = ("phrase", "hash", "notes", "start s", "end s", "pitches") + (("policy",) if trained is not None else ())
     for column in columns:
         table.add_column(column)
-    for p in phrases:
+    for p in phrases[: _shown(table, len(phrases), rows, "phrases")]:
         row = [
             str(p.index),
             p.hash,

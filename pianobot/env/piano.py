@@ -328,13 +328,14 @@ class PianoEnv(gym.Env):
             self._tip_cache = self.world.tip_points()
         return self._tip_cache
 
-    def targets(self, window: np.ndarray, score: np.ndarray | None = None) -> np.ndarray:
+    def targets(self, window: np.ndarray, previous: np.ndarray | None = None) -> np.ndarray:
         """:func:`finger_targets` for the score window at the current step, from the hand's current
-        pose; ``score``: the timeline the window was cut from (default: the episode's)."""
-        score = self.score if score is None else score
-        previous = None
-        if self.config.target_onsets:
-            previous = score[self.t - 1] if self.t > 0 else np.zeros_like(score[0])
+        pose; ``previous``: the score row before the window (default: the episode's own; compositional
+        execution gives its phrase's)."""
+        if not self.config.target_onsets:
+            previous = None
+        elif previous is None:
+            previous = self.score[self.t - 1] if self.t > 0 else np.zeros_like(self.score[0])
         fingers = self.spec_score.hand.fingers
         return finger_targets(window, self._tips(), self.strike_points, fingers, self.config.target_velocity, previous)
 
@@ -376,16 +377,3 @@ class PianoEnv(gym.Env):
 
     def close(self):
         self.world.close()
-
-
-def register_envs() -> None:
-    """Register ``pianobot/Piano-v0`` (give piece=) and one id per task family, e.g. ``pianobot/OneNote-v0``."""
-    if "pianobot/Piano-v0" in gym.registry:
-        return
-    gym.register(id="pianobot/Piano-v0", entry_point="pianobot.env.piano:PianoEnv")
-    for task in TASKS:
-        name = "".join(part.capitalize() for part in task.split("-"))
-        gym.register(id=f"pianobot/{name}-v0", entry_point="pianobot.env.piano:PianoEnv", kwargs={"task": task})
-
-
-register_envs()

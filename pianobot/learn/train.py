@@ -7,6 +7,7 @@ evaluate every ``eval_every`` steps; at the first episode end after every
 buffer, random generators), so that running the same command again continues exactly where an
 interrupted run stopped. The policy stored at the end is the best one evaluated (SAC's
 evaluations swing by tenths of F1 from one to the next; the last is not always the best).
+Every episode is logged beside the policy (:mod:`pianobot.learn.log`: CSV, TensorBoard, a plot).
 Training a whole piece (one job per phrase, parallel workers) is :mod:`pianobot.learn.jobs`.
 """
 
@@ -28,6 +29,7 @@ from pianobot.config import to_dict
 from pianobot.env.piano import EnvConfig, PianoEnv
 from pianobot.learn.config import TrainConfig
 from pianobot.learn.explore import Explorer
+from pianobot.learn.log import TrainingLog
 from pianobot.music.piece import Piece
 from pianobot.perform.rollout import rollout
 
@@ -113,12 +115,14 @@ def train_policy(
     ``about`` goes into the manifest (piece, phrase hash, ...). One run at a time may train
     into a folder (a second one is refused while the first holds it).
     """
-    with store.training_lock(folder):
+    with store.training_lock(folder), TrainingLog(folder) as log:
         store.remove_temporary_files(folder)
-        return _train(target, config, folder, report, stop_after, about)
+        return _train(target, config, folder, report, stop_after, about, log)
 
 
-def _train(target, config: TrainConfig, folder: Path, report, stop_after: int | None, about: dict | None) -> dict:
+def _train(
+    target, config: TrainConfig, folder: Path, report, stop_after: int | None, about: dict | None, log: TrainingLog
+) -> dict:
     torch.manual_seed(config.seed)  # before the networks are made: their first weights come from it
     env_config = config.env
     env = make_env(target, env_config)
@@ -162,6 +166,7 @@ def _train(target, config: TrainConfig, folder: Path, report, stop_after: int | 
     else:
         observation, _ = env.reset(seed=config.seed)
         state = {}
+    log.start(resumed_at=step if checkpoint is not None else None)
     explorer.reset()
     # an evaluation that was due (but waited for exploration to end) stays due
     next_eval = state.get("next_eval", (step // config.eval_every + 1) * config.eval_every)
@@ -191,7 +196,7 @@ def _train(target, config: TrainConfig, folder: Path, report, stop_after: int | 
         if terminated or truncated:
             episode += 1
             report(Progress(step, config.steps, episode_return=episode_return, losses=losses))
-            episode_return = 0.0
+            figures = None
             if step >= next_eval and step > config.sac.exploration_steps:
                 figures = evaluate(agent, target, env_config, config.eval_episodes)
                 temperature = {k: round(losses[k], 4) for k in ("alpha", "entropy")} if losses else {}
@@ -200,9 +205,12 @@ def _train(target, config: TrainConfig, folder: Path, report, stop_after: int | 
                     best, best_tensors = {"step": step, **figures}, agent.tensors(with_training_state=False)
                 report(Progress(step, config.steps, eval_f1=figures["f1"]))
                 next_eval = (step // config.eval_every + 1) * config.eval_every
-                if config.until_f1 is not None and figures["f1"] >= config.until_f1:
-                    final = {"step": step, **figures}  # good enough: stop here
-                    break
+            seconds = seconds_before + time.perf_counter() - started
+            log.row(step, episode, seconds, episode_return, losses, figures)
+            episode_return = 0.0
+            if figures is not None and config.until_f1 is not None and figures["f1"] >= config.until_f1:
+                final = {"step": step, **figures}  # good enough: stop here
+                break
             if step >= next_checkpoint and step < config.steps:
                 state = {
                     "step": step,
@@ -216,7 +224,7 @@ def _train(target, config: TrainConfig, folder: Path, report, stop_after: int | 
                     "buffer_cursor": buffer.cursor,
                     "best": best,
                     "next_eval": next_eval,
-                    "seconds": seconds_before + time.perf_counter() - started,
+                    "seconds": seconds,
                 }
                 kept = {BEST_PREFIX + k: v for k, v in (best_tensors or {}).items()}
                 store.save_checkpoint(
@@ -250,4 +258,5 @@ def _train(target, config: TrainConfig, folder: Path, report, stop_after: int | 
     }
     store.save_policy(folder, tensors, manifest)
     store.drop_checkpoint(folder)
+    log.plot()
     return manifest

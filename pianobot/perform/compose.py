@@ -12,6 +12,7 @@ previous policy left it.
 
 from __future__ import annotations
 
+import bisect
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -37,11 +38,22 @@ class Section:
     phrase: Phrase
     first_step: int
     """Env step at which this phrase's controller takes over."""
-    score: np.ndarray
-    """The whole performance's score timeline with only this phrase's notes."""
+    start: int
+    """Env step of the phrase's first score row."""
+    tensor: np.ndarray
+    """The phrase's own score tensor (steps x keys x channels), from its first onset."""
     controller: Controller
     source: str
     """'policy <folder name>' or 'scripted (fallback)'."""
+
+    def rows(self, begin: int, end: int) -> np.ndarray:
+        """Env steps ``begin`` to ``end`` of the performance's score as this phrase's policy sees
+        it: only its own notes. Memory stays that of the phrase, however long the piece."""
+        out = np.zeros((end - begin, *self.tensor.shape[1:]), self.tensor.dtype)
+        low, high = max(begin, self.start), min(end, self.start + len(self.tensor))
+        if low < high:
+            out[low - begin : high - begin] = self.tensor[low - self.start : high - self.start]
+        return out
 
 
 def find_policy(models: Path, phrase: Phrase) -> Path | None:
@@ -50,7 +62,9 @@ def find_policy(models: Path, phrase: Phrase) -> Path | None:
 
 
 def missing_phrases(models: Path, phrases: list[Phrase]) -> list[Phrase]:
-    return [p for p in phrases if find_policy(models, p) is None]
+    """The phrases without a trained policy in ``models``."""
+    trained = store.trained_keys(models)
+    return [p for p in phrases if p.hash not in trained]
 
 
 def trained_split(models: Path, piece: Piece, phrase_notes: int | None) -> list[Phrase]:
@@ -99,10 +113,7 @@ class CompositionalController:
             else:
                 latest = max(start - 1, previous_last_onset + 1)
                 first = max(min(previous_last_onset + 1 + grace, latest), start - lead)
-            timeline = np.zeros_like(env.score)
             tensor = score_tensor(phrase.piece(), spec)
-            end = min(start + len(tensor), len(timeline))
-            timeline[start:end] = tensor[: end - start]
             folder = find_policy(models, phrase)
             if folder is not None:
                 controller, source = load_policy(folder, env), f"policy {folder.name}"
@@ -110,7 +121,7 @@ class CompositionalController:
                 controller, source = ScriptedPianist(env.config), "scripted (fallback)"
             else:  # checked before simulating; kept as a guard
                 raise PianobotError(f"phrase {phrase.index} has no trained policy in {models}")
-            self.sections.append(Section(phrase, first, timeline, controller, source))
+            self.sections.append(Section(phrase, first, start, tensor, controller, source))
             previous_last_onset = lead + spec.step_of(phrase.notes[-1].onset)
         self.env = env
         self.lookahead = env.config.lookahead
@@ -122,17 +133,16 @@ class CompositionalController:
             section.controller.reset()
 
     def section_at(self, step: int) -> Section:
-        active = self.sections[0]
-        for section in self.sections:
-            if section.first_step <= step:
-                active = section
-        return active
+        """The section whose controller acts at ``step`` (sections take over in order)."""
+        index = bisect.bisect_right([s.first_step for s in self.sections], step) - 1
+        return self.sections[max(index, 0)]
 
     def act(self, observation: dict) -> np.ndarray:
         section = self.section_at(self.step)
-        window = section.score[self.step : self.step + self.lookahead + 1]
+        window = section.rows(self.step, self.step + self.lookahead + 1)
         observation = {**observation, "score": window}
         if "targets" in observation:  # what the phrase's own window asks of each finger
-            observation["targets"] = self.env.targets(window, section.score)
+            previous = section.rows(self.step - 1, self.step)[0] if self.step > 0 else np.zeros_like(window[0])
+            observation["targets"] = self.env.targets(window, previous)
         self.step += 1
         return section.controller.act(observation)
