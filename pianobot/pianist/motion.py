@@ -1,6 +1,6 @@
 """Motion: turning the strike planner's plans into joint speeds, one control step at a time.
 
-- The wrist slides towards where the planned fingers are over their keys (their mean), only a
+- The wrist slides towards where the finger of the next strike is over its key (a chord's: their mean), only a
   little while a finger holds a key, and not at all while a finger that let go of a key is
   still low over the keys (it would drag across them).
 - Each finger's abduction aims its tip at its key from where the wrist will be at the end of
@@ -61,7 +61,14 @@ class Motion:
         layout, tuning = self.layout, self.tuning
         target = wrist
         if plans:
-            wanted = [layout.wrist_for(f, plan.key) for f, plan in plans.items()]
+            # the next strike decides: the mean over every planned finger let a note far ahead pull
+            # the wrist away from one about to be struck, out of its finger's reach
+            strikes = [(plan.start, f, plan.key) for f, plan in plans.items() if plan.phase != "hold"]
+            if strikes:
+                first = min(start for start, _, _ in strikes)
+                wanted = [layout.wrist_for(f, key) for start, f, key in strikes if start == first]
+            else:
+                wanted = [layout.wrist_for(f, plan.key) for f, plan in plans.items()]
             target = float(np.clip(np.mean(wanted), 0.0, layout.width))
             holds = [layout.wrist_for(f, plan.key) for f, plan in plans.items() if plan.phase == "hold"]
             if holds:  # a held key's finger may follow a small move only, and only while all held keys allow it
@@ -179,13 +186,20 @@ class Motion:
 
     def _low(self, q: np.ndarray) -> bool:
         """True when the fingertip is over the keys and lower than their top plus the clearance (it may touch one).
+        Over the black keys' band their tops count.
 
         A fingertip curled back beyond the keys' front, or below them, touches nothing the hand's
         slide could drag: it does not hold the wrist (a policy may leave fingers like that)."""
         reach, drop = lowest_point_in_finger_plane(self.geometry, q[1:])
-        over_keys = 0.0 <= self.hand.palm_y - reach * math.cos(q[0]) <= self.layout.white_length
+        y = self.hand.palm_y - reach * math.cos(q[0])
+        over_keys = 0.0 <= y <= self.layout.white_length
+        # over the black keys' band the keys to drag across stand black_rise higher: a fingertip
+        # that let go of a black key and hung under their tops struck its neighbour at full speed
+        top = self.layout.black_rise if y < self.layout.black_band_y else 0.0
         height = self.hand.palm_height - drop
         return (
             over_keys
-            and -self.layout.white_length * math.tan(self.layout.strike_angle) * 2 < height < self.tuning.clearance
+            and -self.layout.white_length * math.tan(self.layout.strike_angle) * 2
+            < height
+            < top + self.tuning.clearance
         )

@@ -1,0 +1,123 @@
+"""The scripted pianist on random single-voice melodies in all 12 keys.
+
+    python benchmarks/melodies.py [--per-key 4] [--json out.json] [--failures]
+
+Draws ``--per-key`` melodies per key (:func:`pianobot.music.melodies.melody_set`, fixed seeds;
+major and minor in turn), fingers each with the planner (a melody the planner says this hand
+cannot play at its tempo is drawn again, and counted), plays each with the scripted pianist
+from hand start ``index`` and prints a Markdown table per key: mean and lowest note F1,
+velocity MAE (MIDI units, matched notes), mean absolute onset error (ms), extra notes (played
+notes the score does not ask for); then the totals and every melody short of the targets
+(note F1 >= 0.95, velocity MAE <= 5, no extra notes).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import time
+
+import numpy as np
+
+from pianobot.music.instrument import HandSpec, KeyboardSpec
+from pianobot.music.melodies import TONICS, describe, melody_set
+from pianobot.music.piece import Piece
+from pianobot.perform.perform import perform
+from pianobot.pianist.fingering import ensure_fingering
+
+F1_TARGET, VELOCITY_TARGET, MEAN_F1_TARGET = 0.95, 5.0, 0.98
+
+
+def playable(piece: Piece) -> Piece | None:
+    """The piece fingered by the planner, or None when the planner reports notes too fast for the hand."""
+    fingered, plan = ensure_fingering(piece, KeyboardSpec(), HandSpec())
+    return None if plan is not None and plan.problems else fingered
+
+
+def play_set(per_key: int) -> tuple[list[dict], int]:
+    """Every melody's figures, and how many draws the planner turned down."""
+    rejected = 0
+
+    def accept(piece: Piece) -> Piece | None:
+        nonlocal rejected
+        kept = playable(piece)
+        rejected += kept is None
+        return kept
+
+    results = []
+    for melody in melody_set(per_key, accept):
+        report = perform(melody.piece, "scripted", seed=melody.index).report()
+        onset_errors = [abs(r.onset_error) for r in report.rows if r.onset_error is not None]
+        results.append(
+            {
+                "key": melody.key.name,
+                "tonic": melody.key.tonic,
+                "seed": list(melody.seed),
+                "melody": describe(melody.piece),
+                "f1": report.f1,
+                "velocity_mae": report.velocity_mae if report.velocity_mae is not None else float("nan"),
+                "onset_ms": 1000 * float(np.mean(onset_errors)) if onset_errors else float("nan"),
+                "extra": sum(r.reference is None for r in report.rows),
+                "missed": sum(r.played is None for r in report.rows),
+                "notes": len(melody.piece),
+            }
+        )
+    return results, rejected
+
+
+def passes(r: dict) -> bool:
+    return r["f1"] >= F1_TARGET and r["velocity_mae"] <= VELOCITY_TARGET and r["extra"] == 0
+
+
+def table(results: list[dict], rejected: int) -> str:
+    lines = [
+        "| key | melodies | notes | mean F1 | min F1 | velocity MAE (mean, max) | onset error (ms) | extra notes | pass |",
+        "| --- | ---: | ---: | ---: | ---: | --- | ---: | ---: | ---: |",
+    ]
+
+    def row(name: str, rs: list[dict]) -> str:
+        f1 = [r["f1"] for r in rs]
+        vel = [r["velocity_mae"] for r in rs]
+        return (
+            f"| {name} | {len(rs)} | {sum(r['notes'] for r in rs)} | {np.mean(f1):.3f} | {min(f1):.3f} | "
+            f"{np.mean(vel):.1f}, {max(vel):.1f} | {np.mean([r['onset_ms'] for r in rs]):.0f} | "
+            f"{sum(r['extra'] for r in rs)} | {sum(passes(r) for r in rs)}/{len(rs)} |"
+        )
+
+    for tonic, name in enumerate(TONICS):
+        lines.append(row(name, [r for r in results if r["tonic"] == tonic]))
+    lines.append(row("**all**", results))
+    lines.append("")
+    lines.append(f"Melodies the planner said this hand cannot play at their tempo, drawn again: {rejected}.")
+    return "\n".join(lines)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--per-key", type=int, default=4, help="melodies per key (default 4: 48 in all)")
+    parser.add_argument("--json", help="write every melody's figures here")
+    parser.add_argument("--failures", action="store_true", help="list every melody short of the targets")
+    args = parser.parse_args()
+    began = time.perf_counter()
+    results, rejected = play_set(args.per_key)
+    print(table(results, rejected))
+    f1 = [r["f1"] for r in results]
+    ok = all(passes(r) for r in results) and np.mean(f1) >= MEAN_F1_TARGET
+    print(
+        f"\nTargets (every melody F1 >= {F1_TARGET}, velocity MAE <= {VELOCITY_TARGET:g}, no extra notes; "
+        f"mean F1 >= {MEAN_F1_TARGET}): {'met' if ok else 'NOT met'}; {time.perf_counter() - began:.0f} s"
+    )
+    failures = [r for r in results if not passes(r)]
+    if args.failures or failures:
+        for r in failures:
+            print(
+                f"  {r['key']} seed {tuple(r['seed'])}: {r['melody']}: F1 {r['f1']:.3f}, velocity MAE "
+                f"{r['velocity_mae']:.1f}, onset {r['onset_ms']:.0f} ms, {r['missed']} missed, {r['extra']} extra"
+            )
+    if args.json:
+        with open(args.json, "w") as f:
+            json.dump({"rejected": rejected, "melodies": results}, f, indent=1)
+
+
+if __name__ == "__main__":
+    main()

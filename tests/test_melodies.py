@@ -1,0 +1,68 @@
+"""Random single-voice melodies in all 12 keys (issue 19): the generator, and the scripted pianist on them.
+
+Targets: every melody note F1 >= 0.95, velocity MAE <= 5 and no extra notes; mean F1 >= 0.98.
+The full set (4 per key) is ``python benchmarks/melodies.py``; this plays 1 per key.
+"""
+
+import numpy as np
+import pytest
+
+from pianobot.music.instrument import HandSpec, KeyboardSpec
+from pianobot.music.melodies import MelodyKey, melody_set, random_melody
+from pianobot.perform.perform import perform
+from pianobot.pianist.fingering import ensure_fingering
+
+
+def _playable(piece):
+    """Fingered by the planner; None (draw again) where it says the hand cannot play it at this tempo."""
+    fingered, plan = ensure_fingering(piece, KeyboardSpec(), HandSpec())
+    return None if plan is not None and plan.problems else fingered
+
+
+def test_a_melody_is_a_seeded_single_voice_in_its_key():
+    keyboard = KeyboardSpec()
+    for tonic in range(12):
+        key = MelodyKey(tonic, minor=tonic % 2 == 1)
+        piece = random_melody(np.random.default_rng(tonic), keyboard, key)
+        assert piece == random_melody(np.random.default_rng(tonic), keyboard, key)  # a seed fixes it
+        assert 8 <= len(piece) <= 16 and 60 <= piece.bpm <= 144
+        assert all(n.pitch in keyboard and 20 <= n.velocity <= 127 and n.finger is None for n in piece.notes)
+        assert piece.max_polyphony()[0] == 1  # one voice
+        allowed = set(key.pitches(keyboard)) | set(key.pitches(keyboard, raised_seventh=True))
+        assert {n.pitch for n in piece.notes} <= allowed
+
+
+def test_the_set_has_black_keys_leaps_repeats_and_rests():
+    melodies = melody_set(2, _playable)
+    assert len(melodies) == 24 and {m.key.tonic for m in melodies} == set(range(12))
+    notes = [n for m in melodies for n in m.piece.notes]
+    assert sum(KeyboardSpec.is_black(n.pitch) for n in notes) > len(notes) / 5
+    steps = [
+        (b.pitch - a.pitch, b.onset - a.offset) for m in melodies for a, b in zip(m.piece.notes, m.piece.notes[1:])
+    ]
+    assert any(abs(d) >= 5 for d, _ in steps) and any(d == 0 for d, _ in steps)  # leaps, repeated notes
+    assert any(gap >= 60 / 144 * 0.5 for _, gap in steps)  # rests
+    assert min(n.velocity for n in notes) <= 30 and max(n.velocity for n in notes) >= 120
+    hops = [
+        (a.pitch, b.pitch)
+        for m in melodies
+        for a, b in zip(m.piece.notes, m.piece.notes[1:])
+        if a.finger == b.finger and a.pitch != b.pitch
+    ]
+    assert any(KeyboardSpec.is_black(a) != KeyboardSpec.is_black(b) for a, b in hops)  # hops onto and off black keys
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="issue 19 item 1 not done: on the 48-melody set the scripted pianist reaches mean F1 0.840, "
+    "6 of 48 melodies meet the targets (docs/benchmarks.md#scripted-pianist-on-random-melodies)",
+)
+def test_the_scripted_pianist_plays_a_random_melody_in_every_key():
+    results = []
+    for melody in melody_set(1, _playable):
+        report = perform(melody.piece, "scripted", seed=melody.index).report()
+        extra = sum(r.reference is None for r in report.rows)
+        results.append((melody.key.name, melody.seed, report.f1, report.velocity_mae, extra))
+    failing = [r for r in results if r[2] < 0.95 or (r[3] or 0) > 5 or r[4] > 0]
+    assert not failing, failing
+    assert np.mean([r[2] for r in results]) >= 0.98
