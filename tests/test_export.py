@@ -1,0 +1,49 @@
+"""`pianobot export`: a stored policy as ONNX acts as pianobot's policy does, in onnxruntime."""
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import pianobot
+
+ROOT = Path(__file__).parent.parent
+ort = pytest.importorskip("onnxruntime")
+
+
+def test_an_exported_policy_acts_as_the_stored_one(tmp_path):
+    from pianobot.agent.export import export_onnx
+
+    phrase = pianobot.split_phrases(pianobot.load_piece(ROOT / "examples" / "midi" / "twinkle.mid"))[1]
+    folder = next((ROOT / "models").glob(f"{phrase.hash}-*"))
+    path = export_onnx(folder, tmp_path / "policy.onnx")
+    session = ort.InferenceSession(str(path))
+    assert [i.name for i in session.get_inputs()] == ["vector", "tactile"]
+    meta = session.get_modelmeta().custom_metadata_map
+    assert json.loads(meta["pianobot_manifest"])["key"] == phrase.hash
+    env_config, _ = pianobot.policy_configs(folder)
+    env = pianobot.PianoEnv(piece=phrase.piece(), config=env_config)
+    policy = pianobot.load_policy(folder, env)
+    observation, _ = env.reset(seed=3)
+    for _ in range(20):
+        vector, tactile = policy.split(observation)
+        batch = {"vector": np.stack([vector, vector]), "tactile": np.stack([tactile, tactile])}  # any batch size
+        action = session.run(None, batch)[0]
+        assert action.shape == (2, 13) and np.allclose(action[0], policy.act(observation), atol=1e-5)
+        observation, *_ = env.step(action[0])
+    env.close()
+
+
+def test_the_export_command(tmp_path):
+    from typer.testing import CliRunner
+
+    from pianobot.cli.app import app
+
+    folder = next(f for f in sorted((ROOT / "models").iterdir()) if (f / "manifest.json").exists())
+    result = CliRunner().invoke(app, ["export", str(folder), "-o", str(tmp_path / "p.onnx")])
+    assert result.exit_code == 0, result.output
+    assert ort.InferenceSession(str(tmp_path / "p.onnx")).get_outputs()[0].name == "action"
+    bad = CliRunner().invoke(app, ["export", str(tmp_path), "-o", str(tmp_path / "q.onnx")])
+    assert bad.exit_code == 2 and "holds no manifest.json" in bad.stderr
+    assert CliRunner().invoke(app, ["export", str(folder), "-o", str(tmp_path / "p.txt")]).exit_code == 2
