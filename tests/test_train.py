@@ -36,6 +36,7 @@ def test_training_runs_real_updates_with_finite_losses(tmp_path):
     seen: list[Progress] = []
     manifest = train_policy(PHRASE, small(), tmp_path / "m", seen.append, about={"key": "k", "piece": "p"})
     assert manifest["steps"] == 200 and manifest["updates"] == 140  # one update per step after exploration
+    assert seen[-1].finished and seen[-1].step == 200 and sum(p.finished for p in seen) == 1  # the bar ends full
     losses = [p.losses for p in seen if p.losses]
     assert losses and all(np.isfinite(v) for step in losses for v in step.values())
     assert 0.0 <= manifest["evaluation"]["f1"] <= 1.0 and manifest["key"] == "k"

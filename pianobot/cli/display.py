@@ -162,7 +162,7 @@ def training_table(rows) -> Table:
     """(job, manifest) pairs -> the summary `pianobot train` prints at the end."""
     table = Table(title="trained policies")
     for column in ("phrase", "used by", "steps", "kept from step", "eval note F1", "velocity MAE", "minutes", "folder"):
-        table.add_column(column)
+        table.add_column(column, overflow="fold")  # piped output is 80 columns wide: wrap, never cut a path
     for job, manifest in rows:
         evaluation = manifest.get("evaluation", {})  # the kept (best evaluated) policy's figures
         table.add_row(

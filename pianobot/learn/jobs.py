@@ -14,6 +14,7 @@ from typing import Callable
 import torch
 
 from pianobot.agent import store
+from pianobot.errors import PianobotError
 from pianobot.learn.train import Progress, TrainConfig, train_policy
 from pianobot.music.phrases import Phrase
 from pianobot.music.piece import Piece
@@ -133,3 +134,44 @@ def run_jobs(
             key, progress = queue.get()
             on_progress(key, progress)
     return results
+
+
+def run_jobs_on_ray(
+    jobs: list[PhraseJob], config: TrainConfig, on_progress: Callable[[str, Progress], None], threads: int = 1
+) -> dict[str, dict]:
+    """Train every job as a Ray task: on the cluster ``RAY_ADDRESS`` names (Ray's own convention),
+    or on a local Ray runtime when it is unset. Each task asks for ``threads`` CPUs and trains with
+    as many torch threads; progress comes back through a Ray queue. Every node must see the model
+    folders at the same path (a shared file system): checkpoints are written and resumed there."""
+    try:
+        import ray
+        from ray.util.queue import Queue
+    except ImportError:
+        raise PianobotError("training on Ray needs Ray installed: pip install 'pianobot[ray]'") from None
+    started_here = not ray.is_initialized()
+    if started_here:
+        ray.init(include_dashboard=False, log_to_driver=False, configure_logging=False)
+    try:
+        queue = Queue()
+        task = ray.remote(num_cpus=threads, max_retries=0)(_run_job)
+        refs = {task.remote(job, config, queue, threads): job for job in jobs}
+        pending, results = list(refs), {}
+
+        def drain() -> None:
+            while not queue.empty():
+                key, progress = queue.get()
+                on_progress(key, progress)
+
+        while pending:
+            done, pending = ray.wait(pending, num_returns=1, timeout=0.2)
+            drain()
+            for ref in done:
+                try:
+                    results[refs[ref].key] = ray.get(ref)
+                except ray.exceptions.RayTaskError as e:  # a PianobotError in a task stays one line
+                    raise (e.cause if isinstance(e.cause, PianobotError) else e) from None
+        drain()
+        return results
+    finally:
+        if started_here:
+            ray.shutdown()

@@ -53,6 +53,8 @@ class Progress:
     losses: dict | None = None
     resumed: bool = False
     """True once, when an interrupted run continues from its checkpoint at ``step``."""
+    finished: bool = False
+    """True once, when the policy is stored (``step``: the steps it took)."""
 
 
 def make_env(target: Piece | str, env_config: EnvConfig) -> PianoEnv:
@@ -259,4 +261,5 @@ def _train(
     store.save_policy(folder, tensors, manifest)
     store.drop_checkpoint(folder)
     log.plot()
+    report(Progress(step, config.steps, finished=True))
     return manifest
