@@ -9,7 +9,7 @@ from pianobot.music.piece import Note, Piece
 from pianobot.music.tensor import FINGER, NOTE, VELOCITY
 from pianobot.pianist.layout import KeyLayout
 from pianobot.pianist.scripted import ScriptedPianist
-from pianobot.pianist.strikes import Run, StrikePlanner, finger_runs
+from pianobot.pianist.strikes import Run, StrikePlanner, Tip, finger_runs
 from pianobot.pianist.tuning import PianistTuning
 from pianobot.sim.world import WorldConfig
 
@@ -35,7 +35,7 @@ def test_a_finger_strikes_now_holds_then_gets_ready_for_its_next_note():
     world = WorldConfig()
     planner = StrikePlanner(world, KeyLayout(world), PianistTuning())
     finger = world.hand.spec.fingers[0]
-    tips = {f: 0.01 for f in world.hand.spec.fingers}
+    tips = {f: Tip(height=0.01, y=0.11) for f in world.hand.spec.fingers}
     score = window([(5, 0, 3, 0.5, 0), (7, 8, 10, 0.5, 0)])
     now = planner.plan(score, None, tips)[finger]
     assert (now.phase, now.key, now.start) == ("strike", 5, 0)
@@ -46,7 +46,7 @@ def test_a_finger_strikes_now_holds_then_gets_ready_for_its_next_note():
 
 
 def test_the_tuning_is_one_frozen_dataclass_that_the_pianist_uses():
-    assert {f.name for f in fields(PianistTuning)} >= {"idle_height", "prepare_steps", "tilt_step"}
+    assert {f.name for f in fields(PianistTuning)} >= {"idle_height", "settle_steps", "tilt_step"}
     config = EnvConfig(tactile=False)
     env = PianoEnv(piece=Piece((Note(1.0, 60, 1.5, 80, 3),), bpm=60), config=config)
     observation, _ = env.reset(seed=0)

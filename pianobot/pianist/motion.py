@@ -21,7 +21,7 @@ import math
 import numpy as np
 
 from pianobot.pianist.layout import KeyLayout
-from pianobot.pianist.strikes import Plan
+from pianobot.pianist.strikes import Plan, Tip
 from pianobot.pianist.tuning import PianistTuning
 from pianobot.sim.hand import FINGER_BASE_X, PREFERRED_TILT, TILT_RANGE, finger_ik, lowest_point_in_finger_plane
 from pianobot.sim.world import WorldConfig
@@ -38,10 +38,10 @@ class Motion:
         self.fingers = world.hand.spec.fingers
         self.dt = 1.0 / world.control_hz
 
-    def tip_height(self, q: np.ndarray) -> float:
-        """Height of the fingertip's lowest point over the white keys' top (m), from its joint angles."""
-        _, drop = lowest_point_in_finger_plane(self.geometry, q[1:])
-        return self.hand.palm_height - drop
+    def tip(self, q: np.ndarray) -> Tip:
+        """Where the fingertip's lowest point is, from its joint angles (abduction first)."""
+        reach, drop = lowest_point_in_finger_plane(self.geometry, q[1:])
+        return Tip(height=self.hand.palm_height - drop, y=self.hand.palm_y - reach * math.cos(q[0]))
 
     def command(self, plans: dict[int, Plan], joints: np.ndarray, wrist: float) -> np.ndarray:
         """The full command in [-1, 1]: every finger's four joint speeds, then the wrist's.
@@ -90,6 +90,12 @@ class Motion:
         phase, abduction, reach, height = self._target(finger, plan, now_reach, wrist_next)
         abduction, reach, height = self._waypoint(phase, abduction, reach, height, q, now_reach, now_height)
         flexion = self._ik(reach, self.hand.palm_height - height, q[1:])
+        if phase not in ("strike", "hold"):
+            # a change of the finger's shape spreads over several steps: the light links do not
+            # follow a large joint-space move within one step (the distal joint overshot to its limit)
+            change = float(np.max(np.abs(flexion - q[1:])))
+            if change > self.tuning.max_joint_move:
+                flexion = q[1:] + (flexion - q[1:]) * self.tuning.max_joint_move / change
         desired = np.concatenate([[abduction], flexion])
         return np.clip((desired - q) / (self.hand.max_joint_speed * self.dt), -1.0, 1.0)
 
@@ -142,16 +148,19 @@ class Motion:
         rise_here = finger_ik(geometry, now_reach, hand.palm_height - height) is not None
         if height > now_height + tuning.path_tolerance and rise_here:
             reach = now_reach if abs(reach - now_reach) > tuning.path_tolerance else reach
-            over = layout.black_rise if now_reach > hand.palm_y - layout.black_band_y else 0.0
+            over = layout.black_rise if now_reach * math.cos(q[0]) > hand.palm_y - layout.black_band_y else 0.0
             if now_height < over + tuning.clearance:
                 abduction = float(q[0])  # straight up out of the key before swinging sideways
-        elif phase != "hold" and abs(reach - now_reach) > tuning.path_tolerance:
+        elif phase not in ("strike", "hold") and abs(reach - now_reach) > tuning.path_tolerance:
+            # (a strike is in front of its key within aim_tolerance: it corrects the rest on the way down)
             across = max(height, now_height)  # (a held key stays pressed while the wrist slides)
             if finger_ik(geometry, reach, hand.palm_height - across) is not None:
                 height = across  # else the finger, raised high (as a policy may leave it), goes there directly
 
-        band_reach = hand.palm_y - layout.black_band_y  # a tip reaching further lies over the black keys
-        crossing = (reach > band_reach) != (now_reach > band_reach)
+        # a tip reaching further than band_reach lies over the black keys (the reach is in the
+        # finger's plane, turned by its abduction: its depth into the keyboard is reach * cos(abduction))
+        band_reach = hand.palm_y - layout.black_band_y
+        crossing = (reach * math.cos(abduction) > band_reach) != (now_reach * math.cos(q[0]) > band_reach)
         safe = layout.black_rise + tuning.band_clearance
         if crossing and now_height < safe - tuning.band_tolerance:
             if reach < now_reach or finger_ik(geometry, now_reach, hand.palm_height - safe) is not None:
@@ -176,8 +185,9 @@ class Motion:
         from one step to the next, faster than its joints follow."""
         # a finger curled (or stretched) beyond the IK's tilts, as a policy may leave it, starts
         # from the nearest one: from outside them no point would be in reach and it would stay so
-        tilt = float(np.clip(np.sum(current), *TILT_RANGE))
+        tilt = float(np.sum(current))
         tilt += float(np.clip(PREFERRED_TILT - tilt, -self.tuning.tilt_step, self.tuning.tilt_step))
+        tilt = float(np.clip(tilt, *TILT_RANGE))
         for change in (0.0, 0.002, -0.002, 0.004, -0.004, 0.008, 0.012, 0.016, 0.02):
             q = finger_ik(self.geometry, reach, drop + change, tilt)  # the nearest height this finger can reach there
             if q is not None:

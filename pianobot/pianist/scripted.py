@@ -54,7 +54,7 @@ class ScriptedPianist:
         score = observation["score"]
         joints = np.asarray(observation["joints"], dtype=float).reshape(len(self.fingers), 4)
         wrist = (float(observation["wrist"][0]) + 1) / 2 * self.layout.width
-        tips = {finger: self.motion.tip_height(q) for finger, q in zip(self.fingers, joints)}
+        tips = {finger: self.motion.tip(q) for finger, q in zip(self.fingers, joints)}
         plans = self.strikes.plan(score, self.previous_row, tips)
         self.previous_row = score[0].copy()
         return self.motion.command(plans, joints, wrist)[self.actuated]

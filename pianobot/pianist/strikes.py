@@ -56,6 +56,15 @@ def finger_runs(score: np.ndarray, slot: int) -> list[Run]:
     return sorted(runs, key=lambda r: r.start)
 
 
+class Tip(NamedTuple):
+    """Where a fingertip's lowest point is: all the planner knows of the hand."""
+
+    height: float
+    """Over the white keys' top surface (m)."""
+    y: float
+    """Depth into the keyboard: distance from the keys' hinges (m)."""
+
+
 Phase = Literal["ready", "strike", "hold"]
 
 
@@ -77,7 +86,8 @@ class Plan:
     next_note: Run | None = None
     """While holding: this finger's next note in the window."""
     next_lead: int = 0
-    """While holding: control steps the next note's strike takes from its ready height."""
+    """While holding: control steps from letting go to the next note's onset step: getting to its
+    ready height, then its strike."""
 
 
 class StrikePlanner:
@@ -91,12 +101,11 @@ class StrikePlanner:
         self.curve = world.keyboard.curve
         self.max_wrist_speed = world.hand.max_wrist_speed
 
-    def plan(self, score: np.ndarray, previous_row: np.ndarray | None, tips: dict[int, float]) -> dict[int, Plan]:
+    def plan(self, score: np.ndarray, previous_row: np.ndarray | None, tips: dict[int, Tip]) -> dict[int, Plan]:
         """The plan of every finger that has something to do, by finger.
 
         ``previous_row`` is the score row of the previous step (None at the first step): it tells a
-        note that began earlier, to hold, from one to strike now. ``tips`` are the fingertips'
-        heights over the white keys' top (m), by finger.
+        note that began earlier, to hold, from one to strike now. ``tips``: where each fingertip is, by finger.
         """
         plans: dict[int, Plan] = {}
         for slot, finger in enumerate(self.fingers):
@@ -133,11 +142,35 @@ class StrikePlanner:
     def ready_steps(self, tip_speed: float, depth: float) -> int:
         """Control steps of constant-speed travel from the ready height before the onset's step."""
         point = self.strike_point(tip_speed)
-        return max(1, math.ceil((self.tuning.min_ready_height + depth) / (tip_speed * self.dt) - point))
+        needed = (self.tuning.min_ready_height + depth) / (tip_speed * self.dt) - point
+        return max(self.tuning.min_lead_steps, math.ceil(needed))
+
+    def ready(self, run: Run) -> tuple[float, int]:
+        """(height, lead) of ``run``'s strike: its ready height over the key's top (m) and the
+        control steps of constant-speed travel from there before the onset's step."""
+        speed, depth = self.tip_speed(run.key, run.velocity), self.strike_depth(run.key)
+        steps = self.ready_steps(speed, depth)
+        return (steps + self.strike_point(speed)) * speed * self.dt - depth, steps
+
+    def positioning_steps(self, tip: Tip, key: int, height: float) -> int:
+        """Control steps a fingertip at ``tip`` takes to hover ``height`` over ``key``'s top in front
+        of its strike point, along the path :mod:`~pianobot.pianist.motion` takes: up first, across
+        (into or out of the black keys' band only above their tops), then down, at most ``max_move``
+        per step; and ``settle_steps`` more to be still there before the strike starts."""
+        layout, tuning = self.layout, self.tuning
+        goal_y, goal_height = layout.contact_y(key), layout.key_top[key] + height
+        across = abs(goal_y - tip.y)
+        if across <= tuning.path_tolerance:
+            path = abs(goal_height - tip.height)
+        else:
+            crossing = (goal_y < layout.black_band_y) != (tip.y < layout.black_band_y)
+            top = max(goal_height, tip.height, layout.black_rise + tuning.band_clearance if crossing else 0.0)
+            path = (top - tip.height) + across + (top - goal_height)
+        return math.ceil(path / tuning.max_move - 1e-9) + tuning.settle_steps
 
     # -- plans ----------------------------------------------------------------------------------
-    def _plan_finger(self, score: np.ndarray, slot: int, previous_row: np.ndarray | None, tip: float) -> Plan | None:
-        """What one finger should do now, or None when it has nothing to do (``tip``: its height over the white keys, m)."""
+    def _plan_finger(self, score: np.ndarray, slot: int, previous_row: np.ndarray | None, tip: Tip) -> Plan | None:
+        """What one finger should do now, or None when it has nothing to do (``tip``: where its tip is)."""
         runs = finger_runs(score, slot)
         current = next((r for r in runs if r.start == 0), None)
         upcoming = next((r for r in runs if r.start > 0), None)
@@ -149,36 +182,35 @@ class StrikePlanner:
         )
         if not began_earlier:
             return self._approach(current, tip)  # the onset step itself: strike now
-        tip_height = tip - self.layout.key_top[key]
+        tip_height = tip.height - self.layout.key_top[key]
         floor = -self.strike_depth(key) - self.tuning.hold_depth_margin
         goal = max(tip_height - self.tip_speed(key, current.velocity) * self.dt, floor)
         if upcoming is None:
             return Plan(key, "hold", goal=goal)
-        next_lead = self.ready_steps(self.tip_speed(upcoming.key, upcoming.velocity), self.strike_depth(upcoming.key))
+        height, lead = self.ready(upcoming)
+        next_lead = lead + max(self.tuning.prepare_steps, self.positioning_steps(tip, upcoming.key, height))
         return Plan(key, "hold", goal=goal, next_note=upcoming, next_lead=next_lead)
 
-    def _approach(self, run: Run, tip: float) -> Plan:
-        """The plan for striking ``run``: hover while its onset is far, else strike (``tip``: the fingertip's height over the white keys, m)."""
+    def _approach(self, run: Run, tip: Tip) -> Plan:
+        """The plan for striking ``run``: hover while its onset is far, else strike (``tip``: where the fingertip is)."""
         key, start = run.key, run.start
         speed = self.tip_speed(key, run.velocity)
         depth = self.strike_depth(key)
-        steps = self.ready_steps(speed, depth)
+        height, steps = self.ready(run)
         point = self.strike_point(speed)
-        height = (steps + point) * speed * self.dt - depth
         if start > steps:
             return Plan(key, "ready", height=height, start=start, lead=steps)
         # closed loop: after this step the fingertip should be where constant-speed travel passes
         # the strike depth at the strike point of the onset's step, (start - 1 + point) steps on
-        tip_height = tip - self.layout.key_top[key]
-        goal = (
-            tip_height - speed * self.dt
-            if start == 0
-            else -depth - self.overshoot(speed) + speed * self.dt * (start - 1 + point)
-        )
+        tip_height = tip.height - self.layout.key_top[key]
+        if start == 0:  # the onset's step: sound on time, faster (louder) only if a late start asks for it
+            goal = tip_height - max(speed * self.dt, (tip_height + depth + self.overshoot(speed)) / point)
+        else:
+            goal = -depth - self.overshoot(speed) + speed * self.dt * (start - 1 + point)
         floor = -depth - self.tuning.hold_depth_margin
         return Plan(key, "strike", height=height, goal=float(np.clip(goal, floor, tip_height)), start=start, lead=steps)
 
-    def _let_go(self, plans: dict[int, Plan], tips: dict[int, float]) -> None:
+    def _let_go(self, plans: dict[int, Plan], tips: dict[int, Tip]) -> None:
         """Release held keys early when the hand must get ready for what comes next.
 
         A holding finger lets go in time for its own next strike; every holding finger lets go
@@ -195,11 +227,7 @@ class StrikePlanner:
                 plans[finger] = self._approach(upcoming, tips[finger])
 
         for finger, plan in list(plans.items()):
-            if (
-                plan.phase == "hold"
-                and plan.next_note is not None
-                and plan.next_note.start - plan.next_lead - tuning.prepare_steps <= 0
-            ):
+            if plan.phase == "hold" and plan.next_note is not None and plan.next_note.start - plan.next_lead <= 0:
                 release(finger)
         holds = {f: p for f, p in plans.items() if p.phase == "hold"}
         if not holds:

@@ -25,8 +25,16 @@ class PianistTuning:
     """A struck key is pressed this far past its strike depth before the finger just holds it (m).
     It also bounds when in the onset's step a loud strike sounds: the fingertip must not reach
     the key's bottom within that step, or the step's speed, and the note, would be softer."""
+    min_lead_steps: int = 0
+    """Fewest control steps of constant-speed travel before the onset's step (0: a loud strike starts
+    from rest at the onset step's start; the finger's motors reach the strike speed within a few
+    milliseconds, and its ready height is one step's travel lower)."""
     prepare_steps: int = 4
-    """Time a finger needs to lift, move over and settle before a strike from the ready height (control steps)."""
+    """Least time a finger needs to lift, move over and settle before a strike from the ready height (control steps)."""
+    settle_steps: int = 1
+    """Time a fingertip that has reached its ready height needs to be still and in front of its key
+    before its strike starts (control steps). A held key is let go in time for the path there
+    (at ``max_move`` per step), this and the strike."""
     hold_reach: float = 0.030
     """Farthest the wrist may be from straight over a held key: the abduction makes up for it (m)."""
 
@@ -46,6 +54,8 @@ class PianistTuning:
     One that rose towards it could stop a hair short of it and wait there for ever."""
     max_move: float = 0.008
     """Longest fingertip move in one step when positioning; strikes are not limited (m per control step)."""
+    max_joint_move: float = 0.3
+    """Largest change of a flexion joint's angle in one step when positioning (rad per control step)."""
     hold_slide: float = 0.008
     """Farthest the wrist may move in one step while a finger holds a key (m per control step)."""
     tilt_step: float = 0.15
