@@ -169,3 +169,95 @@ def test_writing_is_atomic_and_never_leaves_partial_files(tmp_path, scale):
     write_midi(scale, target)
     assert read_midi(target) == scale
     assert sorted(p.name for p in tmp_path.iterdir()) == ["keep.mid"]
+
+
+def one_note(tmp_path, name="one.mid", tempo=500_000, ticks_per_beat=480, delta=480):
+    return midi_file(
+        tmp_path / name,
+        [("m", [(0, on(64)), (delta, off(64))])],
+        ticks_per_beat=ticks_per_beat,
+        tempo_events=((0, tempo),),
+    )
+
+
+def test_a_tempo_of_zero_is_refused_unless_the_piece_is_re_timed(tmp_path):
+    path = one_note(tmp_path, tempo=0)
+    with pytest.raises(PianobotError, match="sets a tempo of 0 .* --tempo BPM"):
+        read_midi(path)
+    assert read_midi(path, bpm=60) == Piece((Note(0.0, 64, 1.0, 80),), bpm=60)
+
+
+def test_extreme_tempos_and_divisions(tmp_path):
+    slowest = read_midi(one_note(tmp_path, tempo=0xFFFFFF))  # 16.8 s per beat: 3.6 bpm, within 60 minutes
+    assert slowest.notes[0].offset == pytest.approx(16.777, abs=1e-3) and slowest.bpm == 10
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        assert len(read_midi(one_note(tmp_path, tempo=1))) == 0  # a beat of 1 µs: the note lasts under 1 ms
+    data = one_note(tmp_path).read_bytes()
+    for division, words in ((b"\x00\x00", "0 ticks"), (b"\xe7\x28", "SMPTE")):  # 0; -25 fps x 40
+        (tmp_path / "d.mid").write_bytes(data[:12] + division + data[14:])
+        with pytest.raises(PianobotError, match=words):
+            read_midi(tmp_path / "d.mid")
+
+
+def test_many_tempo_changes_read_in_time_proportional_to_the_file(tmp_path):
+    """Each tick's time is found by bisection, not by walking every tempo change before it."""
+    import time
+
+    from pianobot.music.midi_io import _TempoMap
+
+    midi = mido.MidiFile(ticks_per_beat=480)
+    midi.tracks.append(
+        mido.MidiTrack(mido.MetaMessage("set_tempo", tempo=400_000 + i % 7, time=10) for i in range(8000))
+    )
+    tempo_map = _TempoMap(midi, tmp_path / "t.mid")
+    start = time.perf_counter()
+    times = [tempo_map.seconds(tick) for tick in range(0, 80_000, 5)]
+    assert time.perf_counter() - start < 1.0  # walking the changes: 16,000 x 4,000 steps, several seconds
+    assert times == sorted(times) and times[2] == pytest.approx(10 * 500_000 / 480 / 1e6)
+
+
+def test_a_piece_longer_than_the_limit_is_refused_with_the_fix(tmp_path):
+    """A 40-byte file with one delta time of 0x0FFFFFFF ticks asks for 78 hours of music."""
+    huge = one_note(tmp_path, delta=0x0FFFFFFF)
+    assert huge.stat().st_size < 64
+    with pytest.raises(PianobotError, match="lasts 4,660 minutes.*at most 60 minutes.*cut the file.*--tempo"):
+        read_midi(huge)
+    edge = one_note(tmp_path, "edge.mid", ticks_per_beat=1, delta=7199)  # ends at 3599.5 s: inside
+    assert read_midi(edge).duration == 3599.5
+    with pytest.raises(PianobotError, match="at most 60 minutes"):
+        read_midi(edge, bpm=100)  # re-timed slower, it no longer fits
+
+
+def test_the_header_must_match_the_tracks(tmp_path):
+    data = one_note(tmp_path).read_bytes()  # two tracks: tempo and notes
+    for count in (b"\xff\xff", b"\x00\x03"):
+        (tmp_path / "h.mid").write_bytes(data[:10] + count + data[12:])
+        with pytest.raises(PianobotError, match="truncated or its header does not match its tracks") as e:
+            read_midi(tmp_path / "h.mid")
+        assert "holds 2 complete" in str(e.value)
+    (tmp_path / "h.mid").write_bytes(data[:10] + b"\x00\x01" + data[12:])
+    with pytest.warns(PianobotWarning, match="header says 1 track"):
+        read_midi(tmp_path / "h.mid")
+
+
+def test_any_track_name_can_be_written_and_read_back(tmp_path, scale):
+    from pianobot.music.midi_io import describe_tracks
+
+    for name in ("音 fingered by pianobot", "Ünïcödé — 🎹", "plain latin-1 é"):
+        path = write_midi(scale, tmp_path / "n.mid", name=name)
+        assert describe_tracks(path)[0].name == name
+        assert read_midi(path, track=name) == scale
+
+
+def test_long_or_multi_line_texts_are_quoted_short_on_one_line(tmp_path):
+    midi_file(tmp_path / "l.mid", [("m", [(0, lyric("9 " * 500_000)), (0, on(64)), (480, off(64))])])
+    with pytest.raises(PianobotError, match="finger 9") as e:
+        read_midi(tmp_path / "l.mid")
+    assert len(str(e.value)) < 300 and "…" in str(e.value)
+    with pytest.raises(PianobotError) as e:
+        parse_finger_text("1\n9")
+    assert "\n" not in str(e.value) and "1\\n9" in str(e.value)
+    with pytest.raises(PianobotError) as e:
+        read_midi(tmp_path / "l.mid", track="x" * 10_000)
+    assert len(str(e.value)) < 400

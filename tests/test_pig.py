@@ -90,3 +90,54 @@ def test_sidecar_fingering_survives_retiming(tmp_path, scale):
 def test_pig_needs_every_finger(tmp_path, scale):
     with pytest.raises(PianobotError, match="needs a finger"):
         write_pig(scale.without_fingering(), tmp_path / "x.txt")
+
+
+@pytest.mark.parametrize(
+    "onset, offset, words",
+    [
+        ("nan", "0.5", "onset nan"),
+        ("0", "inf", "offset inf"),
+        ("-inf", "0.5", "onset -inf"),
+        ("0", "1e400", "offset inf"),
+        ("0", "1e12", "at most 60 minutes"),
+        ("3600.5", "3601", "at most 60 minutes"),
+    ],
+)
+def test_pig_times_must_be_finite_and_within_the_limit(tmp_path, onset, offset, words):
+    """Without the bound, `score` against a note ending at 1e12 s asked for 2.27 PiB."""
+    path = tmp_path / "bad.txt"
+    path.write_text(f"//Version: PianoFingering_v170101\n0\t{onset}\t{offset}\tC4\t64\t80\t0\t2\n")
+    with pytest.raises(PianobotError, match=words) as e:
+        read_pig(path)
+    assert "bad.txt line 2" in str(e.value)
+
+
+def test_a_nan_in_a_sidecar_is_one_clear_error(tmp_path, scale):
+    midi = write_midi(scale, tmp_path / "song.mid")
+    sidecar_for(midi).write_text("//Version: PianoFingering_v170101\n0\tnan\t1\tC4\t64\t80\t0\t2\n")
+    with pytest.raises(PianobotError, match="song_fingering.txt line 2: note C4 has onset nan"):
+        load_piece(midi)
+
+
+def test_long_texts_in_pig_files_are_quoted_short(tmp_path):
+    path = tmp_path / "long.txt"
+    path.write_text("//Version: PianoFingering_v170101\n0\t0\t1\t" + "Q" * 100_000 + "\t64\t80\t0\t2\n")
+    with pytest.raises(PianobotError, match="not a pitch") as e:
+        read_pig(path)
+    assert len(str(e.value)) < 300 and "…" in str(e.value)
+
+
+def test_sidecar_matching_takes_the_nearest_unused_note_quickly(tmp_path):
+    """Matching looks only at PIG notes of the same pitch near the onset (not every note for every note)."""
+    import time
+
+    from pianobot.music.piece import Note, Piece
+
+    piece = Piece(tuple(Note(i * 0.1, 60 + i % 12, i * 0.1 + 0.1, 80, 2 + i % 3) for i in range(20_000)))
+    write_pig(piece, tmp_path / "many.txt")
+    start = time.perf_counter()
+    assert apply_fingering(piece.without_fingering(), tmp_path / "many.txt") == piece
+    assert time.perf_counter() - start < 10  # every note against every note: 4e8 comparisons, minutes
+    near = Piece((Note(0.0, 60, 0.5, 80), Note(0.01, 60, 0.5, 80)))
+    write_pig(Piece((Note(0.02, 60, 0.5, 80, 3), Note(0.0, 60, 0.5, 80, 2))), tmp_path / "near.txt")
+    assert [n.finger for n in apply_fingering(near, tmp_path / "near.txt")] == [2, 3]

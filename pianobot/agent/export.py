@@ -69,7 +69,9 @@ def export_onnx(folder: Path, path: Path) -> Path:
             )
         model = onnx.load(tmp)
         manifest = store.read_manifest(folder)
-        onnx.helper.set_model_props(model, {"pianobot_manifest": json.dumps(manifest), "pianobot_inputs": ",".join(names)})
+        onnx.helper.set_model_props(
+            model, {"pianobot_manifest": json.dumps(manifest), "pianobot_inputs": ",".join(names)}
+        )
         onnx.save(model, tmp)
         move_into_place(tmp, path)
     except BaseException:

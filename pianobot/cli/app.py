@@ -19,13 +19,14 @@ from typing import Optional
 
 import typer
 from rich.console import Console
+from rich.markup import escape
 
 from pianobot import __version__
 from pianobot.agent.config import SACConfig
 from pianobot.env.piano import EnvConfig
 from pianobot.env.rewards import RewardConfig
-from pianobot.errors import PianobotError, PianobotWarning
-from pianobot.files import atomic_write, check_writable
+from pianobot.errors import PianobotError, PianobotWarning, one_line, quote
+from pianobot.files import atomic_write, check_writable, why
 from pianobot.learn.config import TrainConfig
 from pianobot.learn.explore import EXPLORATIONS
 from pianobot.music.instrument import HandSpec, KeyboardSpec
@@ -40,7 +41,7 @@ from pianobot.sim.world import WorldConfig
 app = typer.Typer(
     help="Teach a simulated robot hand with touch sensors to play the piano from MIDI files.",
     no_args_is_help=True,
-    add_completion=False,
+    add_completion=True,
     pretty_exceptions_enable=False,
 )
 out = Console()
@@ -49,8 +50,17 @@ err = Console(stderr=True)
 EXIT_BAD_INPUT = 2
 
 
+def said(text) -> str:
+    """Text for the terminal as it is: on one line, and any '[...]' in it not taken for rich markup."""
+    return escape(one_line(str(text)))
+
+
 def friendly(command):
-    """Turn PianobotError into one red line + exit 2, and show warnings in yellow."""
+    """Turn PianobotError into one red line + exit 2, and show warnings in yellow.
+
+    An OSError that escaped the library (the file system failed us where no one expected it)
+    gets the same one line, never a traceback.
+    """
 
     @functools.wraps(command)
     def wrapper(*args, **kwargs):
@@ -59,7 +69,11 @@ def friendly(command):
             try:
                 return command(*args, **kwargs)
             except PianobotError as e:
-                err.print(f"[red]error:[/red] {e}", markup=True, highlight=False, soft_wrap=True)
+                err.print(f"[red]error:[/red] {said(e)}", markup=True, highlight=False, emoji=False, soft_wrap=True)
+                raise typer.Exit(EXIT_BAD_INPUT) from None
+            except OSError as e:
+                where = f"{e.filename}: " if e.filename else ""
+                err.print(f"[red]error:[/red] {said(where + why(e))}", highlight=False, emoji=False, soft_wrap=True)
                 raise typer.Exit(EXIT_BAD_INPUT) from None
             except KeyboardInterrupt:
                 err.print("[yellow]interrupted[/yellow]")
@@ -67,7 +81,9 @@ def friendly(command):
             finally:
                 for w in caught:
                     if issubclass(w.category, PianobotWarning):
-                        err.print(f"[yellow]warning:[/yellow] {w.message}", highlight=False, soft_wrap=True)
+                        err.print(
+                            f"[yellow]warning:[/yellow] {said(w.message)}", highlight=False, emoji=False, soft_wrap=True
+                        )
 
     return wrapper
 
@@ -79,7 +95,16 @@ def option(name: str | None = None, value=None):
     try:
         yield
     except ValueError as e:
-        raise PianobotError(f"{name} {value}: {e}" if name else str(e)) from None
+        raise PianobotError(f"{name} {quote(str(value))}: {e}" if name else str(e)) from None
+
+
+def write_json(path: Path, data: dict) -> None:
+    """``data`` as JSON to ``path``, or to standard output when ``path`` is '-'."""
+    text = json.dumps(data, indent=2) + "\n"
+    if str(path) == "-":
+        typer.echo(text, nl=False)
+    else:
+        atomic_write(path, text)
 
 
 # -- shared options --------------------------------------------------------------------------
@@ -115,6 +140,7 @@ Split = typer.Option(
 Quantize = typer.Option(
     None, "--quantize", help="Move onsets and offsets to a grid, e.g. 1/16 (for recordings of human players)."
 )
+AllRows = typer.Option(False, "--all", help="List every note and phrase (by default the tables stop after 100 rows).")
 Refinger = typer.Option(
     LoadOptions.refinger,
     "--refinger",
@@ -142,7 +168,7 @@ def check_midi_output(output: Path, song: Path, what: str) -> None:
     """-o must name a .mid file other than the input."""
     if output.suffix.lower() not in (".mid", ".midi"):
         raise PianobotError(f"-o {output}: {what} is a MIDI file, name it *.mid")
-    if output.resolve() == song.resolve():
+    if os.path.realpath(output) == os.path.realpath(song):  # (realpath: a symbolic-link loop is no crash)
         raise PianobotError(f"-o {output} would overwrite the input {song.name}: choose another file name")
 
 
@@ -193,6 +219,7 @@ def inspect(
     models: Path = typer.Option(
         Path("models"), "--models", help="Model store whose trained phrase split to show (as play uses it)."
     ),
+    all_rows: bool = AllRows,
 ):
     """Explain what a file holds (tracks, hands, pedal, range, polyphony, fingering) and whether the hand can play it."""
     from pianobot.cli import display
@@ -207,7 +234,7 @@ def inspect(
     if song.suffix.lower() != ".txt":
         tracks = midi_io.describe_tracks(song)
         hands = {i: h for h in HANDS for i in hand_tracks(tracks, h)}
-        out.print(display.tracks_table(tracks, hands))
+        out.print(display.tracks_table([replace(t, name=said(t.name)) for t in tracks], hands))
         with_notes = [t for t in tracks if t.notes]
         pedal = sum(t.pedal for t in tracks)
         out.print(
@@ -238,10 +265,12 @@ def inspect(
         )
         for problem in plan.problems:
             out.print(f"[yellow]{problem}[/yellow]")
+    check_playable(piece.without_fingering(), keyboard, hand_spec)  # the keyboard and the chords, before the split
     phrases = trained_split(models, piece, phrase_notes)
-    out.print(display.notes_table(piece, phrases))
+    rows = None if all_rows else display.ROWS
+    out.print(display.notes_table(piece, phrases, rows))
     missing = {p.index for p in missing_phrases(models, phrases)}
-    out.print(display.phrases_table(phrases, {p.index for p in phrases} - missing))
+    out.print(display.phrases_table(phrases, {p.index for p in phrases} - missing, rows))
     check_playable(piece, keyboard, hand_spec)
     out.print(f"[green]playable[/green] on {keyboard.describe()} with fingers {hand_spec.describe()}")
 
@@ -260,6 +289,7 @@ def finger(
     lowest_note: str = LowestNote,
     keys: int = Keys,
     thumb: bool = Thumb,
+    all_rows: bool = AllRows,
 ):
     """Plan a fingering for the robot hand (least wrist travel within its reach) and write it to a MIDI file."""
     from pianobot.cli import display
@@ -275,9 +305,9 @@ def finger(
     piece = load_part(song, options, hand_spec)
     piece, plan = ensure_fingering(piece, keyboard, hand_spec, refinger=True)
     write_midi(piece, output, name=f"{song.stem} fingered by pianobot")
-    out.print(display.notes_table(piece, split_phrases(piece, DEFAULT_MAX_NOTES)))
+    out.print(display.notes_table(piece, split_phrases(piece, DEFAULT_MAX_NOTES), None if all_rows else display.ROWS))
     out.print(
-        f"fingering for fingers {hand_spec.describe()} written to {output}: wrist travel {plan.travel * 100:.1f} cm "
+        f"fingering for fingers {hand_spec.describe()} written to {said(output)}: wrist travel {plan.travel * 100:.1f} cm "
         f"in {plan.moves} moves over {len(piece)} notes"
     )
     for problem in plan.problems:
@@ -320,10 +350,10 @@ def score(
     display.print_all(out, tables if notes else tables[:1])
     if json_path is not None:
         atomic_write(json_path, json.dumps(report.to_dict(), indent=2) + "\n")
-        out.print(f"figures written to {json_path}")
+        out.print(f"figures written to {said(json_path)}")
     if plot is not None:
         plot_report(reference_piece, played_piece, report, plot)
-        out.print(f"piano rolls drawn to {plot}")
+        out.print(f"piano rolls drawn to {said(plot)}")
 
 
 @app.command()
@@ -385,9 +415,9 @@ def play(
     if gui and not os.environ.get("DISPLAY"):
         raise PianobotError("--gui needs a display (DISPLAY is not set): drop --gui, or use --video to watch it later")
     if controller not in CONTROLLERS:
-        raise PianobotError(f"--controller {controller}: choose one of {', '.join(CONTROLLERS)}")
+        raise PianobotError(f"--controller {quote(controller)}: choose one of {', '.join(CONTROLLERS)}")
     if fallback not in (None, "scripted"):
-        raise PianobotError(f"--fallback {fallback}: the only fallback is 'scripted'")
+        raise PianobotError(f"--fallback {quote(fallback)}: the only fallback is 'scripted'")
     keyboard, hand = make_instrument(lowest_note, keys, thumb)
     piece = read_song(
         song, make_options(track, tempo, transpose, fingering, hand_part, split, quantize, refinger), keyboard, hand
@@ -405,7 +435,7 @@ def play(
         if phrase_notes is None and phrases != split_phrases(piece, DEFAULT_MAX_NOTES):
             most = max(len(p.notes) for p in phrases)
             out.print(
-                f"[dim]{len(phrases)} phrases of at most {most} note{'s' * (most > 1)}: the split the policies in {models} were trained for[/dim]"
+                f"[dim]{len(phrases)} phrases of at most {most} note{'s' * (most > 1)}: the split the policies in {said(models)} were trained for[/dim]"
             )
         if missing and not fallback:
             first = missing[0]
@@ -430,9 +460,14 @@ def play(
             return composed
 
     with Progress(
-        TextColumn("{task.description}"), BarColumn(), TimeRemainingColumn(), console=err, transient=True
+        TextColumn("{task.description}"),
+        BarColumn(),
+        TimeRemainingColumn(),
+        console=err,
+        transient=True,
+        disable=not err.is_terminal,  # (a bar in a log is noise, and its last line break an empty line)
     ) as bar:
-        task = bar.add_task(f"playing {song.name}", total=None)
+        task = bar.add_task(f"playing {said(song.name)}", total=None)
         result = perform(
             piece,
             who,
@@ -453,13 +488,13 @@ def play(
             f"[yellow]phrases {', '.join(map(str, fallbacks))} had no trained policy and were played by the scripted pianist[/yellow]"
         )
     display.print_all(out, display.report_tables(report))
-    out.print(f"performance written to {output}, report to {report_path}")
+    out.print(f"performance written to {said(output)}, report to {said(report_path)}")
     if video is not None:
         write_video(result.frames, video, fps=config.world.control_hz)
-        out.print(f"video written to {video}")
+        out.print(f"video written to {said(video)}")
     if wav is not None:
         method = write_wav(result.played, wav)
-        out.print(f"audio written to {wav} ({method})")
+        out.print(f"audio written to {said(wav)} ({method})")
 
 
 @app.command()
@@ -505,6 +540,15 @@ def train(
     ),
     force: bool = typer.Option(False, "--force", help="Retrain phrases that already have a stored policy."),
     models: Path = typer.Option(Path("models"), "--models", help="Folder of the model store."),
+    cluster: str = typer.Option(
+        "local",
+        "--cluster",
+        help="Where phrases train: 'local' (--workers processes here) or 'ray' (Ray tasks on the cluster RAY_ADDRESS "
+        "names, or a local Ray runtime; needs pianobot[ray]).",
+    ),
+    json_path: Optional[Path] = typer.Option(
+        None, "--json", help="Also write each policy's figures and files to this JSON file ('-': standard output)."
+    ),
     track: Optional[str] = Track,
     tempo: Optional[float] = Tempo,
     transpose: int = Transpose,
@@ -523,7 +567,8 @@ def train(
 
     from pianobot.agent import store
     from pianobot.cli import display
-    from pianobot.learn.jobs import phrase_jobs, plan_jobs, run_jobs, task_job
+    from pianobot.learn.jobs import phrase_jobs, plan_jobs, run_jobs, run_jobs_on_ray, task_job
+    from pianobot.learn.log import LOG_FILE, PLOT_FILE
     from pianobot.learn.train import TASK_EVAL_EPISODES
     from pianobot.music.phrases import split_phrases
     from pianobot.sim.hand import HandConfig
@@ -532,9 +577,24 @@ def train(
     if (song is None) == (task is None):
         raise PianobotError("give a .mid file to train on, or --task NAME (not both)")
     if task is not None and task not in TASKS:
-        raise PianobotError(f"--task {task}: choose one of {', '.join(TASKS)}")
+        raise PianobotError(f"--task {quote(task)}: choose one of {', '.join(TASKS)}")
     if workers < 1 or threads < 1:
         raise PianobotError(f"--workers {workers} --threads {threads}: give 1 or more of each")
+    if cluster not in ("local", "ray"):
+        raise PianobotError(f"--cluster {quote(cluster)}: choose local or ray")
+    cores = os.cpu_count() or 1
+    if cluster == "local" and workers * threads > cores:
+        warnings.warn(
+            PianobotWarning(
+                f"--workers {workers} x --threads {threads} asks for {workers * threads} busy threads on {cores} cores: "
+                f"torch's thread pools then spin against each other (measured up to 20x slower); keep workers x threads <= {cores}"
+            )
+        )
+    if task is not None and workers > 1:
+        warnings.warn(PianobotWarning(f"--task trains one policy: --workers {workers} has nothing to share out"))
+    if json_path is not None and str(json_path) != "-":
+        check_writable(json_path)
+    console = err if json_path is not None and str(json_path) == "-" else out  # standard output carries the JSON
     if models.exists() and not models.is_dir():
         raise PianobotError(f"--models {models} is a file: give a folder")
     keyboard, hand = make_instrument(lowest_note, keys, thumb)
@@ -573,10 +633,10 @@ def train(
         label = f"{song.name}: {len(phrases)} phrases"
     models.mkdir(parents=True, exist_ok=True)
     for job in done:
-        out.print(
-            f"phrase {job.key} ({', '.join(map(str, job.phrases))}) already trained in {job.folder}: skipped (--force retrains)"
+        console.print(
+            f"phrase {job.key} ({', '.join(map(str, job.phrases))}) already trained in {said(job.folder)}: skipped (--force retrains)"
         )
-    out.print(f"training {len(todo)} polic{'y' if len(todo) == 1 else 'ies'} for {label}, {steps} steps each")
+    console.print(f"training {len(todo)} polic{'y' if len(todo) == 1 else 'ies'} for {said(label)}, {steps} steps each")
     returns: dict[str, float] = {}
     with Progress(
         TextColumn("{task.description}"),
@@ -584,7 +644,7 @@ def train(
         TextColumn("{task.completed}/{task.total} steps"),
         TextColumn("{task.fields[status]}"),
         TimeRemainingColumn(),
-        console=out,
+        console=console,
     ) as bar:
         rows = {
             job.key: bar.add_task(f"phrase {job.key[:8]}" if task is None else job.key, total=steps, status="")
@@ -596,6 +656,9 @@ def train(
                 bar.console.print(
                     f"{bar.tasks[rows[key]].description}: resuming from its checkpoint at step {progress.step}"
                 )
+            if progress.finished:  # stopped early (--until-f1) or at its last step: the bar ends full
+                bar.update(rows[key], total=progress.step, completed=progress.step)
+                return
             status = bar.tasks[rows[key]].fields.get("status", "")
             if progress.episode_return is not None:
                 returns[key] = progress.episode_return
@@ -605,11 +668,48 @@ def train(
                 status = f"return {returns[key]:.1f}" + (f" | {status.split(' | ')[-1]}" if "eval" in status else "")
             bar.update(rows[key], completed=progress.step, status=status)
 
-        results = run_jobs(todo, config, workers, on_progress, threads=threads)
-    table = display.training_table(
-        [(job, results.get(job.key) or store.read_manifest(job.folder)) for job in done + todo]
-    )
-    out.print(table)
+        if cluster == "ray":
+            results = run_jobs_on_ray(todo, config, on_progress, threads=threads)
+        else:
+            results = run_jobs(todo, config, workers, on_progress, threads=threads)
+    trained = [(job, results.get(job.key) or store.read_manifest(job.folder)) for job in done + todo]
+    console.print(display.training_table(trained))
+    console.print(f"learning curves: {LOG_FILE} and {PLOT_FILE} in each policy's folder")
+    if json_path is not None:
+        summary = [
+            {
+                "key": job.key,
+                "phrases": job.phrases,
+                "folder": str(job.folder),
+                "trained_now": job in todo,
+                **{k: manifest.get(k) for k in ("steps", "updates", "seconds", "evaluation")},
+                "log": str(job.folder / LOG_FILE),
+                "plot": str(job.folder / PLOT_FILE),
+            }
+            for job, manifest in trained
+        ]
+        write_json(json_path, {"policies": summary})
+
+
+@app.command()
+@friendly
+def export(
+    model: Path = typer.Argument(
+        ..., help="A trained policy's folder in the model store, e.g. models/<phrase hash>-<config hash>."
+    ),
+    output: Path = typer.Option(..., "--output", "-o", help="Write the policy to this .onnx file."),
+):
+    """Export a trained policy to ONNX (for a robot or any ONNX runtime); docs/models.md gives its inputs."""
+    from pianobot.agent.export import export_onnx
+
+    if output.suffix.lower() != ".onnx":
+        raise PianobotError(f"-o {output}: the export is an ONNX file, name it *.onnx")
+    if not model.is_dir():
+        raise PianobotError(
+            f"{model} is not a folder: give a trained policy's folder in the model store (see `pianobot inspect`)"
+        )
+    export_onnx(model, output)
+    out.print(f"policy {model.name} written to {output}")
 
 
 def _version(value: bool):

@@ -7,7 +7,7 @@ import warnings
 from dataclasses import dataclass, replace
 from pathlib import Path
 
-from pianobot.errors import PianobotError, PianobotWarning
+from pianobot.errors import PianobotError, PianobotWarning, quote
 from pianobot.music import midi_io, pig
 from pianobot.music.instrument import HandSpec
 from pianobot.music.piece import Note, Piece, pitch_name
@@ -106,7 +106,7 @@ def _read_midi(path: Path, options: LoadOptions, bpm: float | None = None) -> Pi
     if options.hand is None:
         return midi_io.read_midi(path, track=options.track, bpm=bpm, grid=grid)
     if options.hand not in HANDS:
-        raise PianobotError(f"--hand {options.hand}: choose right or left")
+        raise PianobotError(f"--hand {quote(options.hand)}: choose right or left")
     if options.track is not None:
         raise PianobotError("give --track or --hand, not both")
     tracks = midi_io.describe_tracks(path)
@@ -152,6 +152,8 @@ def load_piece(path: str | Path, options: LoadOptions = LoadOptions()) -> Piece:
         if options.hand is not None or options.quantize is not None:
             raise PianobotError("--hand and --quantize need a MIDI file")
         piece = pig.read_pig(path)
+    elif options.tempo is not None and options.fingering is None and not pig.sidecar_for(path).exists():
+        piece = _read_midi(path, options, bpm=options.tempo)  # the file's tempo map is never needed
     else:
         piece = _read_midi(path, options)
         sidecar = options.fingering or pig.sidecar_for(path)

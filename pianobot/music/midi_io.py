@@ -12,6 +12,7 @@ so that one beat lasts 60/bpm seconds.
 
 from __future__ import annotations
 
+import bisect
 import io
 import re
 import warnings
@@ -21,9 +22,9 @@ from pathlib import Path
 
 import mido
 
-from pianobot.errors import PianobotError, PianobotWarning
-from pianobot.files import atomic_write
-from pianobot.music.piece import Note, Piece, pitch_name
+from pianobot.errors import PianobotError, PianobotWarning, quote
+from pianobot.files import atomic_write, read_input
+from pianobot.music.piece import MAX_SECONDS, Note, Piece, pitch_name
 
 _FINGER_TOKEN = r"(?:[0-9](?:_[0-9])?|-)"
 _FINGER_TEXT = re.compile(rf"^\s*{_FINGER_TOKEN}(?:[\s,]+{_FINGER_TOKEN})*\s*$")
@@ -57,7 +58,7 @@ def parse_finger_text(text: str) -> list[int | None] | None:
         finger = int(token.split("_")[0])
         if not 1 <= finger <= 5:
             raise PianobotError(
-                f"fingering text '{text}' holds finger {finger}: fingers are 1 (thumb) to 5 (little finger)"
+                f"fingering text '{quote(text)}' holds finger {finger}: fingers are 1 (thumb) to 5 (little finger)"
             )
         fingers.append(finger)
     return fingers
@@ -68,19 +69,49 @@ def finger_text(fingers: list[int | None]) -> str:
     return " ".join("-" if f is None else str(f) for f in fingers)
 
 
+def _track_chunks(data: bytes) -> tuple[int, bool]:
+    """How many complete track chunks ('MTrk' and its whole length) follow the header, and
+    whether the data ends inside a chunk (a cut file)."""
+    pos, count = 8 + int.from_bytes(data[4:8], "big"), 0
+    while pos + 8 <= len(data):
+        size = int.from_bytes(data[pos + 4 : pos + 8], "big")
+        if pos + 8 + size > len(data):
+            return count, True
+        count += data[pos : pos + 4] == b"MTrk"
+        pos += 8 + size
+    return count, pos < len(data)
+
+
 def _load(path: Path) -> mido.MidiFile:
-    if not path.exists():
-        raise PianobotError(f"no such file: {path}")
-    if path.is_dir():
-        raise PianobotError(f"{path} is a folder: give a .mid file")
-    if path.stat().st_size > MAX_FILE_BYTES:
-        raise PianobotError(f"{path} is larger than {MAX_FILE_BYTES // 1_000_000} MB: that is not a piano piece")
-    try:
-        data = path.read_bytes()
-    except OSError as e:
-        raise PianobotError(f"cannot read {path}: {e.strerror}") from None
+    data = read_input(path, limit=MAX_FILE_BYTES, kind=".mid file")
     if not data.startswith(b"MThd"):
         raise PianobotError(f"{path} is not a MIDI file (it does not start with 'MThd'): give a standard .mid file")
+    if len(data) < 14:
+        raise PianobotError(
+            f"{path} is not a readable MIDI file (its header is cut short): it may be truncated or corrupt; re-export it"
+        )
+    division = int.from_bytes(data[12:14], "big")
+    if division & 0x8000:
+        raise PianobotError(f"{path} uses SMPTE time division, which pianobot does not read: re-export it with beats")
+    if division == 0:
+        raise PianobotError(f"{path} says a beat has 0 ticks (its header is corrupt): re-export it")
+    declared, (held, cut) = int.from_bytes(data[10:12], "big"), _track_chunks(data)
+    if cut and declared > held:
+        raise PianobotError(
+            f"{path} is not a readable MIDI file (it ends inside track {held}): it may be truncated or corrupt; "
+            "re-export it"
+        )
+    if declared > held:
+        raise PianobotError(
+            f"{path} is truncated or its header does not match its tracks: the header says {declared} track(s), "
+            f"the file holds {held} complete one(s); re-export it"
+        )
+    if declared < held:
+        warnings.warn(
+            PianobotWarning(
+                f"{path.name}: the header says {declared} track(s) but the file holds {held}; read {declared}"
+            )
+        )
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
@@ -92,8 +123,6 @@ def _load(path: Path) -> mido.MidiFile:
         ) from None
     if midi.type == 2:
         raise PianobotError(f"{path} is a type 2 MIDI file (independent patterns): re-export it as type 0 or 1")
-    if midi.ticks_per_beat <= 0:
-        raise PianobotError(f"{path} uses SMPTE time division, which pianobot does not read: re-export it with beats")
     return midi
 
 
@@ -113,33 +142,37 @@ def _absolute(track: mido.MidiTrack) -> list[tuple[int, mido.Message]]:
 
 
 class _TempoMap:
-    """Ticks to seconds through a file's set_tempo events (default 120 bpm)."""
+    """Ticks to seconds through a file's set_tempo events (default 120 bpm).
 
-    def __init__(self, midi: mido.MidiFile):
+    A tempo of 0 (no time per beat) is refused: every note after it would last no time.
+    """
+
+    def __init__(self, midi: mido.MidiFile, path: Path):
         changes = sorted((t, m.tempo) for track in midi.tracks for t, m in _absolute(track) if m.type == "set_tempo")
         self.tpb = midi.ticks_per_beat
-        self.points: list[tuple[int, float, int]] = []  # (tick, seconds at tick, tempo from there)
-        tick, seconds, tempo = 0, 0.0, 500_000
+        self.points: list[tuple[int, float, int]] = [(0, 0.0, 500_000)]  # (tick, seconds at tick, tempo from there)
         for change_tick, new_tempo in changes:
-            seconds += mido.tick2second(change_tick - tick, self.tpb, tempo)
-            tick, tempo = change_tick, new_tempo
-            self.points.append((tick, seconds, tempo))
+            if new_tempo <= 0:
+                raise PianobotError(
+                    f"{path} sets a tempo of 0 (no time per beat) at beat {change_tick / self.tpb:.0f}: "
+                    "re-export it, or give the tempo with --tempo BPM"
+                )
+            tick, seconds, tempo = self.points[-1]
+            self.points.append(
+                (change_tick, seconds + mido.tick2second(change_tick - tick, self.tpb, tempo), new_tempo)
+            )
+        self.ticks = [point[0] for point in self.points]
         self.first_tempo = changes[0][1] if changes and changes[0][0] == 0 else 500_000
-        self._base = (0, 0.0, 500_000)
 
     def seconds(self, tick: int) -> float:
-        start = self._base
-        for point in self.points:
-            if point[0] > tick:
-                break
-            start = point
-        return start[1] + mido.tick2second(tick - start[0], self.tpb, start[2])
+        tick0, seconds, tempo = self.points[bisect.bisect_right(self.ticks, tick) - 1]
+        return seconds + mido.tick2second(tick - tick0, self.tpb, tempo)
 
 
 def list_tracks(midi: mido.MidiFile) -> list[TrackInfo]:
     infos = []
     for i, track in enumerate(midi.tracks):
-        name = next((m.name for m in track if m.type == "track_name"), "")
+        name = _text(next((m.name for m in track if m.type == "track_name"), ""))
         ons = [m for m in track if m.type == "note_on" and m.velocity > 0]
         pedal = sum(1 for m in track if m.type == "control_change" and m.control == 64 and m.value >= 64)
         pitches = [m.note for m in ons]
@@ -157,6 +190,14 @@ def list_tracks(midi: mido.MidiFile) -> list[TrackInfo]:
     return infos
 
 
+def _text(text: str) -> str:
+    """A text read as Latin-1 (mido's default), as UTF-8 where its bytes are UTF-8 (as pianobot writes names)."""
+    try:
+        return text.encode("latin-1").decode("utf-8")
+    except UnicodeError:
+        return text
+
+
 def parse_grid(text: str) -> float:
     """A quantisation grid like '1/16' (a sixteenth note) as a fraction of a whole note."""
     try:
@@ -164,7 +205,9 @@ def parse_grid(text: str) -> float:
         if top < 1 or bottom < 1:
             raise ValueError
     except ValueError:
-        raise PianobotError(f"--quantize {text}: give a note value like 1/8, 1/16 or 1/12 (triplet eighths)") from None
+        raise PianobotError(
+            f"--quantize {quote(text)}: give a note value like 1/8, 1/16 or 1/12 (triplet eighths)"
+        ) from None
     return top / bottom
 
 
@@ -172,7 +215,8 @@ def _select_tracks(midi: mido.MidiFile, track: str | int | None, path: Path) -> 
     infos = list_tracks(midi)
     if track is None:
         return [t.index for t in infos]
-    with_notes = ", ".join(f"{t.index} '{t.name}'" if t.name else str(t.index) for t in infos if t.notes)
+    with_notes = ", ".join(f"{t.index} '{quote(t.name, 30)}'" if t.name else str(t.index) for t in infos if t.notes)
+    with_notes = quote(with_notes, 200)
     key = str(track).strip()
     if key.isdigit():
         if int(key) < len(infos):
@@ -181,7 +225,9 @@ def _select_tracks(midi: mido.MidiFile, track: str | int | None, path: Path) -> 
         hits = [t.index for t in infos if t.name.strip().lower() == key.lower()]
         if hits:
             return hits
-    raise PianobotError(f"{path} has no track '{track}': choose one of the tracks with notes: {with_notes or 'none'}")
+    raise PianobotError(
+        f"{path} has no track '{quote(str(track))}': choose one of the tracks with notes: {with_notes or 'none'}"
+    )
 
 
 def _track_notes(
@@ -237,7 +283,6 @@ def read_midi(
     """
     path = Path(path)
     midi = _load(path)
-    tempo_map = _TempoMap(midi)
     if bpm is not None:
         if not 10 <= bpm <= 1000:
             raise PianobotError(f"--tempo {bpm}: choose a tempo between 10 and 1000 bpm")
@@ -245,6 +290,7 @@ def read_midi(
         seconds = lambda tick: tick / tpb * 60.0 / bpm  # noqa: E731
         nominal = bpm
     else:
+        tempo_map = _TempoMap(midi, path)
         seconds = tempo_map.seconds
         nominal = max(10.0, min(1000.0, mido.tempo2bpm(tempo_map.first_tempo)))
 
@@ -257,6 +303,13 @@ def read_midi(
         if grid is not None:
             raw = [(snap(on), max(snap(off), snap(on) + step), pitch, vel) for on, off, pitch, vel in raw]
             fingering = {snap(tick): fingers for tick, fingers in fingering.items()}
+        last = max(raw, key=lambda item: item[1], default=None)
+        if last is not None and seconds(last[1]) > MAX_SECONDS:
+            raise PianobotError(
+                f"{path} track {index} lasts {seconds(last[1]) / 60:,.0f} minutes ({pitch_name(last[2])} ends at "
+                f"{seconds(last[1]):,.3f} s): pianobot reads at most {MAX_SECONDS / 60:.0f} minutes of music; "
+                "cut the file, or choose a part with --track or a faster --tempo"
+            )
         by_tick: dict[int, list[tuple[int, int, int, int]]] = defaultdict(list)
         for item in raw:
             by_tick[item[0]].append(item)
@@ -265,14 +318,14 @@ def read_midi(
             if not starting:
                 warnings.warn(
                     PianobotWarning(
-                        f"track {index}: fingering '{finger_text(fingers)}' at {seconds(tick):.3f} s has no "
+                        f"track {index}: fingering '{quote(finger_text(fingers))}' at {seconds(tick):.3f} s has no "
                         "note starting there; ignored"
                     )
                 )
                 continue
             if len(fingers) != len(starting):
                 raise PianobotError(
-                    f"{path} track {index} at {seconds(tick):.3f} s: fingering '{finger_text(fingers)}' gives "
+                    f"{path} track {index} at {seconds(tick):.3f} s: fingering '{quote(finger_text(fingers))}' gives "
                     f"{len(fingers)} finger(s) for {len(starting)} note(s) starting there "
                     f"({', '.join(pitch_name(s[2]) for s in starting)}): give one finger per note, lowest pitch first"
                 )
@@ -338,7 +391,7 @@ def midi_bytes(piece: Piece, *, name: str = "pianobot") -> bytes:
         track.append(msg.copy(time=tick - last))
         last = tick
     track.append(mido.MetaMessage("end_of_track", time=0))
-    midi = mido.MidiFile(type=0, ticks_per_beat=tpb)
+    midi = mido.MidiFile(type=0, ticks_per_beat=tpb, charset="utf-8")  # any name: a file name may be '音.mid'
     midi.tracks.append(track)
     buffer = io.BytesIO()
     midi.save(file=buffer)

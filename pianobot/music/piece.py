@@ -12,17 +12,23 @@ the 50 ms control step and the 50 ms onset tolerance of the metrics, and it make
 
 from __future__ import annotations
 
+import math
+import numbers
 import re
 from dataclasses import dataclass, field, replace
 from typing import Iterable, Sequence
 
-from pianobot.errors import PianobotError
+from pianobot.errors import PianobotError, quote
 
 FINGER_NAMES = {1: "thumb", 2: "index", 3: "middle", 4: "ring", 5: "little"}
 _NAMES = ("C", "C#", "D", "D#", "E", "F", "F#", "G", "G#", "A", "A#", "B")
 _LETTER = {"C": 0, "D": 2, "E": 4, "F": 5, "G": 7, "A": 9, "B": 11}
 TIME_RESOLUTION = 1e-3
 """Note times are rounded to this many seconds (1 ms)."""
+MAX_SECONDS = 3600.0
+"""The longest piece pianobot reads: every note ends within 60 minutes. It bounds what a file can
+ask for (the score tensor, the simulation, the metrics grow with the piece's length), whatever
+its times say; a longer piece is cut into parts (e.g. with --track) or re-timed with --tempo."""
 
 
 def pitch_name(pitch: int) -> str:
@@ -36,21 +42,21 @@ def parse_pitch(name: str) -> int:
     Also accepts a plain MIDI number ('60').
     """
     text = name.strip()
-    if text.lstrip("-").isdigit():
-        value = int(text)
+    if re.fullmatch(r"-?[0-9]+", text):
+        value = int(text) if len(text) <= 10 else 1 << 40  # far outside the range, without reading 5,000 digits
     else:
         if not text or text[0].upper() not in _LETTER:
-            raise PianobotError(f"'{name}' is not a pitch: write it like C4, F#3, Bb5 or a MIDI number 0-127")
+            raise PianobotError(f"'{quote(name)}' is not a pitch: write it like C4, F#3, Bb5 or a MIDI number 0-127")
         value = _LETTER[text[0].upper()]
         # the octave is the trailing number; "-1" at the end is octave -1 (C-1 = 0), not a flat
-        match = re.fullmatch(r"([#b-]*?)(-1|\d+)", text[1:])
+        match = re.fullmatch(r"([#b-]*?)(-1|[0-9]{1,3})", text[1:])
         if match is None:
-            raise PianobotError(f"'{name}' is not a pitch: write it like C4, F#3, Bb5 or a MIDI number 0-127")
+            raise PianobotError(f"'{quote(name)}' is not a pitch: write it like C4, F#3, Bb5 or a MIDI number 0-127")
         accidentals, octave = match.group(1), int(match.group(2))
         value += accidentals.count("#") - accidentals.count("b") - accidentals.count("-")
         value += (octave + 1) * 12
     if not 0 <= value <= 127:
-        raise PianobotError(f"pitch '{name}' is outside MIDI's range 0-127 (C-1 to G9)")
+        raise PianobotError(f"pitch '{quote(name)}' is outside MIDI's range 0-127 (C-1 to G9)")
     return value
 
 
@@ -69,10 +75,21 @@ class Note:
     finger: int | None = None
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "onset", _ms(self.onset))
-        object.__setattr__(self, "offset", _ms(self.offset))
         if not isinstance(self.pitch, int) or not 0 <= self.pitch <= 127:
             raise PianobotError(f"pitch {self.pitch!r} is outside MIDI's range 0-127")
+        for name in ("onset", "offset"):
+            value = getattr(self, name)
+            if not isinstance(value, numbers.Real) or not math.isfinite(value):
+                raise PianobotError(
+                    f"note {pitch_name(self.pitch)} has {name} {value!r}: times must be finite numbers of seconds"
+                )
+            if value > MAX_SECONDS:
+                raise PianobotError(
+                    f"note {pitch_name(self.pitch)} has {name} {value:.3f} s, after {MAX_SECONDS / 60:.0f} minutes: "
+                    f"pianobot reads pieces of at most {MAX_SECONDS / 60:.0f} minutes; cut the piece into parts"
+                )
+        object.__setattr__(self, "onset", _ms(self.onset))
+        object.__setattr__(self, "offset", _ms(self.offset))
         if self.onset < 0:
             raise PianobotError(f"note {pitch_name(self.pitch)} starts at {self.onset} s: onsets must be >= 0")
         if self.offset <= self.onset:

@@ -11,10 +11,12 @@ a .mid file (:func:`apply_fingering`).
 
 from __future__ import annotations
 
+import bisect
+from collections import defaultdict
 from pathlib import Path
 
-from pianobot.errors import PianobotError
-from pianobot.files import atomic_write
+from pianobot.errors import PianobotError, quote
+from pianobot.files import atomic_write, read_input
 from pianobot.music.piece import Note, Piece, parse_pitch, pitch_name
 
 HEADER = "//Version: PianoFingering_v170101"
@@ -22,6 +24,8 @@ SIDECAR_SUFFIX = "_fingering.txt"
 """A sidecar for ``song.mid`` is ``song_fingering.txt`` in the same folder (PIG's own naming)."""
 MATCH_TOLERANCE = 0.025
 """A sidecar note matches a MIDI note of the same pitch whose onset is this close (seconds)."""
+MAX_FILE_BYTES = 50_000_000
+"""A PIG file larger than this is refused unread (bytes), as a MIDI file is."""
 
 
 def _parse_finger(text: str, where: str) -> tuple[int, int]:
@@ -30,20 +34,24 @@ def _parse_finger(text: str, where: str) -> tuple[int, int]:
     try:
         value = int(token)
     except ValueError:
-        raise PianobotError(f"{where}: finger '{text}' is not a number like +3, -2 or 3_1") from None
+        raise PianobotError(f"{where}: finger '{quote(text)}' is not a number like +3, -2 or 3_1") from None
     if not 1 <= abs(value) <= 5:
-        raise PianobotError(f"{where}: finger '{text}' must be 1-5 (right hand) or -1..-5 (left hand)")
+        raise PianobotError(f"{where}: finger '{quote(text)}' must be 1-5 (right hand) or -1..-5 (left hand)")
     return abs(value), (-1 if token.startswith("-") else 1)
 
 
 def read_pig_rows(path: str | Path) -> list[tuple[Note, int]]:
     """Every note of a PIG file with its channel (0 right hand, 1 left hand)."""
     path = Path(path)
-    if not path.exists():
-        raise PianobotError(f"fingering file {path} does not exist: check the path given to --fingering")
+    data = read_input(
+        path,
+        limit=MAX_FILE_BYTES,
+        kind="PIG fingering file",
+        missing=f"fingering file {path} does not exist: check the path given to --fingering",
+    )
     try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as e:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as e:
         raise PianobotError(f"cannot read fingering file {path} ({e}): it must be a UTF-8 PIG text file") from None
     rows: list[tuple[Note, int]] = []
     for number, line in enumerate(text.splitlines(), start=1):
@@ -124,22 +132,27 @@ def apply_fingering(piece: Piece, pig_path: str | Path) -> Piece:
     Every note of ``piece`` must find its PIG note (within :data:`MATCH_TOLERANCE`); PIG notes
     left over (e.g. the other hand's) are ignored.
     """
-    rows = sorted(read_pig_rows(pig_path), key=lambda r: (r[0].onset, r[0].pitch))
-    used = [False] * len(rows)
+    by_pitch: dict[int, list[Note]] = defaultdict(list)  # each pitch's PIG notes in onset order
+    for note, _ in sorted(read_pig_rows(pig_path), key=lambda r: (r[0].onset, r[0].pitch)):
+        by_pitch[note.pitch].append(note)
+    onsets = {pitch: [n.onset for n in notes] for pitch, notes in by_pitch.items()}
+    used = {pitch: [False] * len(notes) for pitch, notes in by_pitch.items()}
     fingers = []
     for note in piece.notes:
         best = None
-        for i, (candidate, _) in enumerate(rows):
-            if used[i] or candidate.pitch != note.pitch:
-                continue
-            gap = abs(candidate.onset - note.onset)
-            if gap <= MATCH_TOLERANCE and (best is None or gap < best[0]):
+        candidates = by_pitch.get(note.pitch, [])
+        first = bisect.bisect_left(onsets.get(note.pitch, []), note.onset - MATCH_TOLERANCE - 1e-9)
+        for i in range(first, len(candidates)):
+            gap = abs(candidates[i].onset - note.onset)
+            if candidates[i].onset > note.onset + MATCH_TOLERANCE + 1e-9:
+                break
+            if not used[note.pitch][i] and gap <= MATCH_TOLERANCE and (best is None or gap < best[0]):
                 best = (gap, i)
         if best is None:
             raise PianobotError(
                 f"fingering file {Path(pig_path).name} has no note for {note.describe()}: "
                 "the sidecar must list the same notes as the .mid file (same pitches and onsets)"
             )
-        used[best[1]] = True
-        fingers.append(rows[best[1]][0].finger)
+        used[note.pitch][best[1]] = True
+        fingers.append(candidates[best[1]].finger)
     return piece.with_fingers(fingers)

@@ -7,13 +7,16 @@
 
 from __future__ import annotations
 
+import contextlib
+import errno
+import shutil
 from pathlib import Path
 from typing import Callable
 
 import numpy as np
 
 from pianobot.env.piano import EnvConfig, PianoEnv
-from pianobot.files import check_writable, move_into_place, temporary_beside
+from pianobot.files import check_writable, move_into_place, not_written, temporary_beside
 from pianobot.music.piece import Piece
 from pianobot.perform.controllers import make_controller
 from pianobot.perform.rollout import Controller, Rollout, rollout
@@ -48,15 +51,43 @@ def write_video(frames: list[np.ndarray], path: str | Path, fps: float) -> Path:
     import imageio.v2 as imageio  # only needed for videos
 
     path = check_writable(path)
-    tmp = temporary_beside(path)
+    tmp = None
     try:
+        tmp = temporary_beside(path)
         with imageio.get_writer(
-            tmp, format="FFMPEG", fps=fps, codec="libx264", quality=7, macro_block_size=16
+            tmp, format="FFMPEG", fps=fps, codec="libx264", quality=7, macro_block_size=16, ffmpeg_log_level="quiet"
         ) as writer:
             for frame in frames:
                 writer.append_data(frame)
+        if frames and not _complete_mp4(Path(tmp)):  # ffmpeg may stop short (a full disk) without an error
+            full = shutil.disk_usage(path.parent).free < 1_000_000
+            raise OSError(errno.ENOSPC if full else errno.EIO, "the encoder stopped before the video was complete")
         move_into_place(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
+    except BaseException as e:
+        if tmp is not None:
+            with contextlib.suppress(OSError):
+                Path(tmp).unlink(missing_ok=True)
+        if isinstance(e, (OSError, RuntimeError)):  # imageio-ffmpeg raises these when ffmpeg or the disk fails
+            raise not_written(path, e if isinstance(e, OSError) else OSError(None, str(e))) from None
         raise
     return path
+
+
+def _complete_mp4(path: Path) -> bool:
+    """Whether an MP4 file's top-level boxes run exactly to its end and include the index ('moov')."""
+    size, seen = path.stat().st_size, set()
+    with open(path, "rb") as f:
+        at = 0
+        while at + 8 <= size:
+            f.seek(at)
+            header = f.read(16)
+            length, kind = int.from_bytes(header[:4], "big"), header[4:8]
+            if length == 1 and len(header) == 16:  # a 64-bit size follows
+                length = int.from_bytes(header[8:16], "big")
+            elif length == 0:  # the box runs to the end of the file
+                length = size - at
+            if length < 8:
+                return False
+            seen.add(kind)
+            at += length
+    return at == size and b"moov" in seen
