@@ -16,11 +16,22 @@ import types
 import typing
 from typing import Any, TypeVar
 
+from pianobot.errors import quote
+
 T = TypeVar("T")
 
 
 class ConfigError(ValueError):
     """A value does not fit its field; the message starts with the field's dotted path."""
+
+
+def check_ranges(config: Any, **ranges: tuple[float, float]) -> None:
+    """Raise ValueError naming the first field of ``config`` outside its (low, high) range
+    (inclusive): the physical and numerical settings' sanity checks in ``__post_init__``."""
+    for name, (low, high) in ranges.items():
+        value = getattr(config, name)
+        if not low <= value <= high:
+            raise ValueError(f"{name} {value} must lie between {low:g} and {high:g}")
 
 
 def to_dict(config: Any) -> dict:
@@ -39,13 +50,13 @@ def from_dict(cls: type[T], data: Any, path: str = "config") -> T:
     fields = {f.name: f for f in dataclasses.fields(cls) if f.init}
     unknown = sorted(set(data) - set(fields))
     if unknown:
-        raise ConfigError(f"{path}.{unknown[0]}: not a field of {cls.__name__}")
+        raise ConfigError(f"{path}.{quote(unknown[0])}: not a field of {cls.__name__}")
     hints = typing.get_type_hints(cls)
     values = {name: _convert(hints[name], value, f"{path}.{name}") for name, value in data.items()}
     try:
         return cls(**values)
     except (TypeError, ValueError) as e:
-        raise ConfigError(f"{path}: {e}") from None
+        raise ConfigError(f"{path}: {quote(str(e), 200)}") from None
 
 
 def _convert(kind: Any, value: Any, path: str) -> Any:
@@ -94,5 +105,4 @@ def _convert(kind: Any, value: Any, path: str) -> Any:
 
 
 def _show(value: Any) -> str:
-    text = repr(value)
-    return f"{type(value).__name__} {text if len(text) <= 40 else text[:37] + '...'}"
+    return f"{type(value).__name__} {quote(repr(value), 40)}"

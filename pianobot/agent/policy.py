@@ -14,7 +14,7 @@ from pianobot.agent import store
 from pianobot.agent.config import SACConfig
 from pianobot.agent.sac import SAC, score_size, vector_size
 from pianobot.config import ConfigError, from_dict
-from pianobot.env.piano import EnvConfig, PianoEnv
+from pianobot.env.piano import EnvConfig, PianoEnv, idle_pose
 from pianobot.errors import PianobotError
 
 
@@ -30,11 +30,16 @@ def policy_configs(folder: Path) -> tuple[EnvConfig, SACConfig]:
     """The environment and agent configurations the policy in ``folder`` was trained with."""
     manifest = store.read_manifest(folder)
     try:
-        return from_dict(EnvConfig, manifest["config"]["env"], "config.env"), from_dict(
-            SACConfig, manifest["config"]["sac"], "config.sac"
-        )
+        env = from_dict(EnvConfig, manifest["config"]["env"], "config.env")
+        sac = from_dict(SACConfig, manifest["config"]["sac"], "config.sac")
+        idle_pose(env.world)  # a hand that can reach the keys at all
+        return env, sac
     except ConfigError as e:
         raise PianobotError(f"{folder / store.MANIFEST_FILE}: {e}: retrain the phrase with --force") from None
+    except ValueError as e:
+        raise PianobotError(
+            f"{folder / store.MANIFEST_FILE} describes a world pianobot cannot build ({e}): retrain the phrase with --force"
+        ) from None
 
 
 def load_policy(folder: Path, env: PianoEnv) -> SAC:

@@ -31,6 +31,7 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
+from pianobot.config import check_ranges
 from pianobot.env.rewards import RewardConfig, reward_terms
 from pianobot.music.instrument import check_playable
 from pianobot.music.piece import Piece
@@ -161,8 +162,7 @@ class EnvConfig:
             raise ValueError(
                 f"actuated joints must be distinct names from {', '.join(JOINT_KINDS)}; got {', '.join(self.actuated) or 'none'}"
             )
-        if self.lookahead < 0 or self.lead_in < 0 or self.tail < 0:
-            raise ValueError("lookahead, lead_in and tail cannot be negative")
+        check_ranges(self, lookahead=(0, 200), lead_in=(0.0, 60.0), tail=(0.0, 60.0))
         if self.tactile_pool is not None:
             (rows, cols), sensor = self.tactile_pool, self.tactile_sensor
             if not (rows >= 1 and cols >= 1 and sensor.rows % rows == 0 and sensor.cols % cols == 0):

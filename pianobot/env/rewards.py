@@ -22,6 +22,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from pianobot.config import check_ranges
+
 REWARDS = ("linear", "squared", "wasserstein")
 
 
@@ -48,6 +50,14 @@ class RewardConfig:
     def __post_init__(self) -> None:
         if self.kind not in REWARDS:
             raise ValueError(f"reward must be one of {', '.join(REWARDS)}; got {self.kind!r}")
+        check_ranges(
+            self,
+            constant=(0.0, 1e3),
+            sigma=(0.0, 1e3),
+            key_cost=(0.0, 1e3),
+            closeness_weight=(0.0, 1e3),
+            closeness_scale=(1e-4, 1.0),
+        )
 
 
 def gate(played: np.ndarray, played_finger: np.ndarray, target: np.ndarray, target_finger: np.ndarray) -> np.ndarray:

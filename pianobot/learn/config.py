@@ -5,7 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from pianobot.agent.config import SACConfig
-from pianobot.config import ConfigError, from_dict
+from pianobot.config import ConfigError, check_ranges, from_dict
 from pianobot.env.piano import EnvConfig
 from pianobot.errors import PianobotError
 from pianobot.learn.explore import EXPLORATIONS
@@ -39,8 +39,9 @@ class TrainConfig:
             )
         if self.until_f1 is not None and not 0.0 < self.until_f1 <= 1.0:
             raise ValueError(f"the note F1 to stop at must lie in (0, 1]; got {self.until_f1}")
-        if min(self.eval_every, self.eval_episodes, self.checkpoint_every) < 1:
-            raise ValueError("eval_every, eval_episodes and checkpoint_every must be 1 or more")
+        check_ranges(
+            self, steps=(1, 10**9), eval_every=(1, 10**9), eval_episodes=(1, 10_000), checkpoint_every=(1, 10**9)
+        )
 
 
 def config_from_manifest(manifest: dict) -> TrainConfig:

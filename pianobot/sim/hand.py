@@ -18,6 +18,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from pianobot.config import check_ranges
 from pianobot.music.instrument import HandSpec
 
 
@@ -35,6 +36,21 @@ class FingerGeometry:
     link_radius: float = 0.008
     abduction_limit: float = 0.47
     flexion_limits: tuple[tuple[float, float], ...] = ((-0.196, 1.61), (-0.174, 1.709), (-0.227, 1.618))
+
+    def __post_init__(self) -> None:
+        m = (1e-4, 1.0)  # metres
+        check_ranges(
+            self,
+            base_to_mcp=(0.0, 1.0),
+            proximal=m,
+            middle=m,
+            distal=m,
+            tip_radius=m,
+            link_radius=m,
+            abduction_limit=(0.0, 1.6),
+        )
+        if len(self.flexion_limits) != 3 or any(not -3.2 < low < high < 3.2 for low, high in self.flexion_limits):
+            raise ValueError(f"flexion_limits {self.flexion_limits}: three (low, high) pairs in radians, low < high")
 
 
 FINGER_BASE_X = {1: -0.0870, 2: -0.0435, 3: 0.0, 4: 0.0435}
@@ -65,6 +81,19 @@ class HandConfig:
     """Most force (N) the wrist motor may use."""
     finger_mass: float = 0.03
     """Mass of each finger link (kg)."""
+
+    def __post_init__(self) -> None:
+        check_ranges(
+            self,
+            palm_height=(1e-3, 1.0),
+            palm_y=(1e-3, 1.0),
+            max_joint_speed=(1e-3, 1e3),
+            joint_force=(1e-4, 1e3),
+            max_joint_torque=(1e-4, 1e3),
+            max_wrist_speed=(1e-3, 100.0),
+            wrist_force=(1e-3, 1e5),
+            finger_mass=(1e-4, 10.0),
+        )
 
 
 def joint_names(spec: HandSpec) -> list[str]:

@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from pianobot.config import check_ranges
 from pianobot.music.instrument import KeyboardSpec
 
 
@@ -42,6 +43,23 @@ class KeyGeometry:
     def max_angle(self) -> float:
         return math.atan2(self.front_dip, self.white_length)
 
+    def __post_init__(self) -> None:
+        m = (1e-4, 1.0)  # metres
+        check_ranges(
+            self,
+            white_pitch=m,
+            white_width=m,
+            white_length=m,
+            white_height=m,
+            black_width=m,
+            black_length=m,
+            black_rise=m,
+            black_height=m,
+            front_dip=m,
+        )
+        if self.front_dip >= self.white_height or self.black_length >= self.white_length:
+            raise ValueError("front_dip must be below white_height and black keys shorter than white ones")
+
 
 @dataclass(frozen=True)
 class VelocityCurve:
@@ -66,6 +84,11 @@ class VelocityCurve:
         x = (np.clip(np.asarray(velocity, dtype=float), 1, 127) - 1) / 126
         return self.slow * np.exp(x * math.log(self.fast / self.slow))
 
+    def __post_init__(self) -> None:
+        check_ranges(self, slow=(1e-4, 100.0), fast=(1e-4, 100.0))
+        if self.slow >= self.fast:
+            raise ValueError(f"slow {self.slow} must be below fast {self.fast}")
+
 
 @dataclass(frozen=True)
 class KeyboardConfig:
@@ -87,6 +110,19 @@ class KeyboardConfig:
     release_fraction: float = 0.35
     """A sounding key releases when it rises above this fraction of its full travel."""
     curve: VelocityCurve = field(default_factory=VelocityCurve)
+
+    def __post_init__(self) -> None:
+        check_ranges(
+            self,
+            key_mass=(1e-4, 10.0),
+            spring_gain=(0.0, 100.0),
+            spring_torque=(0.0, 100.0),
+            spring_torque_pressed=(0.0, 100.0),
+            strike_fraction=(0.01, 0.99),
+            release_fraction=(0.01, 0.99),
+        )
+        if self.release_fraction >= self.strike_fraction:
+            raise ValueError("release_fraction must be below strike_fraction (a key sounds before it can release)")
 
 
 @dataclass(frozen=True)

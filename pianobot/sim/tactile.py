@@ -22,6 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from pianobot.config import check_ranges
 from pianobot.sim.hand import FingerGeometry
 from pianobot.sim.keyboard import KeyBox
 
@@ -42,6 +43,18 @@ class TactileConfig:
     """Depth (m) that maps to 1.0 in the image."""
     pad_tilt: float = 0.2
     """Angle (rad) by which the gel's normal leans from the fingertip's end towards its pad."""
+
+    def __post_init__(self) -> None:
+        check_ranges(
+            self,
+            rows=(1, 512),
+            cols=(1, 512),
+            gel_length=(1e-4, 0.1),
+            gel_width=(1e-4, 0.1),
+            stiffness=(1e-3, 1e7),
+            max_depth=(1e-5, 0.1),
+            pad_tilt=(-1.6, 1.6),
+        )
 
 
 class TactileRenderer:

@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from pianobot.config import check_ranges
 from pianobot.music.tensor import ScoreSpec
 from pianobot.sim.bullet import p
 from pianobot.sim.hand import HandConfig, hand_urdf, joint_names
@@ -46,8 +47,7 @@ class WorldConfig:
     def __post_init__(self) -> None:
         if self.control not in CONTROL_MODES:
             raise ValueError(f"control must be one of {', '.join(CONTROL_MODES)}; got {self.control!r}")
-        if not 0 < self.control_hz <= self.physics_hz:
-            raise ValueError(f"control_hz {self.control_hz} must be positive and at most physics_hz {self.physics_hz}")
+        check_ranges(self, physics_hz=(1.0, 10_000.0), control_hz=(0.1, self.physics_hz), solver_iterations=(1, 1000))
 
     @property
     def substeps(self) -> int:
