@@ -9,17 +9,22 @@ interface (``reset()``, ``act(observation)``).
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from pianobot.agent import store
 from pianobot.agent.config import SACConfig
-from pianobot.agent.sac import SAC, score_size, vector_size
 from pianobot.config import ConfigError, from_dict
 from pianobot.env.piano import EnvConfig, PianoEnv, idle_pose
 from pianobot.errors import PianobotError
 
+if TYPE_CHECKING:
+    from pianobot.agent.sac import SAC
+
 
 def make_agent(env: PianoEnv, config: SACConfig) -> SAC:
     """A fresh agent for this environment's observation and action spaces."""
+    from pianobot.agent.sac import SAC, score_size, vector_size  # torch: only once an agent is built
+
     space = env.observation_space
     tactile = space["tactile"].shape if "tactile" in space.spaces else None
     score = config.score_input

@@ -23,14 +23,16 @@ import os
 import shutil
 from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-import torch
 from safetensors import SafetensorError
-from safetensors.torch import load_file, save_file
 
 from pianobot.config import to_dict
 from pianobot.errors import PianobotError
 from pianobot.files import atomic_write, move_into_place, temporary_beside
+
+if TYPE_CHECKING:  # torch is imported by the functions that read and write tensors: finding models needs none
+    import torch
 
 FORMAT = 2
 """Version of the model files (manifest layout and tensor names). Older versions are upgraded on
@@ -70,6 +72,8 @@ def package_versions() -> dict[str, str]:
 
 def save_tensors(tensors: dict[str, torch.Tensor], path: Path, metadata: dict[str, str] | None = None) -> None:
     """safetensors file written atomically."""
+    from safetensors.torch import save_file
+
     tmp = temporary_beside(path)
     try:
         save_file(tensors, tmp, metadata=metadata)
@@ -80,6 +84,9 @@ def save_tensors(tensors: dict[str, torch.Tensor], path: Path, metadata: dict[st
 
 
 def load_tensors(path: Path) -> dict[str, torch.Tensor]:
+    """A safetensors file's tensors (nothing is unpickled); a missing or unreadable file is one line."""
+    from safetensors.torch import load_file
+
     try:
         return load_file(path)
     except FileNotFoundError:

@@ -122,6 +122,10 @@ class Motion:
             phase = "idle"  # not over the key yet: wait high
         if phase == "strike" and abs(reach - now_reach) > tuning.aim_tolerance:
             phase = "ready"  # not in front of the key yet: a strike now would hit its edge
+        if phase == "hold" and abs(reach - now_reach) > tuning.aim_tolerance:
+            # the score says the key is held, but the fingertip never got to it (a strike that could
+            # not start in time): pressing on from here would sound its neighbours, or the key late
+            phase = "idle"
         if phase == "idle":
             height = top + tuning.idle_height
         elif phase == "ready":

@@ -234,6 +234,9 @@ class StrikePlanner:
             return
         low = max(layout.wrist_for(f, p.key) for f, p in holds.items()) - tuning.hold_reach
         high = min(layout.wrist_for(f, p.key) for f, p in holds.items()) + tuning.hold_reach
+        # (finger, key, onset, lead): a holding finger's next_lead counts its path to the ready height and
+        # its strike; prepare_steps is added on top for every strike below, as the wrist does not slide
+        # until the fingers that let go have risen (tidying that overlap away cost a melody: measured)
         strikes = [(f, p.key, p.start, p.lead) for f, p in plans.items() if p.phase != "hold"]
         strikes += [
             (f, p.next_note.key, p.next_note.start, p.next_lead) for f, p in holds.items() if p.next_note is not None
