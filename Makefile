@@ -3,7 +3,7 @@ PYTHON ?= python3
 VENV := .venv
 BIN := $(VENV)/bin
 
-.PHONY: demo test install examples clean
+.PHONY: demo test install examples clean sound
 
 $(BIN)/pianobot: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -29,3 +29,12 @@ examples: install
 
 clean:
 	rm -rf $(VENV) *.egg-info
+
+# A piano sound for --wav and --video: the FluidSynth library and a small General MIDI soundfont
+# (Debian packages; needs root). Without them, pianobot synthesises sine waves.
+sound:
+	@if command -v apt-get >/dev/null 2>&1 && [ "$$(id -u)" = 0 ]; then \
+		timeout 300 apt-get install -y -q libfluidsynth3 timgm6mb-soundfont >/dev/null 2>&1 || \
+		(timeout 300 apt-get update -q >/dev/null 2>&1 && timeout 300 apt-get install -y -q libfluidsynth3 timgm6mb-soundfont >/dev/null 2>&1) || \
+		echo "could not install FluidSynth: --wav and --video use sine waves"; \
+	else echo "install libfluidsynth3 and a General MIDI soundfont (e.g. timgm6mb-soundfont) for a piano sound"; fi

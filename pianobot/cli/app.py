@@ -220,6 +220,9 @@ def inspect(
         Path("models"), "--models", help="Model store whose trained phrase split to show (as play uses it)."
     ),
     all_rows: bool = AllRows,
+    json_path: Optional[Path] = typer.Option(
+        None, "--json", help="Also write what inspect found to this JSON file ('-': standard output)."
+    ),
 ):
     """Explain what a file holds (tracks, hands, pedal, range, polyphony, fingering) and whether the hand can play it."""
     from pianobot.cli import display
@@ -231,13 +234,18 @@ def inspect(
 
     keyboard, hand_spec = make_instrument(lowest_note, keys, thumb)
     options = make_options(track, tempo, transpose, fingering, hand_part, split, quantize, refinger)
+    to_stdout = json_path is not None and str(json_path) == "-"
+    if json_path is not None and not to_stdout:
+        check_writable(json_path)
+    console = err if to_stdout else out  # standard output carries the JSON
+    tracks = []
     if song.suffix.lower() != ".txt":
         tracks = midi_io.describe_tracks(song)
         hands = {i: h for h in HANDS for i in hand_tracks(tracks, h)}
-        out.print(display.tracks_table([replace(t, name=said(t.name)) for t in tracks], hands))
+        console.print(display.tracks_table([replace(t, name=said(t.name)) for t in tracks], hands))
         with_notes = [t for t in tracks if t.notes]
         pedal = sum(t.pedal for t in tracks)
-        out.print(
+        console.print(
             f"{len(with_notes)} track(s) with notes"
             + (f"; named for hands: {', '.join(f'{i} {h}' for i, h in sorted(hands.items()))}" if hands else "")
             + (
@@ -247,32 +255,61 @@ def inspect(
             )
         )
         if len(with_notes) > 1 and track is None and hand_part is None:
-            out.print("[yellow]several tracks are merged; play one part with --track N or --hand right|left[/yellow]")
+            console.print(
+                "[yellow]several tracks are merged; play one part with --track N or --hand right|left[/yellow]"
+            )
     piece = load_part(song, options, hand_spec)
     polyphony, _ = piece.max_polyphony()
     given = sum(n.finger is not None for n in piece.notes)
     low, high = min(n.pitch for n in piece.notes), max(n.pitch for n in piece.notes)
     velocities = sorted({n.velocity for n in piece.notes})
-    out.print(
+    console.print(
         f"{len(piece)} notes, {piece.duration:.2f} s at {piece.bpm:.0f} bpm; range {pitch_name(low)}-{pitch_name(high)} "
         f"({high - low} semitones); at most {polyphony} notes at once; velocities {velocities[0]}-{velocities[-1]}; "
         f"{given}/{len(piece)} notes fingered in the file"
     )
     piece, plan = ensure_fingering(piece, keyboard, hand_spec, refinger)
     if plan is not None:
-        out.print(
+        console.print(
             f"fingering planned for fingers {hand_spec.describe()}: wrist travel {plan.travel * 100:.1f} cm in {plan.moves} moves"
         )
         for problem in plan.problems:
-            out.print(f"[yellow]{problem}[/yellow]")
+            console.print(f"[yellow]{problem}[/yellow]")
     check_playable(piece.without_fingering(), keyboard, hand_spec)  # the keyboard and the chords, before the split
     phrases = trained_split(models, piece, phrase_notes)
     rows = None if all_rows else display.ROWS
-    out.print(display.notes_table(piece, phrases, rows))
+    console.print(display.notes_table(piece, phrases, rows))
     missing = {p.index for p in missing_phrases(models, phrases)}
-    out.print(display.phrases_table(phrases, {p.index for p in phrases} - missing, rows))
+    console.print(display.phrases_table(phrases, {p.index for p in phrases} - missing, rows))
     check_playable(piece, keyboard, hand_spec)
-    out.print(f"[green]playable[/green] on {keyboard.describe()} with fingers {hand_spec.describe()}")
+    console.print(f"[green]playable[/green] on {keyboard.describe()} with fingers {hand_spec.describe()}")
+    if json_path is not None:
+        write_json(
+            json_path,
+            {
+                "tracks": [{"index": t.index, "name": t.name, "notes": t.notes, "pedal": t.pedal} for t in tracks],
+                "notes": len(piece),
+                "duration": piece.duration,
+                "bpm": piece.bpm,
+                "range": [pitch_name(low), pitch_name(high)],
+                "polyphony": polyphony,
+                "fingered_in_file": given,
+                "playable": True,
+                "keyboard": keyboard.describe(),
+                "fingers": list(hand_spec.fingers),
+                "phrases": [
+                    {
+                        "index": p.index,
+                        "hash": p.hash,
+                        "notes": [n.name for n in p.notes],
+                        "start": p.start,
+                        "end": p.end,
+                        "trained": p.index not in missing,
+                    }
+                    for p in phrases
+                ],
+            },
+        )
 
 
 @app.command()
@@ -329,31 +366,47 @@ def score(
         None, "--plot", help="Draw both piano rolls with the errors marked to this PNG file."
     ),
     notes: bool = typer.Option(True, "--notes/--no-notes", help="Print the per-note table."),
+    track: Optional[str] = Track,
+    tempo: Optional[float] = Tempo,
+    transpose: int = Transpose,
+    fingering: Optional[Path] = Fingering,
+    hand_part: Optional[str] = Hand,
+    split: str = Split,
+    quantize: Optional[str] = Quantize,
+    thumb: bool = Thumb,
 ):
-    """Compare a performance with its reference: note F1, velocity and timing errors, fingering."""
+    """Compare a performance with its reference: note F1, velocity and timing errors, fingering.
+
+    The reading options apply to the reference, as `play` applied them to the piece it played:
+    `pianobot score out.mid original.mid --hand right --transpose -3` compares like with like."""
     from pianobot.cli import display
     from pianobot.music import midi_io
-    from pianobot.music.load import load_piece
+    from pianobot.music.load import load_part
     from pianobot.music.metrics import compare, plot_report
 
     if not 0 < onset_tolerance <= 1:
         raise PianobotError(f"--onset-tolerance {onset_tolerance}: give seconds between 0 and 1, e.g. 0.05")
     if plot is not None and plot.suffix.lower() != ".png":
         raise PianobotError(f"--plot {plot}: the plot is a PNG image, name the file *.png")
-    for target in (json_path, plot):
+    to_stdout = json_path is not None and str(json_path) == "-"
+    for target in (None if to_stdout else json_path, plot):
         if target is not None:
             check_writable(target)
-    reference_piece = load_piece(reference)
+    console = err if to_stdout else out  # standard output carries the JSON
+    _, hand = make_instrument(pitch_name(KeyboardSpec.lowest), KeyboardSpec.count, thumb)
+    options = make_options(track, tempo, transpose, fingering, hand_part, split, quantize)
+    reference_piece = load_part(reference, options, hand)
     played_piece = midi_io.read_midi(played)
     report = compare(reference_piece, played_piece, onset_tolerance=onset_tolerance)
     tables = display.report_tables(report)
-    display.print_all(out, tables if notes else tables[:1])
+    display.print_all(console, tables if notes else tables[:1])
     if json_path is not None:
-        atomic_write(json_path, json.dumps(report.to_dict(), indent=2) + "\n")
-        out.print(f"figures written to {said(json_path)}")
+        write_json(json_path, report.to_dict())
+        if not to_stdout:
+            console.print(f"figures written to {said(json_path)}")
     if plot is not None:
         plot_report(reference_piece, played_piece, report, plot)
-        out.print(f"piano rolls drawn to {said(plot)}")
+        console.print(f"piano rolls drawn to {said(plot)}")
 
 
 @app.command()
@@ -378,6 +431,12 @@ def play(
     ),
     video: Optional[Path] = typer.Option(None, "--video", help="Also record the performance to this .mp4 file."),
     wav: Optional[Path] = typer.Option(None, "--wav", help="Also synthesise what was played to this .wav file."),
+    soundfont: Optional[Path] = typer.Option(
+        None,
+        "--soundfont",
+        help="A General MIDI .sf2 soundfont for --wav and --video's sound (FluidSynth; default: an installed one, "
+        "else sine waves).",
+    ),
     gui: bool = typer.Option(False, "--gui", help="Show the simulation in a PyBullet window (needs a display)."),
     track: Optional[str] = Track,
     tempo: Optional[float] = Tempo,
@@ -397,7 +456,7 @@ def play(
     from pianobot.cli import display
     from pianobot.music.midi_io import write_midi
     from pianobot.music.phrases import split_phrases
-    from pianobot.perform.audio import write_wav
+    from pianobot.perform.audio import check_soundfont, write_wav
     from pianobot.perform.compose import CompositionalController, missing_phrases, shared_env_config, trained_split
     from pianobot.perform.perform import PLAY_CONFIG, perform, write_video
     from pianobot.sim.hand import HandConfig
@@ -412,6 +471,8 @@ def play(
         raise PianobotError(f"--video {video}: the video is an MP4 file, name it *.mp4")
     if wav is not None and wav.suffix.lower() != ".wav":
         raise PianobotError(f"--wav {wav}: the audio is a WAV file, name it *.wav")
+    if soundfont is not None:
+        check_soundfont(soundfont)
     if gui and not os.environ.get("DISPLAY"):
         raise PianobotError("--gui needs a display (DISPLAY is not set): drop --gui, or use --video to watch it later")
     if controller not in CONTROLLERS:
@@ -490,10 +551,14 @@ def play(
     display.print_all(out, display.report_tables(report))
     out.print(f"performance written to {said(output)}, report to {said(report_path)}")
     if video is not None:
-        write_video(result.frames, video, fps=config.world.control_hz)
-        out.print(f"video written to {said(video)}")
+        import tempfile
+
+        with tempfile.TemporaryDirectory() as scratch:  # the sound, starting with the first frame
+            method = write_wav(result.played, Path(scratch) / "sound.wav", font=soundfont, delay=result.start)
+            write_video(result.frames, video, fps=config.world.control_hz, audio=Path(scratch) / "sound.wav")
+        out.print(f"video written to {said(video)}, with sound ({method})")
     if wav is not None:
-        method = write_wav(result.played, wav)
+        method = write_wav(result.played, wav, font=soundfont)
         out.print(f"audio written to {said(wav)} ({method})")
 
 

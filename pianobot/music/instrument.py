@@ -103,7 +103,13 @@ def check_playable(piece: Piece, keyboard: KeyboardSpec, hand: HandSpec) -> None
     if outside:
         names = ", ".join(n.describe() for n in outside[:4]) + (" ..." if len(outside) > 4 else "")
         shift = suggest_transpose(piece, keyboard)
-        fix = f"use --transpose {shift}" if shift is not None else "the piece spans more than the keyboard"
+        low, high = min(n.pitch for n in piece.notes), max(n.pitch for n in piece.notes)
+        fix = (
+            f"use --transpose {shift}"
+            if shift is not None
+            else f"the piece spans {pitch_name(low)}-{pitch_name(high)}, more than the keyboard: if it holds both "
+            "hands' parts, play one with --hand right (or --hand left)"
+        )
         raise PianobotError(
             f"{len(outside)} note(s) outside the keyboard {keyboard.describe()}: {names}; "
             f"{fix}, or widen the keyboard with --lowest-note / --keys"

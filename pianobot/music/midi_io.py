@@ -298,8 +298,9 @@ def read_midi(
         step = max(1, round(midi.ticks_per_beat * 4 * grid))
         snap = lambda tick: round(tick / step) * step  # noqa: E731
     notes: list[Note] = []
-    for index in tracks if tracks is not None else _select_tracks(midi, track, path):
-        raw, fingering = _track_notes(midi.tracks[index], index, seconds, path)
+    for index, raw, fingering in _parts(
+        midi, tracks if tracks is not None else _select_tracks(midi, track, path), seconds, path
+    ):
         if grid is not None:
             raw = [(snap(on), max(snap(off), snap(on) + step), pitch, vel) for on, off, pitch, vel in raw]
             fingering = {snap(tick): fingers for tick, fingers in fingering.items()}
@@ -339,6 +340,27 @@ def read_midi(
                 continue
             notes.append(Note(onset=onset, pitch=pitch, offset=offset, velocity=vel, finger=finger))
     return Piece(tuple(_resolve_overlaps(notes)), bpm=nominal)
+
+
+def _parts(midi: mido.MidiFile, chosen: list[int], seconds, path: Path) -> list[tuple[int, list, dict]]:
+    """(track index, notes, fingering by tick) of the chosen tracks.
+
+    Fingering normally sits in the notes' own track. Some writers move every lyric to the first
+    track, away from the notes (pretty_midi does): when lyric-only tracks hold fingering and no
+    chosen track has its own, the chosen tracks' notes are read as one part with that fingering."""
+    parts = [(index, *_track_notes(midi.tracks[index], index, seconds, path)) for index in chosen]
+    if any(fingering for _, raw, fingering in parts if raw):
+        return parts
+    lyrics: dict[int, list[int]] = {}
+    for index, track in enumerate(midi.tracks):
+        raw, fingering = _track_notes(track, index, seconds, path)
+        if not raw:
+            lyrics.update(fingering)
+    if not lyrics:
+        return parts
+    noted = [(index, raw) for index, raw, _ in parts if raw]
+    merged = [item for _, raw in noted for item in raw]
+    return [(noted[0][0] if len(noted) == 1 else 0, merged, lyrics)] if noted else parts
 
 
 def _resolve_overlaps(notes: list[Note]) -> list[Note]:

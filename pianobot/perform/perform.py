@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import contextlib
 import errno
+import os
 import shutil
 from pathlib import Path
 from typing import Callable
@@ -16,6 +17,7 @@ from typing import Callable
 import numpy as np
 
 from pianobot.env.piano import EnvConfig, PianoEnv
+from pianobot.errors import one_line
 from pianobot.files import check_writable, move_into_place, not_written, temporary_beside
 from pianobot.music.piece import Piece
 from pianobot.perform.controllers import make_controller
@@ -46,8 +48,9 @@ def perform(
         env.close()
 
 
-def write_video(frames: list[np.ndarray], path: str | Path, fps: float) -> Path:
-    """Encode frames to an MP4 file (imageio with its ffmpeg plugin), written atomically."""
+def write_video(frames: list[np.ndarray], path: str | Path, fps: float, audio: Path | None = None) -> Path:
+    """Encode frames to an MP4 file (imageio with its ffmpeg plugin), written atomically; with
+    ``audio`` (a WAV file starting with the first frame), the video carries it as an AAC track."""
     import imageio.v2 as imageio  # only needed for videos
 
     path = check_writable(path)
@@ -62,6 +65,8 @@ def write_video(frames: list[np.ndarray], path: str | Path, fps: float) -> Path:
         if frames and not _complete_mp4(Path(tmp)):  # ffmpeg may stop short (a full disk) without an error
             full = shutil.disk_usage(path.parent).free < 1_000_000
             raise OSError(errno.ENOSPC if full else errno.EIO, "the encoder stopped before the video was complete")
+        if audio is not None:
+            _add_audio(Path(tmp), audio)
         move_into_place(tmp, path)
     except BaseException as e:
         if tmp is not None:
@@ -71,6 +76,24 @@ def write_video(frames: list[np.ndarray], path: str | Path, fps: float) -> Path:
             raise not_written(path, e if isinstance(e, OSError) else OSError(None, str(e))) from None
         raise
     return path
+
+
+def _add_audio(video: Path, audio: Path) -> None:
+    """Mux ``audio`` into the MP4 file ``video`` in place (ffmpeg from imageio-ffmpeg; the frames are copied)."""
+    import subprocess
+
+    import imageio_ffmpeg
+
+    muxed = video.with_name(video.name + ".av.mp4")
+    command = [imageio_ffmpeg.get_ffmpeg_exe(), "-y", "-loglevel", "error", "-i", str(video), "-i", str(audio),
+               "-map", "0:v", "-map", "1:a", "-c:v", "copy", "-c:a", "aac", str(muxed)]  # fmt: skip
+    try:
+        done = subprocess.run(command, capture_output=True, text=True)
+        if done.returncode != 0 or not _complete_mp4(muxed):
+            raise OSError(errno.EIO, f"ffmpeg could not add the sound ({one_line(done.stderr.strip())[:200]})")
+        os.replace(muxed, video)
+    finally:
+        muxed.unlink(missing_ok=True)
 
 
 def _complete_mp4(path: Path) -> bool:

@@ -37,6 +37,8 @@ class Rollout:
     steps: int
     frames: list[np.ndarray] | None = None
     """Rendered images, first before the first step, when asked for."""
+    start: float = 0.0
+    """Simulated time (s) of the piece's time 0: the lead-in before it (the video's first frame is at 0)."""
 
     def report(self) -> Report:
         """Note F1, velocity and timing errors of ``played`` against ``reference``."""
@@ -71,4 +73,4 @@ def rollout(
             break
     reference = info["piece"]
     played = recorder.piece(end=env.world.time, start=env.score_start, bpm=reference.bpm)
-    return Rollout(reference, played, total, steps, frames)
+    return Rollout(reference, played, total, steps, frames, env.score_start)
