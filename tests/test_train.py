@@ -15,7 +15,7 @@ from pianobot.errors import PianobotError
 from pianobot.learn.config import TrainConfig
 from pianobot.learn.explore import Explorer
 from pianobot.learn.jobs import phrase_jobs, plan_jobs
-from pianobot.learn.log import LOG_FILE, PLOT_FILE
+from pianobot.learn.log import LOG_FILE, PLOT_FILE, TENSORBOARD_DIR
 from pianobot.learn.train import Progress, make_env, train_policy
 from pianobot.music.phrases import split_phrases
 from pianobot.music.piece import Note, Piece
@@ -450,7 +450,8 @@ def test_a_kill_at_any_point_of_a_checkpoint_write_loses_at_most_one_interval(tm
     )
     assert a.keys() == b.keys() and all(torch.equal(a[k], b[k]) for k in a)
     left = sorted(p.name for p in (tmp_path / "killed").iterdir())
-    assert left == sorted([store.LOCK_FILE, store.MANIFEST_FILE, store.POLICY_FILE, LOG_FILE, PLOT_FILE])
+    expected = [store.LOCK_FILE, store.MANIFEST_FILE, store.POLICY_FILE, LOG_FILE, PLOT_FILE]
+    assert left == sorted(expected + ([TENSORBOARD_DIR] if (tmp_path / "killed" / TENSORBOARD_DIR).is_dir() else []))
     assert _log_without_time(tmp_path / "killed") == _log_without_time(tmp_path / "straight")  # as one run
 
 
@@ -473,3 +474,15 @@ def test_two_runs_cannot_train_into_one_folder(tmp_path):
             train_policy(PHRASE, small(), tmp_path / "m")
     train_policy(PHRASE, small(steps=80), tmp_path / "m")  # free again once the first is done
     assert store.is_trained(tmp_path / "m")
+
+
+def test_training_writes_tensorboard_events_when_it_is_installed(tmp_path):
+    pytest.importorskip("tensorboard")
+    from tensorboard.backend.event_processing.event_accumulator import EventAccumulator
+
+    train_policy(PHRASE, small(steps=140, eval_every=70), tmp_path / "m")
+    events = EventAccumulator(str(tmp_path / "m" / "tensorboard"))
+    events.Reload()
+    scalars = events.Tags()["scalars"]
+    assert "return" in scalars and "critic_loss" in scalars and "eval/f1" in scalars
+    assert [e.step for e in events.Scalars("return")] == [35, 70, 105, 140]
