@@ -2,6 +2,11 @@
 
 from __future__ import annotations
 
+import os
+import signal
+import tempfile
+from contextlib import contextmanager
+
 import mido
 import pytest
 
@@ -71,3 +76,31 @@ def one_torch_thread():
         return
     torch.set_num_threads(1)
     yield
+
+
+@contextmanager
+def within(seconds: int):
+    """Fail instead of hanging (a FIFO read without care waits for a writer forever)."""
+
+    def stop(*_):
+        raise TimeoutError(f"still running after {seconds} s")
+
+    old = signal.signal(signal.SIGALRM, stop)
+    signal.alarm(seconds)
+    try:
+        yield
+    finally:
+        signal.alarm(0)
+        signal.signal(signal.SIGALRM, old)
+
+
+def fail_in(folder, error):
+    """A mkstemp that fails with ``error`` in ``folder`` (as a read-only or full disk would) and works elsewhere."""
+    real = tempfile.mkstemp
+
+    def mkstemp(*args, dir=None, **kwargs):
+        if dir is not None and os.path.samefile(dir, folder):
+            raise OSError(error, os.strerror(error))
+        return real(*args, dir=dir, **kwargs)
+
+    return mkstemp

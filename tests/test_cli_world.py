@@ -78,43 +78,29 @@ def streams(video: Path) -> str:
     return subprocess.run([imageio_ffmpeg.get_ffmpeg_exe(), "-i", str(video)], capture_output=True, text=True).stderr
 
 
+def play_one_note(tmp_path, *extra):
+    return run("play", EXAMPLES / "one-note.mid", "-o", tmp_path / "o.mid", "--controller", "scripted", *extra)
+
+
 def test_the_video_carries_the_sound(tmp_path):
     from pianobot.perform.audio import has_fluidsynth
 
-    args = (
-        "play",
-        EXAMPLES / "one-note.mid",
-        "-o",
-        tmp_path / "o.mid",
-        "--controller",
-        "scripted",
-        "--video",
-        tmp_path / "v.mp4",
-    )
-    result = run(*args)
+    result = play_one_note(tmp_path, "--video", tmp_path / "v.mp4")
     assert result.exit_code == 0, result.output
     info = streams(tmp_path / "v.mp4")
     assert "Video: h264" in info and "Audio: aac" in info
     font = Path("/usr/share/sounds/sf2/TimGM6mb.sf2")
     if has_fluidsynth() and font.exists():  # `make sound` installs both
-        result = run(*args, "--soundfont", font, "--wav", tmp_path / "s.wav")
+        result = play_one_note(
+            tmp_path, "--video", tmp_path / "v.mp4", "--soundfont", font, "--wav", tmp_path / "s.wav"
+        )
         assert result.exit_code == 0 and "FluidSynth with TimGM6mb.sf2" in result.output, result.output
 
 
 def test_a_soundfont_that_cannot_be_used_is_one_line(tmp_path):
-    base = (
-        "play",
-        EXAMPLES / "one-note.mid",
-        "-o",
-        tmp_path / "o.mid",
-        "--controller",
-        "scripted",
-        "--wav",
-        tmp_path / "s.wav",
-    )
-    missing = run(*base, "--soundfont", tmp_path / "none.sf2")
+    missing = play_one_note(tmp_path, "--wav", tmp_path / "s.wav", "--soundfont", tmp_path / "none.sf2")
     assert missing.exit_code == 2 and "does not exist" in missing.stderr
     (tmp_path / "fake.sf2").write_bytes(b"not a soundfont at all")
-    fake = run(*base, "--soundfont", tmp_path / "fake.sf2")
+    fake = play_one_note(tmp_path, "--wav", tmp_path / "s.wav", "--soundfont", tmp_path / "fake.sf2")
     assert fake.exit_code == 2 and "not a SoundFont 2" in fake.stderr
     assert not (tmp_path / "o.mid").exists()  # refused before playing

@@ -3,31 +3,13 @@ that cannot be read or written, and a failed write never changes an existing fil
 
 import errno
 import os
-import signal
-import tempfile
-from contextlib import contextmanager
 
 import pytest
+from conftest import fail_in, within
 
 from pianobot import files
 from pianobot.errors import PianobotError
 from pianobot.files import atomic_write, check_writable, read_input
-
-
-@contextmanager
-def within(seconds: int):
-    """Fail instead of hanging (a FIFO read without care waits for a writer forever)."""
-
-    def stop(*_):
-        raise TimeoutError(f"still running after {seconds} s")
-
-    old = signal.signal(signal.SIGALRM, stop)
-    signal.alarm(seconds)
-    try:
-        yield
-    finally:
-        signal.alarm(0)
-        signal.signal(signal.SIGALRM, old)
 
 
 def test_only_regular_files_are_read_and_never_more_than_the_limit(tmp_path):
@@ -50,18 +32,6 @@ def test_only_regular_files_are_read_and_never_more_than_the_limit(tmp_path):
         ):
             with pytest.raises(PianobotError, match=words):
                 read_input(path, limit=1000, kind=".mid file")
-
-
-def fail_in(folder, error):
-    """A mkstemp that fails with ``error`` in ``folder`` (as a read-only or full disk would) and works elsewhere."""
-    real = tempfile.mkstemp
-
-    def mkstemp(*args, dir=None, **kwargs):
-        if dir is not None and os.path.samefile(dir, folder):
-            raise OSError(error, os.strerror(error))
-        return real(*args, dir=dir, **kwargs)
-
-    return mkstemp
 
 
 @pytest.mark.parametrize(

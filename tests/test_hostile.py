@@ -4,14 +4,11 @@ file really holds, and a failed run never changes an existing output file."""
 
 import errno
 import os
-import signal
-import tempfile
-from contextlib import contextmanager
 from pathlib import Path
 
 import mido
 import pytest
-from conftest import lyric, midi_file, off, on
+from conftest import fail_in, lyric, midi_file, off, on, within
 from typer.testing import CliRunner
 
 from pianobot import files
@@ -37,22 +34,6 @@ def assert_one_line_error(result, *words):
     for word in words:
         assert word in errors[0], errors[0]
     return errors[0]
-
-
-@contextmanager
-def within(seconds: int):
-    """Fail instead of hanging."""
-
-    def stop(*_):
-        raise TimeoutError(f"still running after {seconds} s")
-
-    old = signal.signal(signal.SIGALRM, stop)
-    signal.alarm(seconds)
-    try:
-        yield
-    finally:
-        signal.alarm(0)
-        signal.signal(signal.SIGALRM, old)
 
 
 @pytest.fixture
@@ -148,15 +129,6 @@ def test_symbolic_link_loops_fifos_and_devices_are_one_line(tmp_path, no_simulat
 
 
 # -- 5. output folders that cannot be written --------------------------------------------------
-def fail_in(folder, error):
-    real = tempfile.mkstemp
-
-    def mkstemp(*args, dir=None, **kwargs):
-        if dir is not None and os.path.samefile(dir, folder):
-            raise OSError(error, os.strerror(error))
-        return real(*args, dir=dir, **kwargs)
-
-    return mkstemp
 
 
 def output_commands(song, folder, other):
