@@ -104,3 +104,15 @@ def test_a_soundfont_that_cannot_be_used_is_one_line(tmp_path):
     fake = play_one_note(tmp_path, "--wav", tmp_path / "s.wav", "--soundfont", tmp_path / "fake.sf2")
     assert fake.exit_code == 2 and "not a SoundFont 2" in fake.stderr
     assert not (tmp_path / "o.mid").exists()  # refused before playing
+
+
+def test_long_tables_stop_at_100_rows_unless_all_is_asked(tmp_path):
+    notes = tuple(Note(i * 0.25, 60 + (i % 5) * 2, i * 0.25 + 0.2, 80, 2 + i % 3) for i in range(150))
+    song = write_midi(Piece(notes, bpm=120), tmp_path / "long.mid")
+    short = run("inspect", song)
+    assert short.exit_code == 0, short.output
+    assert "the first 100 of 150 notes; --all shows every one" in short.output
+    full = run("inspect", song, "--all")
+    assert full.exit_code == 0 and "--all shows" not in full.output and " 149 " in full.output
+    fingered = run("finger", song, "-o", tmp_path / "f.mid", "--all")
+    assert fingered.exit_code == 0 and " 149 " in fingered.output
