@@ -26,14 +26,19 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 from itertools import combinations
+from typing import Sequence
 
 import numpy as np
 
 from pianobot.errors import PianobotError
 from pianobot.music.instrument import HandSpec, KeyboardSpec, check_playable
-from pianobot.music.piece import Note, Piece
+from pianobot.music.piece import Note, Piece, pitch_name
+from pianobot.pianist.layout import KeyLayout
+from pianobot.pianist.strikes import StrikePlanner
+from pianobot.pianist.tuning import PianistTuning
 from pianobot.sim.hand import FINGER_BASE_X, HandConfig
 from pianobot.sim.keyboard import KeyboardConfig, key_boxes, keyboard_width, strike_points
+from pianobot.sim.world import WorldConfig
 
 REACH_FRACTION = 0.75
 """Share of the abduction limit's sideways reach the planner uses (the rest is margin for aim)."""
@@ -74,6 +79,21 @@ class FingeringPlan:
     """Notes this hand cannot play as written at this tempo, and why."""
 
 
+@dataclass(frozen=True, eq=False)
+class Reach:
+    """Where the hand can be once it has played ``chord``: for every state (finger assignment x
+    wrist position, as :class:`Planner` numbers them) the least cost of getting there, at least
+    :data:`_INFEASIBLE` where it cannot. Made by :meth:`Planner.place` and :meth:`Planner.follow`."""
+
+    chord: tuple[Note, ...]
+    cost: np.ndarray
+
+    @property
+    def possible(self) -> bool:
+        """Whether the hand can play the chord at all, after what came before."""
+        return bool(self.cost.min() < _INFEASIBLE)
+
+
 class Planner:
     """Fingering for one hand on one keyboard."""
 
@@ -91,12 +111,16 @@ class Planner:
         )
         self.pitch = keyboard.geometry.white_pitch
         self.grid = np.arange(0.0, keyboard_width(keyboard) + 1e-9, self.pitch / GRID)
+        world = WorldConfig(keyboard=keyboard, hand=hand)
+        self.strikes = StrikePlanner(world, KeyLayout(world), PianistTuning())
+        """The scripted pianist's strike planning: how soon a finger can strike again."""
 
     # -- one chord ---------------------------------------------------------------------------
-    def _states(self, chord: tuple[Note, ...]) -> tuple[list[tuple[int, ...]], np.ndarray, np.ndarray]:
-        """Finger assignments (pitch order = finger order), and per assignment and wrist
-        position: the stretch cost (inf where a finger cannot reach its key) and the offsets."""
-        keys = [self.spec.index(n.pitch) for n in chord]
+    def _states(self, chord: Sequence[Note]) -> tuple[list[tuple[int, ...]], list[int], np.ndarray]:
+        """Finger assignments (pitch order = finger order), the chord's keys, and per assignment
+        and wrist position the stretch cost (at least :data:`_INFEASIBLE` where a finger cannot
+        reach its key)."""
+        keys = [self.spec.index(n.pitch) for n in sorted(chord, key=lambda n: n.pitch)]
         assignments = list(combinations(self.fingers, len(chord)))
         cost = np.zeros((len(assignments), len(self.grid)))
         for a, fingers in enumerate(assignments):
@@ -106,10 +130,9 @@ class Planner:
         return assignments, keys, cost
 
     def _transition(
-        self, prev: tuple, chord: tuple, fingers_prev: tuple, fingers: tuple, held: list[bool], time: float
+        self, prev_keys: list[int], keys: list[int], fingers_prev: tuple, fingers: tuple, held: list[bool], time: float
     ) -> np.ndarray:
         """Cost (W_prev x W) of going from one state's fingers to the next's, for every pair of wrist positions."""
-        (_, prev_keys), (_, keys) = prev, chord
         move = self.grid[None, :] - self.grid[:, None]  # wrist displacement, rows: from, columns: to
         cost = np.abs(move) / self.pitch + MOVE_COST * (np.abs(move) > 1e-9)
         for key_p, finger_p, is_held in zip(prev_keys, fingers_prev, held):
@@ -128,6 +151,64 @@ class Planner:
                 cost = cost + np.where(np.sign(finger - finger_p) * relative >= TIP_GAP, 0.0, _INFEASIBLE)
         return cost
 
+    # -- from chord to chord: the queries behind plan() -----------------------------------
+    def place(self, chord: Sequence[Note]) -> Reach:
+        """Every way of playing ``chord`` on its own: ``place(chord).possible`` says whether one
+        hand position reaches all its notes (distinct fingers in pitch order)."""
+        _, _, cost = self._states(chord)
+        return Reach(tuple(chord), cost.ravel())
+
+    def follow(self, before: Reach, chord: Sequence[Note], in_time: bool = False) -> Reach:
+        """Every way of playing ``chord`` right after ``before``'s chord, holding those of its notes
+        that still sound at ``chord``'s onset. ``possible`` is False when no fingering gets there
+        (a held note out of reach, fingertips that would cross); with ``in_time``, also when the
+        wrist cannot make the move in the time between the onsets."""
+        return self._follow(before, chord, in_time)[0]
+
+    def _follow(self, before: Reach, chord: Sequence[Note], in_time: bool) -> tuple[Reach, np.ndarray]:
+        """:meth:`follow`, and for each state the state before it on the cheapest way there."""
+        prev_chord, chord = before.chord, tuple(chord)
+        p_assign, p_keys, _ = self._states(prev_chord)
+        assignments, keys, local = self._states(chord)
+        onset = chord[0].onset
+        held = [n.offset > onset + 1e-6 for n in sorted(prev_chord, key=lambda n: n.pitch)]
+        velocities = [n.velocity for n in sorted(chord, key=lambda n: n.pitch)]
+        time = onset - prev_chord[0].onset
+        slow = _INFEASIBLE if in_time else _TOO_FAST
+        move = np.abs(self.grid[None, :] - self.grid[:, None])
+        too_fast = np.where(move > self._wrist_limit(time) + 1e-9, slow, 0.0)
+        blocks = np.empty((len(p_assign), len(self.grid), len(assignments), len(self.grid)))
+        for a_p, f_p in enumerate(p_assign):
+            for a, f in enumerate(assignments):
+                hop = slow if self._fast_hop(p_keys, f_p, keys, f, time, velocities) else 0.0
+                blocks[a_p, :, a, :] = self._transition(p_keys, keys, f_p, f, held, time) + too_fast + hop
+        step = before.cost[:, None] + blocks.reshape(len(before.cost), -1)
+        best = np.argmin(step, axis=0)
+        return Reach(chord, step[best, np.arange(step.shape[1])] + local.ravel()), best
+
+    def _wrist_limit(self, time: float) -> float:
+        """Farthest the wrist can move (m) between two onsets ``time`` s apart."""
+        return self.hand.max_wrist_speed * max(0.0, time - SETTLE_TIME)
+
+    def _fast_hop(
+        self,
+        prev_keys: list[int],
+        fingers_prev: tuple,
+        keys: list[int],
+        fingers: tuple,
+        time: float,
+        velocities: Sequence[int],
+    ) -> str:
+        """'FINGER from KEY to KEY' where a finger must strike again (another key, or the same one)
+        sooner than the scripted pianist can let go, move over, settle and strike at the new note's
+        velocity (:meth:`~pianobot.pianist.strikes.StrikePlanner.hop_steps`), else ''."""
+        for key_p, finger_p in zip(prev_keys, fingers_prev):
+            for key, finger, velocity in zip(keys, fingers, velocities):
+                if finger == finger_p and time < self.strikes.hop_steps(key_p, key, velocity) * self.strikes.dt - 1e-9:
+                    low = self.spec.lowest
+                    return f"finger {finger} must go from {pitch_name(low + key_p)} to {pitch_name(low + key)}"
+        return ""
+
     # -- the whole piece ---------------------------------------------------------------------
     def plan(self, piece: Piece) -> FingeringPlan:
         chords = piece.chords()
@@ -137,42 +218,25 @@ class Planner:
                 f"{len(too_many)} notes start together at {too_many[0].onset:.3f} s ({', '.join(n.name for n in too_many)}) "
                 f"but the hand has {len(self.fingers)} fingers: drop notes from that chord (e.g. with --track) or enable the thumb with --thumb"
             )
-        states, totals, back = [], [], []
+        reaches, back = [], [None]
         for i, chord in enumerate(chords):
-            assignments, keys, local = self._states(chord)
-            if np.all(local >= _INFEASIBLE):
+            if not self.place(chord).possible:
+                keys = [self.spec.index(n.pitch) for n in chord]
                 span = abs(self.key_x[keys[-1]] - self.key_x[keys[0]]) * 100
                 raise PianobotError(
                     f"the chord {' '.join(n.name for n in chord)} at {chord[0].onset:.3f} s spans {span:.1f} cm, "
                     "more than this hand reaches: drop a note from it or transpose part of it"
                 )
             if i == 0:
-                total = local.ravel()
-                back.append(None)
+                reaches.append(self.place(chord))
             else:
-                p_assign, p_keys = states[-1][0], states[-1][1]
-                prev_chord = chords[i - 1]
-                onset = chord[0].onset
-                held = [n.offset > onset + 1e-6 for n in prev_chord]
-                time = onset - prev_chord[0].onset
-                limit = self.hand.max_wrist_speed * max(0.0, time - SETTLE_TIME)
-                too_fast = np.where(np.abs(self.grid[None, :] - self.grid[:, None]) <= limit + 1e-9, 0.0, _TOO_FAST)
-                blocks = np.empty((len(p_assign), len(self.grid), len(assignments), len(self.grid)))
-                for a_p, f_p in enumerate(p_assign):
-                    for a, f in enumerate(assignments):
-                        blocks[a_p, :, a, :] = (
-                            self._transition((prev_chord, p_keys), (chord, keys), f_p, f, held, time) + too_fast
-                        )
-                step = totals[-1][:, None] + blocks.reshape(len(totals[-1]), -1)
-                best = np.argmin(step, axis=0)
-                total = step[best, np.arange(step.shape[1])] + local.ravel()
+                reach, best = self._follow(reaches[-1], chord, in_time=False)
+                reaches.append(reach)
                 back.append(best)
-            states.append((assignments, keys))
-            totals.append(total)
 
-        index = int(np.argmin(totals[-1]))
-        if totals[-1][index] >= _INFEASIBLE:
-            i = next(i for i, total in enumerate(totals) if total.min() >= _INFEASIBLE)
+        index = int(np.argmin(reaches[-1].cost))
+        if not reaches[-1].possible:
+            i = next(i for i, reach in enumerate(reaches) if not reach.possible)
             raise PianobotError(
                 f"no fingering lets this hand go from {' '.join(n.name for n in chords[i - 1])} to "
                 f"{' '.join(n.name for n in chords[i])} at {chords[i][0].onset:.3f} s: the notes held there cross or lie "
@@ -184,20 +248,27 @@ class Planner:
         path.reverse()
 
         fingers: list[int] = []  # piece.chords() groups piece.notes in order, each chord by pitch
-        wrist = []
-        for (assignments, _), state in zip(states, path):
+        wrist, chosen = [], []
+        for chord, state in zip(chords, path):
             a, w = divmod(state, len(self.grid))
+            assignments, keys, _ = self._states(chord)
             wrist.append(float(self.grid[w]))
+            chosen.append((keys, assignments[a]))
             fingers.extend(assignments[a])
         problems = []
         for i in range(1, len(chords)):
             time = chords[i][0].onset - chords[i - 1][0].onset
             distance = abs(wrist[i] - wrist[i - 1])
-            if distance > self.hand.max_wrist_speed * max(0.0, time - SETTLE_TIME) + 1e-9:
+            velocities = [n.velocity for n in sorted(chords[i], key=lambda n: n.pitch)]
+            hop = self._fast_hop(*chosen[i - 1], *chosen[i], time, velocities)
+            if distance > self._wrist_limit(time) + 1e-9 or hop:
+                what = (
+                    f"{hop} in {time:.3f} s" if hop else f"the wrist must move {distance * 100:.1f} cm in {time:.3f} s"
+                )
                 problems.append(
                     f"{' '.join(n.name for n in chords[i - 1])} at {chords[i - 1][0].onset:.3f} s -> "
-                    f"{' '.join(n.name for n in chords[i])} at {chords[i][0].onset:.3f} s: the wrist must move "
-                    f"{distance * 100:.1f} cm in {time:.3f} s, faster than this hand can (slow down with --tempo)"
+                    f"{' '.join(n.name for n in chords[i])} at {chords[i][0].onset:.3f} s: {what}, "
+                    "faster than this hand can (slow down with --tempo)"
                 )
         moves = np.abs(np.diff(wrist)) > 1e-9
         fingered = piece.with_fingers(fingers)

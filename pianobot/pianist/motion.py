@@ -150,11 +150,14 @@ class Motion:
         positioning moves in short straight steps, so the tip never dips on the way."""
         hand, geometry, layout, tuning = self.hand, self.geometry, self.layout, self.tuning
         rise_here = finger_ik(geometry, now_reach, hand.palm_height - height) is not None
-        if height > now_height + tuning.path_tolerance and rise_here:
-            reach = now_reach if abs(reach - now_reach) > tuning.path_tolerance else reach
+        if height > now_height + tuning.path_tolerance:
+            if rise_here:
+                reach = now_reach if abs(reach - now_reach) > tuning.path_tolerance else reach
             over = layout.black_rise if now_reach * math.cos(q[0]) > hand.palm_y - layout.black_band_y else 0.0
             if now_height < over + tuning.clearance:
-                abduction = float(q[0])  # straight up out of the key before swinging sideways
+                # straight up out of the key before swinging sideways (also where the finger cannot
+                # rise that high at this reach: swinging at the keys' level strikes the neighbour)
+                abduction = float(q[0])
         elif phase not in ("strike", "hold") and abs(reach - now_reach) > tuning.path_tolerance:
             # (a strike is in front of its key within aim_tolerance: it corrects the rest on the way down)
             across = max(height, now_height)  # (a held key stays pressed while the wrist slides)

@@ -168,6 +168,19 @@ class StrikePlanner:
             path = (top - tip.height) + across + (top - goal_height)
         return math.ceil(path / tuning.max_move - 1e-9) + tuning.settle_steps
 
+    def hop_steps(self, from_key: int, to_key: int, velocity: float) -> int:
+        """Fewest control steps from one note's onset to the next note's onset for the same finger:
+        ``from_key`` sounds in its onset's step and is let go at the next, the fingertip goes from the
+        pressed key to its ready height over ``to_key`` (:meth:`positioning_steps`, at least
+        ``prepare_steps``), then strikes at ``velocity``. ``to_key`` may be ``from_key`` (a repeat)."""
+        layout = self.layout
+        pressed = Tip(
+            layout.key_top[from_key] - self.strike_depth(from_key) - self.tuning.hold_depth_margin,
+            layout.contact_y(from_key),
+        )
+        height, lead = self.ready(Run(to_key, 0, 1, velocity))
+        return 1 + max(self.tuning.prepare_steps, self.positioning_steps(pressed, to_key, height)) + lead
+
     # -- plans ----------------------------------------------------------------------------------
     def _plan_finger(self, score: np.ndarray, slot: int, previous_row: np.ndarray | None, tip: Tip) -> Plan | None:
         """What one finger should do now, or None when it has nothing to do (``tip``: where its tip is)."""

@@ -52,9 +52,9 @@ class PianistTuning:
     band_tolerance: float = 0.0002
     """A fingertip this little under the safe height for crossing counts as over it (m).
     One that rose towards it could stop a hair short of it and wait there for ever."""
-    max_move: float = 0.008
+    max_move: float = 0.016
     """Longest fingertip move in one step when positioning; strikes are not limited (m per control step)."""
-    max_joint_move: float = 0.3
+    max_joint_move: float = 0.6
     """Largest change of a flexion joint's angle in one step when positioning (rad per control step)."""
     hold_slide: float = 0.008
     """Farthest the wrist may move in one step while a finger holds a key (m per control step)."""

@@ -35,8 +35,9 @@ class WorldConfig:
     """Physics steps per second (500 Hz cost twice as much and showed no benefit)."""
     control_hz: float = ScoreSpec.control_hz
     """Control steps per second; each runs physics_hz / control_hz physics steps (the score's rate)."""
-    solver_iterations: int = 15
-    """Constraint solver iterations per physics step (50 is PyBullet's default; 15 is twice as fast and keys stay stable)."""
+    solver_iterations: int = 50
+    """Constraint solver iterations per physics step (PyBullet's default). At 15 the env steps 1.5x
+    as fast, but the last finger's joints do not follow a large commanded move (docs/simulator.md)."""
     control: str = "velocity"
     """Finger joint control: 'velocity' (action = joint speed) or 'torque' (action = joint torque)."""
     discrete_wrist: bool = False
