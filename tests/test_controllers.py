@@ -9,13 +9,14 @@ import pytest
 from pianobot.env.piano import EnvConfig
 from pianobot.errors import PianobotWarning
 from pianobot.music.instrument import HandSpec, KeyboardSpec
-from pianobot.music.load import LoadOptions, load_part, load_piece
+from pianobot.music.load import LoadOptions, load_piece
 from pianobot.music.metrics import compare
 from pianobot.music.tasks import TASKS, make_task
 from pianobot.perform.controllers import RandomController
 from pianobot.perform.perform import perform
 from pianobot.perform.rollout import rollout
 from pianobot.pianist.fingering import ensure_fingering
+from pianobot.pianist.reduce import load_for_hand
 from pianobot.pianist.scripted import ScriptedPianist
 from pianobot.sim.world import WorldConfig
 
@@ -24,11 +25,13 @@ EXAMPLES = sorted((Path(__file__).parent.parent / "examples" / "midi").glob("*.m
 
 @pytest.mark.parametrize("path", EXAMPLES, ids=lambda p: p.stem)
 def test_scripted_pianist_plays_every_example(path):
-    """The performance-style file is read as `--hand right` would, and fingered by the planner."""
+    """The performance-style files are read (and reduced) as `--hand right` would, and fingered by the planner."""
     options = LoadOptions(hand="right") if "performed" in path.stem else LoadOptions()
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", PianobotWarning)
-        reference, _ = ensure_fingering(load_part(path, options, HandSpec()), KeyboardSpec(), HandSpec())
+        reference, _ = ensure_fingering(
+            load_for_hand(path, options, KeyboardSpec(), HandSpec()), KeyboardSpec(), HandSpec()
+        )
     report = compare(reference, perform(reference, "scripted", seed=1).played)
     assert report.f1 >= 0.95, [(r.reference, r.played) for r in report.rows if r.reference is None or r.played is None]
     assert report.velocity_mae <= 10

@@ -95,6 +95,21 @@ def test_too_fast_a_leap_is_reported_with_its_notes():
     assert not plan_fingering(melody("C4 B5 C4", beat=1.0)).problems
 
 
+def test_the_planner_answers_what_the_hand_can_reach_and_how_fast():
+    """The queries the reduction of a part (pianobot/pianist/reduce.py) asks."""
+    planner = Planner()
+    assert planner.place([Note(0, 60, 1), Note(0, 64, 1), Note(0, 67, 1)]).possible  # C4 E4 G4
+    assert not planner.place([Note(0, 60, 1), Note(0, 72, 1)]).possible  # C4 C5: 16.4 cm
+    held = planner.place([Note(0, 64, 2), Note(0, 72, 0.5)])  # E4 held on ...
+    assert not planner.follow(held, [Note(0.5, 79, 1)]).possible  # ... under the leap to G5
+    let_go = planner.place([Note(0, 64, 0.5), Note(0, 72, 0.5)])
+    assert planner.follow(let_go, [Note(0.5, 79, 1)]).possible
+    start = planner.place([Note(0, 60, 0.15)])
+    assert planner.follow(start, [Note(0.15, 83, 0.3)]).possible  # C4 -> B5 in 0.15 s: a fingering exists ...
+    assert not planner.follow(start, [Note(0.15, 83, 0.3)], in_time=True).possible  # ... but not in time
+    assert planner.follow(start, [Note(1.0, 83, 1.5)], in_time=True).possible
+
+
 def test_a_chord_wider_than_the_hand_is_a_clear_error():
     with pytest.raises(PianobotError, match="spans .* more than this hand reaches"):
         plan_fingering(Piece((Note(0, 60, 1), Note(0, 72, 1))))

@@ -175,10 +175,10 @@ def check_midi_output(output: Path, song: Path, what: str) -> None:
 def read_song(song: Path, options: LoadOptions, keyboard: KeyboardSpec, hand: HandSpec) -> Piece:
     """Load a piece for this hand and keyboard; finger it with the planner when it has no fingering."""
     from pianobot.music.instrument import check_playable
-    from pianobot.music.load import load_part
     from pianobot.pianist.fingering import ensure_fingering
+    from pianobot.pianist.reduce import load_for_hand
 
-    piece = load_part(song, options, hand)
+    piece = load_for_hand(song, options, keyboard, hand)  # with --hand, reduced to what the hand can play
     piece, plan = ensure_fingering(piece, keyboard, hand, options.refinger)
     if plan is not None:
         why = "--refinger" if options.refinger else "it has notes without fingering"
@@ -228,9 +228,10 @@ def inspect(
     from pianobot.cli import display
     from pianobot.music import midi_io
     from pianobot.music.instrument import check_playable
-    from pianobot.music.load import HANDS, hand_tracks, load_part
+    from pianobot.music.load import HANDS, hand_tracks
     from pianobot.perform.compose import missing_phrases, trained_split
     from pianobot.pianist.fingering import ensure_fingering
+    from pianobot.pianist.reduce import load_for_hand
 
     keyboard, hand_spec = make_instrument(lowest_note, keys, thumb)
     options = make_options(track, tempo, transpose, fingering, hand_part, split, quantize, refinger)
@@ -258,7 +259,7 @@ def inspect(
             console.print(
                 "[yellow]several tracks are merged; play one part with --track N or --hand right|left[/yellow]"
             )
-    piece = load_part(song, options, hand_spec)
+    piece = load_for_hand(song, options, keyboard, hand_spec)
     polyphony, _ = piece.max_polyphony()
     given = sum(n.finger is not None for n in piece.notes)
     low, high = min(n.pitch for n in piece.notes), max(n.pitch for n in piece.notes)
@@ -330,16 +331,16 @@ def finger(
 ):
     """Plan a fingering for the robot hand (least wrist travel within its reach) and write it to a MIDI file."""
     from pianobot.cli import display
-    from pianobot.music.load import load_part
     from pianobot.music.midi_io import write_midi
     from pianobot.music.phrases import split_phrases
     from pianobot.pianist.fingering import ensure_fingering
+    from pianobot.pianist.reduce import load_for_hand
 
     check_midi_output(output, song, "the fingered piece")
     check_writable(output)
     keyboard, hand_spec = make_instrument(lowest_note, keys, thumb)
     options = make_options(track, tempo, transpose, None, hand_part, split, quantize)
-    piece = load_part(song, options, hand_spec)
+    piece = load_for_hand(song, options, keyboard, hand_spec)
     piece, plan = ensure_fingering(piece, keyboard, hand_spec, refinger=True)
     write_midi(piece, output, name=f"{song.stem} fingered by pianobot")
     out.print(display.notes_table(piece, split_phrases(piece, DEFAULT_MAX_NOTES), None if all_rows else display.ROWS))
@@ -381,8 +382,8 @@ def score(
     `pianobot score out.mid original.mid --hand right --transpose -3` compares like with like."""
     from pianobot.cli import display
     from pianobot.music import midi_io
-    from pianobot.music.load import load_part
     from pianobot.music.metrics import compare, plot_report
+    from pianobot.pianist.reduce import load_for_hand
 
     if not 0 < onset_tolerance <= 1:
         raise PianobotError(f"--onset-tolerance {onset_tolerance}: give seconds between 0 and 1, e.g. 0.05")
@@ -393,9 +394,9 @@ def score(
         if target is not None:
             check_writable(target)
     console = err if to_stdout else out  # standard output carries the JSON
-    _, hand = make_instrument(pitch_name(KeyboardSpec.lowest), KeyboardSpec.count, thumb)
+    keyboard, hand = make_instrument(pitch_name(KeyboardSpec.lowest), KeyboardSpec.count, thumb)
     options = make_options(track, tempo, transpose, fingering, hand_part, split, quantize)
-    reference_piece = load_part(reference, options, hand)
+    reference_piece = load_for_hand(reference, options, keyboard, hand)  # with --hand, reduced as play reduces it
     played_piece = midi_io.read_midi(played)
     report = compare(reference_piece, played_piece, onset_tolerance=onset_tolerance)
     tables = display.report_tables(report)

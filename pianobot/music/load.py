@@ -27,7 +27,9 @@ class LoadOptions:
     """A PIG fingering file for the notes; None looks for the sidecar ``<name>_fingering.txt``."""
     hand: str | None = None
     """'right' or 'left': play that hand's part of a two-hand piece (tracks named for it, else
-    the notes above or below ``split``); chords are thinned to what the robot hand can hold."""
+    the notes above or below ``split``); chords are thinned to what the robot hand can hold, and
+    where a piece is fingered for playing, :func:`pianobot.pianist.reduce.load_for_hand` reduces
+    the part further to what the hand can reach in time."""
     split: int = 60
     """With ``hand`` and no track named for it: the lowest pitch of the right hand's part (60 = C4)."""
     quantize: str | None = None
@@ -177,7 +179,8 @@ def load_piece(path: str | Path, options: LoadOptions = LoadOptions()) -> Piece:
 
 
 def load_part(path: str | Path, options: LoadOptions, hand: HandSpec) -> Piece:
-    """:func:`load_piece`; with ``options.hand``, also thin chords to what ``hand`` can hold."""
+    """:func:`load_piece`; with ``options.hand``, also thin chords to what ``hand`` can hold
+    (:func:`pianobot.pianist.reduce.load_for_hand` goes on to what it can reach in time)."""
     piece = load_piece(path, options)
     if options.hand is not None:
         piece, dropped = thin_chords(piece, len(hand.fingers))

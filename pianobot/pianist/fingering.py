@@ -15,10 +15,17 @@ states with the lowest total cost:
 Hard constraints (what this hand cannot do): a finger reaches at most :data:`REACH_FRACTION` of
 what its abduction limit allows; simultaneous notes take distinct fingers in pitch order; a
 finger still holding a key is not reused and the wrist keeps that key in its reach; fingertips
-never cross each other in the hand's frame between consecutive chords; and the wrist moves at
+never cross each other in the hand's frame between consecutive chords; the wrist moves at
 most as fast as its motor allows in the time between onsets, less the time a finger needs to
-lift and settle. Where the tempo makes that last one impossible, the planner still returns its
-best fingering and says which notes and why (:attr:`FingeringPlan.problems`).
+lift and settle; and a finger strikes again no sooner than the scripted pianist can let go,
+move over and strike. Where the tempo makes those last two impossible, the planner still
+returns its best fingering and says which notes and why (:attr:`FingeringPlan.problems`).
+
+The same dynamic programme answers, chord by chord, what the hand can do: :meth:`Planner.place`
+(can one hand position reach this chord?) and :meth:`Planner.follow` (can the hand get from
+what it has played to this chord, holding what still sounds, and in time?). Reading one hand's
+part of a recording asks them to reduce the part to what the hand can play
+(:mod:`pianobot.pianist.reduce`); no other module knows the hand's geometry.
 """
 
 from __future__ import annotations
@@ -161,8 +168,8 @@ class Planner:
     def follow(self, before: Reach, chord: Sequence[Note], in_time: bool = False) -> Reach:
         """Every way of playing ``chord`` right after ``before``'s chord, holding those of its notes
         that still sound at ``chord``'s onset. ``possible`` is False when no fingering gets there
-        (a held note out of reach, fingertips that would cross); with ``in_time``, also when the
-        wrist cannot make the move in the time between the onsets."""
+        (a held note out of reach, fingertips that would cross); with ``in_time``, also when
+        neither the wrist nor a finger can get there in the time between the onsets."""
         return self._follow(before, chord, in_time)[0]
 
     def _follow(self, before: Reach, chord: Sequence[Note], in_time: bool) -> tuple[Reach, np.ndarray]:
