@@ -1,17 +1,22 @@
 """How precise must a policy be? The scripted pianist with Gaussian noise on its actions.
 
     python benchmarks/precision.py [examples/midi/three-note.mid] [--sigmas 0 0.02 0.05 0.1] [--starts 4]
+                                   [--control velocity|position]
 
 A learned policy imitates the scripted pianist (behaviour cloning) and acts on top of it (SAC);
 its action is never exactly the teacher's. This measures what a given action error costs: the
 noise-free teacher's actions plus N(0, sigma) on every joint, on the finger joints only, or on
 the wrist only, over several hand starts of the piece's first phrase (the starts evaluation
 uses). Prints a Markdown table of mean note F1, per-step F1 and mean onset error.
+
+``--control`` picks the finger joints' action space: joint speeds (velocity) or joint angle
+targets (position); the same sigma is the same share of each action's full scale.
 """
 
 from __future__ import annotations
 
 import argparse
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -58,14 +63,17 @@ def main() -> None:
     parser.add_argument("song", nargs="?", default="examples/midi/three-note.mid")
     parser.add_argument("--sigmas", type=float, nargs="+", default=[0.0, 0.02, 0.05, 0.1])
     parser.add_argument("--starts", type=int, default=4, help="hand starts per setting")
+    parser.add_argument("--control", choices=["velocity", "position"], default="velocity")
     args = parser.parse_args()
 
     env_config = TrainConfig().env
+    env_config = replace(env_config, world=replace(env_config.world, control=args.control))
     piece = load_part(Path(args.song), LoadOptions(), HandSpec())
     env = make_env(split_phrases(piece)[0].piece(), env_config)
     pianist = ScriptedPianist(env_config)
     print(
-        f"{Path(args.song).name}, first phrase, {args.starts} hand starts; action noise N(0, sigma) on [-1, 1] actions\n"
+        f"{Path(args.song).name}, first phrase, {args.starts} hand starts, {args.control} control; "
+        "action noise N(0, sigma) on [-1, 1] actions\n"
     )
     print(
         "| noise on | sigma | note F1 (mean) | note F1 per start | step F1 | mean onset error of matched notes (ms) |"

@@ -12,7 +12,9 @@ speeds; for each finger, where the next key it has to play lies relative to its 
 soon, how loud, and how much longer to hold the key it holds (:func:`finger_targets`, not in the
 paper); and, only when asked for (the paper's ablation), key angles and speeds.
 Actions: the actuated finger joints (of abduction, MCP, PIP, DIP per finger) then the wrist,
-each in [-1, 1].
+each in [-1, 1]: joint speeds (``WorldConfig.control='velocity'``, the default), joint angle
+targets with -1 and 1 at the joint's limits ('position') or joint torques ('torque'); the wrist's
+is always its speed along the rail (or, with ``discrete_wrist``, a white key to go to).
 
 Version history (ids ``pianobot/Piano-v0``, ``pianobot/OneNote-v0``, ...; a stored model
 records the :class:`EnvConfig` it was trained with, and :data:`pianobot.agent.store.FORMAT`
@@ -37,7 +39,7 @@ from pianobot.music.instrument import check_playable
 from pianobot.music.piece import Piece
 from pianobot.music.tasks import TASKS, make_task
 from pianobot.music.tensor import FINGER, NOTE, VELOCITY, ScoreSpec, score_tensor, steps_for
-from pianobot.sim.hand import finger_ik, joint_names
+from pianobot.sim.hand import finger_ik, joint_limits, joint_names
 from pianobot.sim.keyboard import strike_points
 from pianobot.sim.tactile import TactileConfig, TactileRenderer, pool, to_uint8
 from pianobot.sim.world import PianoWorld, WorldConfig
@@ -227,6 +229,11 @@ class PianoEnv(gym.Env):
             obs["key_velocities"] = spaces.Box(-SPEED_BOUND, SPEED_BOUND, (keys,), np.float32)
         self.observation_space = spaces.Dict(obs)
         self.actuated = actuated_indices(config)
+        # what the joints left out of the action get: no speed, or (position control) their starting angles
+        self.frozen = np.zeros(self.n_joints + 1)
+        if config.world.control == "position":
+            low, high = joint_limits(config.world.hand)
+            self.frozen[:-1] = (np.tile(idle_pose(config.world), self.n_fingers) - low) / (high - low) * 2.0 - 1.0
         self.action_space = spaces.Box(-1.0, 1.0, (len(self.actuated),), np.float32)
         if piece is not None:
             self._set_piece(piece)
@@ -274,8 +281,9 @@ class PianoEnv(gym.Env):
 
     # -- the step: act, observe, reward ------------------------------------------------------
     def full_action(self, action) -> np.ndarray:
-        """The policy's action spread over every finger joint and the wrist (frozen joints: speed 0)."""
-        full = np.zeros(self.n_joints + 1)
+        """The policy's action spread over every finger joint and the wrist (frozen joints: speed 0, or
+        in position control the angles they start at)."""
+        full = self.frozen.copy()
         full[self.actuated] = action
         return full
 

@@ -9,7 +9,8 @@
   in short straight moves, and into or out of the black keys' band only above their tops;
   strikes and holds go straight to the planned height.
 - Inverse kinematics (:func:`~pianobot.sim.hand.finger_ik`) turns the waypoint into flexion
-  angles, and the action is the joint speed that reaches them within the step.
+  angles, and the action is the joint speed that reaches them within the step (velocity
+  control), or those angles themselves (position control).
 
 Heights are in metres over the white keys' top surface (or over a key's top, where it says so).
 """
@@ -23,7 +24,14 @@ import numpy as np
 from pianobot.pianist.layout import KeyLayout
 from pianobot.pianist.strikes import Plan, Tip
 from pianobot.pianist.tuning import PianistTuning
-from pianobot.sim.hand import FINGER_BASE_X, PREFERRED_TILT, TILT_RANGE, finger_ik, lowest_point_in_finger_plane
+from pianobot.sim.hand import (
+    FINGER_BASE_X,
+    PREFERRED_TILT,
+    TILT_RANGE,
+    finger_ik,
+    joint_limits,
+    lowest_point_in_finger_plane,
+)
 from pianobot.sim.world import WorldConfig
 
 
@@ -37,6 +45,10 @@ class Motion:
         self.geometry = world.hand.geometry
         self.fingers = world.hand.spec.fingers
         self.dt = 1.0 / world.control_hz
+        self.position = world.control == "position"
+        """Actions are joint angle targets (else joint speeds)."""
+        self.limits = joint_limits(world.hand)[:, :4]
+        """(lower, upper) limits of one finger's four joints (rad)."""
 
     def tip(self, q: np.ndarray) -> Tip:
         """Where the fingertip's lowest point is, from its joint angles (abduction first)."""
@@ -97,7 +109,12 @@ class Motion:
             if change > self.tuning.max_joint_move:
                 flexion = q[1:] + (flexion - q[1:]) * self.tuning.max_joint_move / change
         desired = np.concatenate([[abduction], flexion])
-        return np.clip((desired - q) / (self.hand.max_joint_speed * self.dt), -1.0, 1.0)
+        step = self.hand.max_joint_speed * self.dt
+        change = np.clip(desired - q, -step, step)  # the most a joint moves in one control step
+        if self.position:  # the angle to be at by the end of the step, -1 and 1 at the joint's limits
+            low, high = self.limits
+            return np.clip((q + change - low) / (high - low) * 2.0 - 1.0, -1.0, 1.0)
+        return change / step
 
     def _target(
         self, finger: int, plan: Plan | None, now_reach: float, wrist_next: float

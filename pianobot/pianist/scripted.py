@@ -30,11 +30,11 @@ from pianobot.pianist.tuning import PianistTuning
 
 
 class ScriptedPianist:
-    """A hand-written pianist for velocity control. See the module docstring."""
+    """A hand-written pianist for velocity or position control. See the module docstring."""
 
     def __init__(self, config: EnvConfig, tuning: PianistTuning = PianistTuning()):
-        if config.world.control != "velocity":
-            raise ValueError("the scripted pianist drives joint velocities: use control='velocity'")
+        if config.world.control not in ("velocity", "position"):
+            raise ValueError("the scripted pianist drives joint speeds or angles: use control='velocity' or 'position'")
         self.config = config
         self.tuning = tuning
         self.fingers = config.world.hand.spec.fingers

@@ -70,7 +70,7 @@ class HandConfig:
     palm_y: float = 0.190
     """y of the finger bases (the keys run from y = 0 at the hinge to 0.15 at the front)."""
     max_joint_speed: float = 12.0
-    """Joint speed (rad/s) at action +-1 in velocity control."""
+    """Joint speed (rad/s) at action +-1 in velocity control, and the fastest a joint moves in position control."""
     joint_force: float = 0.7
     """Most torque (N m) a joint motor may use to reach its commanded speed (about the Allegro's)."""
     max_joint_torque: float = 0.7
@@ -94,6 +94,13 @@ class HandConfig:
             wrist_force=(1e-3, 1e5),
             finger_mass=(1e-4, 10.0),
         )
+
+
+def joint_limits(config: HandConfig) -> np.ndarray:
+    """(2, 4F): the lower and upper limit (rad) of every finger joint, in action order."""
+    g = config.geometry
+    per_finger = [(-g.abduction_limit, g.abduction_limit), *g.flexion_limits]
+    return np.array(per_finger * len(config.spec.fingers)).T
 
 
 def joint_names(spec: HandSpec) -> list[str]:

@@ -17,10 +17,10 @@ import numpy as np
 from pianobot.config import check_ranges
 from pianobot.music.tensor import ScoreSpec
 from pianobot.sim.bullet import p
-from pianobot.sim.hand import HandConfig, hand_urdf, joint_names
+from pianobot.sim.hand import HandConfig, hand_urdf, joint_limits, joint_names
 from pianobot.sim.keyboard import KeyboardConfig, KeyEvent, KeySensor, key_boxes, keyboard_urdf, keyboard_width
 
-CONTROL_MODES = ("velocity", "torque")
+CONTROL_MODES = ("velocity", "position", "torque")
 LIMIT_STOP_TORQUE = 5.0
 """Torque (N m) with which a joint's mechanical stop holds it at its limit under torque control."""
 
@@ -39,7 +39,8 @@ class WorldConfig:
     """Constraint solver iterations per physics step (PyBullet's default). At 15 the env steps 1.5x
     as fast, but the last finger's joints do not follow a large commanded move (docs/simulator.md)."""
     control: str = "velocity"
-    """Finger joint control: 'velocity' (action = joint speed) or 'torque' (action = joint torque)."""
+    """Finger joint control: 'velocity' (action = joint speed), 'position' (action = joint angle
+    target, -1 and 1 at the joint's limits) or 'torque' (action = joint torque)."""
     discrete_wrist: bool = False
     """If True the wrist action picks one of the white keys' positions and the wrist servoes there."""
     gui: bool = False
@@ -124,9 +125,7 @@ class PianoWorld:
             for j in range(p.getNumJoints(body, physicsClientId=c))
         }
         fingers = [index[name] for name in joint_names(hand.spec)]
-        g = hand.geometry
-        per_finger = [(-g.abduction_limit, g.abduction_limit), *g.flexion_limits]
-        self.joint_limits = np.array([per_finger[i % 4] for i in range(len(fingers))]).T
+        self.joint_limits = joint_limits(hand)
         tips = {f: index[f"f{f}_dip"] for f in hand.spec.fingers}  # the DIP joint's child is the distal link
         for j in [index["wrist"], *fingers]:
             p.changeDynamics(body, j, linearDamping=0, angularDamping=0, physicsClientId=c)
@@ -146,7 +145,9 @@ class PianoWorld:
             p.resetJointState(self.hand, j, float(angle), 0.0, physicsClientId=c)
         self.sensor.reset()
         self.time = 0.0
-        self._finger_command = np.zeros(len(self.finger_joints))
+        # no speed, no torque, or (position control) the angles it starts at
+        position = self.config.control == "position"
+        self._finger_command = np.array(finger_angles, dtype=float) if position else np.zeros(len(self.finger_joints))
         self._hold(finger_angles, wrist)
 
     def _hold(self, finger_angles: np.ndarray, wrist: float) -> None:
@@ -245,6 +246,9 @@ class PianoWorld:
         fingers, wrist = action[:n], float(action[n])
         if cfg.control == "velocity":
             self._finger_command = fingers * hand.max_joint_speed
+        elif cfg.control == "position":
+            low, high = self.joint_limits
+            self._finger_command = low + (fingers + 1.0) / 2.0 * (high - low)
         else:
             self._finger_command = fingers * hand.max_joint_torque
             p.setJointMotorControlArray(
@@ -271,8 +275,13 @@ class PianoWorld:
                 physicsClientId=c,
             )
 
-    def _drive_fingers(self, torque: bool) -> None:
+    def _drive_fingers(self, torque: bool, left: int) -> None:
         """Apply the finger command for one physics step, never driving a joint past its limit.
+        ``left``: physics steps left in the control step, this one included.
+
+        Position control moves each joint at the constant speed that reaches its target when the
+        control step ends (velocity control's path when the target is angle + speed x step), up
+        to ``max_joint_speed``; the next target is absolute, so an error does not carry over.
 
         PyBullet's joint limits are soft: a finger motor at full speed pushes the light finger
         links far past them (we saw the PIP joint at -1.5 rad against a limit of -0.17). So the
@@ -285,7 +294,10 @@ class PianoWorld:
         # speeds that reach a limit within this physics step, and no further
         slowest, fastest = (low - q) / self.dt, (high - q) / self.dt
         if not torque:
-            speed = np.clip(self._finger_command, slowest, fastest)
+            command = self._finger_command
+            if self.config.control == "position":  # at the speed that reaches the target at the control step's end
+                command = np.clip((command - q) / (left * self.dt), -hand.max_joint_speed, hand.max_joint_speed)
+            speed = np.clip(command, slowest, fastest)
             p.setJointMotorControlArray(
                 self.hand,
                 self.finger_joints,
@@ -330,8 +342,8 @@ class PianoWorld:
         pressed = self.sensor.sounding.copy()
         pressed_velocity = self.sensor.velocity.copy()
         torque = self.config.control == "torque"
-        for _ in range(self.config.substeps):
-            self._drive_fingers(torque)
+        for substep in range(self.config.substeps):
+            self._drive_fingers(torque, self.config.substeps - substep)
             p.stepSimulation(physicsClientId=self.client)
             self.time += self.dt
             angles, speeds = self.key_state()
