@@ -1,7 +1,7 @@
 """Learning curves: evaluation note F1 against environment steps, per task and seed.
 
     python benchmarks/learn.py --tasks one-note three-note --seeds 0 1 2 --steps 100000 \
-        [--explore prior] [--no-tactile] [--workers 2] [--plot docs/learning.png] [--store /tmp/learn]
+        [--explore prior] [--no-tactile] [--control position] [--workers 2] [--plot docs/learning.png] [--store /tmp/learn]
     python benchmarks/learn.py ... --report    # no training: the runs so far, finished or not
     python benchmarks/learn.py ... --report --check   # and what unfinished runs' best policies play
 
@@ -26,6 +26,7 @@ from pianobot.agent.policy import load_policy, make_agent
 from pianobot.env.piano import EnvConfig
 from pianobot.learn.config import TrainConfig, config_from_manifest
 from pianobot.learn.train import TASK_EVAL_EPISODES, best_policy_tensors, evaluate, make_env, train_policy
+from pianobot.sim.world import CONTROL_MODES, WorldConfig
 
 CHECK_SEED = 20_000
 """Seeds of the held-out check's instances (the training evaluations use 10000, 10001, ...)."""
@@ -44,7 +45,11 @@ def run_folder(task: str, seed: int, args) -> tuple[TrainConfig, Path]:
         checkpoint_every=args.eval_every,
         until_f1=args.until_f1,
         sac=SACConfig(exploration_steps=args.exploration_steps),
-        env=EnvConfig(tactile=args.tactile, actuated=tuple(args.joints.split(","))),
+        env=EnvConfig(
+            tactile=args.tactile,
+            actuated=tuple(args.joints.split(",")),
+            world=WorldConfig(control=args.control),
+        ),
     )
     return config, store.model_dir(Path(args.store), f"task-{task}-seed{seed}", config)
 
@@ -118,6 +123,7 @@ def main() -> None:
     )
     parser.add_argument("--until-f1", type=float, default=None, help="stop a run once an evaluation reaches this F1")
     parser.add_argument("--tactile", action=argparse.BooleanOptionalAction, default=True)
+    parser.add_argument("--control", choices=CONTROL_MODES, default=WorldConfig.control, help="finger joint control")
     parser.add_argument("--joints", default=",".join(EnvConfig.actuated), help="finger joints the policy moves")
     parser.add_argument("--workers", type=int, default=1)
     parser.add_argument("--store", default="/tmp/pianobot-learn")
