@@ -47,3 +47,61 @@ def test_train_on_a_local_ray_runtime(tmp_path):
     (policy,) = json.loads(result.stdout)["policies"]
     assert policy["steps"] == 60 and (Path(policy["folder"]) / "policy.safetensors").exists()
     assert run("train", EXAMPLES / "one-note.mid", "--cluster", "slurm").exit_code == 2
+
+
+def test_train_the_melody_family_and_rebuild_its_policy_from_the_manifest(tmp_path):
+    """`train --task melody`: a tiny run stores a policy whose manifest names its task, so that
+    evaluation and play rebuild its environment (fresh phrases, fingered by the planner)."""
+    import numpy as np
+
+    from pianobot.agent.policy import load_policy, policy_configs, policy_env, policy_target
+    from pianobot.agent.tasks import draw_melody
+    from pianobot.learn.train import evaluate
+    from pianobot.perform.perform import perform
+
+    assert "melody" in run("train", "--help").output
+    result = run("train", "--task", "melody", *QUICK, "--models", tmp_path, "--json", "-")
+    assert result.exit_code == 0, result.output
+    (policy,) = json.loads(result.stdout)["policies"]
+    folder = Path(policy["folder"])
+    assert folder.name.startswith("task-melody-") and policy_target(folder) == "melody"
+    env = policy_env(folder)
+    observation, info = env.reset(seed=1)
+    agent = load_policy(folder, env)
+    assert info["piece"].has_fingering and agent.act(observation).shape == env.action_space.shape
+    env_config, _ = policy_configs(folder)
+    assert 0.0 <= evaluate(agent, "melody", env_config, episodes=2)["f1"] <= 1.0
+    piece = draw_melody(np.random.default_rng(5), env_config)
+    played = perform(piece, lambda env: load_policy(folder, env), config=env_config)
+    assert played.reference == piece
+
+
+def test_train_envs_and_device_options(tmp_path, monkeypatch):
+    import torch
+    import typer.main
+
+    from pianobot.learn.config import TrainConfig
+
+    options = {p.name: p.default for p in typer.main.get_command(app).commands["train"].params}
+    assert options["envs"] == TrainConfig.envs == 1 and options["device"] == TrainConfig.device == "auto"
+    help_text = run("train", "--help").output
+    assert "--envs" in help_text and "--device" in help_text
+    song = EXAMPLES / "one-note.mid"
+    for args, words in (
+        (("--envs", "0"), ("--envs 0", "give 1 to 256")),
+        (("--envs", "1000"), ("--envs 1000", "give 1 to 256")),
+        (("--device", "gpu"), ("--device gpu", "auto, cpu, cuda")),
+    ):
+        result = run("train", song, *QUICK, *args, "--models", tmp_path)
+        assert result.exit_code == 2 and len(result.stderr.strip().splitlines()) == 1, result.output
+        assert all(word in result.stderr for word in words), result.stderr
+    monkeypatch.setattr(torch.cuda, "is_available", lambda: False)
+    result = run("train", song, *QUICK, "--device", "cuda", "--models", tmp_path)
+    assert result.exit_code == 2 and result.stderr.strip().splitlines() == [
+        f"error: --device cuda: torch {torch.__version__} sees no CUDA GPU on this machine: use --device cpu, or auto "
+        "(cuda where there is one)"
+    ]
+    result = run("train", song, *QUICK, "--device", "auto", "--models", tmp_path, "--json", "-")
+    assert result.exit_code == 0, result.output
+    manifest = json.loads((Path(json.loads(result.stdout)["policies"][0]["folder"]) / "manifest.json").read_text())
+    assert manifest["device"] == "cpu"

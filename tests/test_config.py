@@ -52,7 +52,11 @@ def test_fields_left_out_take_their_defaults():
         (("sac", "learning_rate"), float("inf"), r"config\.sac\.learning_rate: expected a finite number"),
         (("env", "tactile"), 1, r"config\.env\.tactile: expected true or false"),
         (("env", "tactile_pool"), [15], r"config\.env\.tactile_pool: expected 2 values, got 1"),
-        (("env", "world", "control"), "position", r"config\.env\.world: control must be one of velocity, torque"),
+        (
+            ("env", "world", "control"),
+            "servo",
+            r"config\.env\.world: control must be one of velocity, position, torque",
+        ),
         (("env", "world", "hand"), [], r"config\.env\.world\.hand: expected a mapping"),
         (("env", "colour"), 1, r"config\.env\.colour: not a field of EnvConfig"),
     ],

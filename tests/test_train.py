@@ -66,6 +66,10 @@ def test_interrupted_training_resumes_to_the_same_state(tmp_path):
     resumed = tmp_path / "resumed"
     assert train_policy(PHRASE, config, resumed, stop_after=100) == {"interrupted_at": 105}
     assert store.checkpoint_state(resumed)["step"] == 70 and not store.is_trained(resumed)
+    (state_file,) = (resumed / store.CHECKPOINT_DIR).glob("*/state.json")
+    state = json.loads(state_file.read_text())
+    state["env_rng"] = state["env_rng"][0]  # as checkpoints from before --envs held it: they resume exactly too
+    state_file.write_text(json.dumps(state))
     train_policy(PHRASE, config, resumed)
     a = store.load_tensors(straight / store.POLICY_FILE)
     b = store.load_tensors(resumed / store.POLICY_FILE)
@@ -486,3 +490,97 @@ def test_training_writes_tensorboard_events_when_it_is_installed(tmp_path):
     scalars = events.Tags()["scalars"]
     assert "return" in scalars and "critic_loss" in scalars and "eval/f1" in scalars
     assert [e.step for e in events.Scalars("return")] == [35, 70, 105, 140]
+
+
+# -- --envs and --device (issue 20) ------------------------------------------------------------
+BEFORE_ENVS = [  # (step, return, critic loss, actor loss) of small(explore="uniform", eval_every=70), as the loop gave them before --envs
+    (35, -11.5748, None, None),
+    (70, -36.4502, 1.283197, 0.110609),
+    (105, 23.3825, 0.991734, 0.169682),
+    (140, 20.2443, 1.142979, 0.298618),
+    (175, 8.4252, 0.892158, 0.181338),
+]
+BEFORE_ENVS_EVALUATIONS = [(70, 21.54005490647198), (140, 28.700787445549494), (200, 28.701110188774823)]
+
+
+def test_one_environment_trains_exactly_as_before_there_were_more():
+    """--envs 1 (the default) steps its environment in the training process: a seeded run gives
+    the log and evaluations the loop gave before --envs existed (pinned from it, bit-identical on
+    the machine that pinned them; uniform exploration, so that the scripted pianist's tuning does
+    not move them). Pin them again only when the simulator or the agent changes on purpose."""
+    import csv
+    import tempfile
+    from pathlib import Path
+
+    torch.set_num_threads(1)
+    with tempfile.TemporaryDirectory() as scratch:
+        manifest = train_policy(PHRASE, small(explore="uniform", eval_every=70), Path(scratch))
+        with open(Path(scratch) / LOG_FILE, newline="") as log:
+            rows = [
+                (
+                    int(r["step"]),
+                    float(r["return"]),
+                    *(float(r[k]) if r[k] else None for k in ("critic_loss", "actor_loss")),
+                )
+                for r in csv.DictReader(log)
+            ]
+    assert [r[0] for r in rows] == [r[0] for r in BEFORE_ENVS] and rows[0][2:] == (None, None)
+    figures = [x for r in rows for x in r[1:] if x is not None]
+    assert figures == pytest.approx([x for r in BEFORE_ENVS for x in r[1:] if x is not None], rel=1e-4, abs=1e-5)
+    evaluations = [(e["step"], e["return"]) for e in manifest["evaluations"]]
+    assert [s for s, _ in evaluations] == [s for s, _ in BEFORE_ENVS_EVALUATIONS]
+    assert [r for _, r in evaluations] == pytest.approx([r for _, r in BEFORE_ENVS_EVALUATIONS], rel=1e-4)
+
+
+def test_environments_in_worker_processes_train_checkpoint_and_resume(tmp_path):
+    """--envs 2: two environments step in worker processes, one row per episode, and an
+    interrupted run resumes from its checkpoint, with two environments or (the same model
+    folder: --envs is not part of what is trained) with one."""
+    import shutil
+
+    config = small(envs=2, eval_every=70, env=EnvConfig(tactile=False))
+    folder = store.model_dir(tmp_path, "phrase", config)
+    assert folder == store.model_dir(tmp_path, "phrase", replace(config, envs=1, device="cpu"))
+    assert train_policy(PHRASE, config, folder, stop_after=100) == {"interrupted_at": 140}
+    assert len(store.checkpoint_state(folder)["env_rng"]) == 2  # each worker's generator
+    shutil.copytree(folder, tmp_path / "other")
+
+    seen: list[Progress] = []
+    manifest = train_policy(PHRASE, config, folder, seen.append)
+    assert [p.step for p in seen if p.resumed] == [140]
+    assert manifest["steps"] == 200 and manifest["updates"] == 140 and manifest["config"]["envs"] == 2
+    rows = _log_without_time(folder)
+    assert [int(r["step"]) for r in rows] == [70, 70, 140, 140]  # both environments' episodes end together
+    assert [bool(r["eval_f1"]) for r in rows] == [True, False, True, False]  # an evaluation is logged once
+    assert [e["step"] for e in manifest["evaluations"]] == [70, 140, 200]
+
+    other = train_policy(PHRASE, replace(config, envs=1), tmp_path / "other")  # resumed with one environment
+    assert other["steps"] == 200 and other["updates"] == 140 and store.is_trained(tmp_path / "other")
+
+
+def test_the_learner_runs_on_the_cpu_here_and_a_missing_gpu_is_one_line(tmp_path, monkeypatch):
+    from pianobot.agent.sac import resolve_device
+
+    monkeypatch.setattr(torch.cuda, "is_available", lambda: False)
+    assert resolve_device("auto") == resolve_device("cpu") == torch.device("cpu")
+    with pytest.raises(PianobotError, match="--device cuda: torch .* sees no CUDA GPU") as error:
+        resolve_device("cuda")
+    assert "\n" not in str(error.value)
+    with pytest.raises(PianobotError, match="--device cuda"):
+        train_policy(PHRASE, small(device="cuda"), tmp_path / "m")
+    with pytest.raises(ValueError, match="device must be one of auto, cpu, cuda"):
+        small(device="gpu")
+    manifest = train_policy(PHRASE, small(steps=80, env=EnvConfig(tactile=False)), tmp_path / "m")
+    assert manifest["device"] == "cpu" and manifest["config"]["device"] == "auto"
+
+
+@pytest.mark.skipif(not torch.cuda.is_available(), reason="needs a CUDA GPU")
+def test_a_run_on_the_gpu_checkpoints_and_stores_tensors_that_load_on_the_cpu(tmp_path):
+    config = small(device="cuda")
+    train_policy(PHRASE, config, tmp_path / "m", stop_after=100)
+    tensors, _, _ = store.load_checkpoint(tmp_path / "m")
+    assert all(t.device.type == "cpu" for t in tensors.values())
+    manifest = train_policy(PHRASE, replace(config, device="cpu"), tmp_path / "m")  # resumed on the CPU
+    assert manifest["device"] == "cpu"
+    env = make_env(PHRASE, config.env)
+    assert load_policy(tmp_path / "m", env).act(env.reset(seed=0)[0]).shape == (13,)

@@ -43,9 +43,29 @@ class ReplayBuffer:
         self.cursor = (i + 1) % self.capacity
         self.size = min(self.size + 1, self.capacity)
 
-    def sample(self, batch_size: int, rng: np.random.Generator) -> dict[str, torch.Tensor | None]:
+    def add_batch(
+        self, vectors, tactiles, actions, rewards, terminations, next_vectors, next_tactiles, experts
+    ) -> None:
+        """One transition per environment of a vector environment, in order (rows of each array;
+        ``tactiles`` None without images; ``experts`` a list of teacher actions or Nones)."""
+        for i in range(len(vectors)):
+            self.add(
+                vectors[i],
+                None if tactiles is None else tactiles[i],
+                actions[i],
+                rewards[i],
+                terminations[i],
+                next_vectors[i],
+                None if next_tactiles is None else next_tactiles[i],
+                expert=experts[i],
+            )
+
+    def sample(
+        self, batch_size: int, rng: np.random.Generator, device: str | torch.device = "cpu"
+    ) -> dict[str, torch.Tensor | None]:
+        """``batch_size`` transitions drawn uniformly (with replacement), as tensors on ``device``."""
         index = rng.integers(0, self.size, batch_size)
-        batch = {k: torch.from_numpy(v[index]) for k, v in self.arrays.items()}
+        batch = {k: torch.from_numpy(v[index]).to(device) for k, v in self.arrays.items()}
         batch.setdefault("tactile", None)
         batch.setdefault("next_tactile", None)
         return batch

@@ -4,6 +4,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+DEVICES = ("auto", "cpu", "cuda")
+"""Where the learner can run (``TrainConfig.device``): 'auto' is cuda when torch sees a GPU, else cpu."""
+
 
 @dataclass(frozen=True)
 class SACConfig:

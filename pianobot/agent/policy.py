@@ -1,9 +1,11 @@
 """Stored policies: the agent a model's manifest describes, with its weights loaded.
 
 Performing needs only this module, not the training loop: a manifest records the environment
-and agent configurations a policy was trained with (rebuilt by :func:`pianobot.config.from_dict`),
-and ``policy.safetensors`` holds its actor and encoder. A loaded :class:`SAC` has the controller
-interface (``reset()``, ``act(observation)``).
+and agent configurations a policy was trained with (rebuilt by :func:`pianobot.config.from_dict`)
+and what it was trained on, a phrase or a task family's name (:func:`policy_env` rebuilds its
+environment), and ``policy.safetensors`` holds its actor and encoder, loaded on the CPU whatever
+device trained them. A loaded :class:`SAC` has the controller interface (``reset()``,
+``act(observation)``).
 """
 
 from __future__ import annotations
@@ -13,22 +15,29 @@ from typing import TYPE_CHECKING
 
 from pianobot.agent import store
 from pianobot.agent.config import SACConfig
+from pianobot.agent.tasks import make_env
 from pianobot.config import ConfigError, from_dict
 from pianobot.env.piano import EnvConfig, PianoEnv, idle_pose
-from pianobot.errors import PianobotError
+from pianobot.errors import PianobotError, quote
+from pianobot.music.piece import Note, Piece
+from pianobot.music.tasks import FAMILIES
 
 if TYPE_CHECKING:
+    import torch
+
     from pianobot.agent.sac import SAC
 
 
-def make_agent(env: PianoEnv, config: SACConfig) -> SAC:
-    """A fresh agent for this environment's observation and action spaces."""
+def make_agent(env, config: SACConfig, device: str | torch.device = "cpu") -> SAC:
+    """A fresh agent, on ``device``, for the observation and action spaces of ``env`` (a
+    :class:`PianoEnv`, or a gymnasium vector of them)."""
     from pianobot.agent.sac import SAC, score_size, vector_size  # torch: only once an agent is built
 
-    space = env.observation_space
+    space = getattr(env, "single_observation_space", env.observation_space)
+    actions = getattr(env, "single_action_space", env.action_space)
     tactile = space["tactile"].shape if "tactile" in space.spaces else None
     score = config.score_input
-    return SAC(vector_size(space, score), score_size(space, score), tactile, env.action_space.shape[0], config)
+    return SAC(vector_size(space, score), score_size(space, score), tactile, actions.shape[0], config, device)
 
 
 def policy_configs(folder: Path) -> tuple[EnvConfig, SACConfig]:
@@ -45,6 +54,32 @@ def policy_configs(folder: Path) -> tuple[EnvConfig, SACConfig]:
         raise PianobotError(
             f"{folder / store.MANIFEST_FILE} describes a world pianobot cannot build ({e}): retrain the phrase with --force"
         ) from None
+
+
+def policy_target(folder: Path) -> Piece | str:
+    """What the policy in ``folder`` was trained on, as its manifest records it: its phrase (a
+    Piece), or the name of its task family (one of :data:`~pianobot.music.tasks.FAMILIES`)."""
+    target = store.read_manifest(folder).get("target")
+    where = folder / store.MANIFEST_FILE
+    if isinstance(target, str):
+        if target not in FAMILIES:
+            raise PianobotError(
+                f"{where}: task {quote(target)} is not one pianobot knows ({', '.join(FAMILIES)}): retrain with --force"
+            )
+        return target
+    try:
+        return Piece(tuple(Note(**note) for note in target))
+    except (TypeError, ValueError, PianobotError) as e:
+        raise PianobotError(
+            f"{where} does not record the phrase it was trained on ({e}): retrain with --force"
+        ) from None
+
+
+def policy_env(folder: Path) -> PianoEnv:
+    """The environment the policy in ``folder`` was trained in, rebuilt from its manifest: its
+    phrase, or fresh instances of its task family each episode."""
+    env_config, _ = policy_configs(folder)
+    return make_env(policy_target(folder), env_config)
 
 
 def load_policy(folder: Path, env: PianoEnv) -> SAC:

@@ -1,4 +1,5 @@
-"""Soft Actor-Critic (paper, section "Soft Actor-Critic"), written for a CPU.
+"""Soft Actor-Critic (paper, section "Soft Actor-Critic"), written for a CPU; it runs on a GPU too
+(``device``, :func:`resolve_device`), and its tensors are always handed out and stored on the CPU.
 
 Networks (paper, "Architecture"): a tactile encoder of three convolution layers shared across
 fingers, a three-layer MLP for the vector inputs (finger targets, wrist, joints; the score
@@ -20,7 +21,8 @@ import torch
 from torch import nn
 from torch.nn import functional as F
 
-from pianobot.agent.config import SACConfig
+from pianobot.agent.config import DEVICES, SACConfig
+from pianobot.errors import PianobotError, quote
 
 # -- observation layout -----------------------------------------------------------------------
 VECTOR_KEYS = ("score", "wrist", "joints", "joint_velocities", "targets", "keys", "key_velocities")
@@ -45,6 +47,15 @@ def split_observation(observation: dict, score: bool = True) -> tuple[np.ndarray
     the score window (an agent that does not read it need not store it)."""
     vector = np.concatenate([np.asarray(observation[k], np.float32).ravel() for k in _keys(score) if k in observation])
     return vector, observation.get("tactile")
+
+
+def split_observations(observations: dict, score: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
+    """:func:`split_observation` for a batch: a vector environment's observations, one row per environment."""
+    count = len(observations["wrist"])
+    vectors = np.concatenate(
+        [np.asarray(observations[k], np.float32).reshape(count, -1) for k in _keys(score) if k in observations], axis=1
+    )
+    return vectors, observations.get("tactile")
 
 
 # -- networks ---------------------------------------------------------------------------------
@@ -182,20 +193,42 @@ def _load_checked(module: nn.Module, state: dict[str, torch.Tensor], prefix: str
     module.load_state_dict(state)
 
 
+def resolve_device(name: str) -> torch.device:
+    """The device the learner runs on: 'cpu', 'cuda', or 'auto' (cuda when torch sees a GPU, else
+    cpu). Asking for cuda where torch sees none is a one-line :class:`PianobotError`."""
+    if name not in DEVICES:
+        raise PianobotError(f"--device {quote(name)}: choose one of {', '.join(DEVICES)}")
+    if name == "auto":
+        name = "cuda" if torch.cuda.is_available() else "cpu"
+    if name == "cuda" and not torch.cuda.is_available():
+        raise PianobotError(
+            f"--device cuda: torch {torch.__version__} sees no CUDA GPU on this machine: use --device cpu, or auto "
+            "(cuda where there is one)"
+        )
+    return torch.device(name)
+
+
 # -- the agent --------------------------------------------------------------------------------
 class SAC:
     """Actor, twin critic with targets, learned temperature; :meth:`update` is one gradient step."""
 
     def __init__(
-        self, vector_dim: int, score_dim: int, tactile_shape, action_dim: int, config: SACConfig = SACConfig()
+        self,
+        vector_dim: int,
+        score_dim: int,
+        tactile_shape,
+        action_dim: int,
+        config: SACConfig = SACConfig(),
+        device: str | torch.device = "cpu",
     ):
         self.config = config
-        self.critic = Critic(vector_dim, score_dim, tactile_shape, action_dim, config)
-        self.target = Critic(vector_dim, score_dim, tactile_shape, action_dim, config)
+        self.device = torch.device(device)
+        self.critic = Critic(vector_dim, score_dim, tactile_shape, action_dim, config).to(self.device)
+        self.target = Critic(vector_dim, score_dim, tactile_shape, action_dim, config).to(self.device)
         self.target.load_state_dict(self.critic.state_dict())
         self.target.requires_grad_(False)
-        self.actor = Actor(self.critic.encoder.out_dim, action_dim, config)
-        self.log_alpha = torch.tensor(math.log(config.initial_alpha), requires_grad=True)
+        self.actor = Actor(self.critic.encoder.out_dim, action_dim, config).to(self.device)
+        self.log_alpha = torch.tensor(math.log(config.initial_alpha), device=self.device, requires_grad=True)
         self.target_entropy = -config.target_entropy_scale * action_dim
         lr = config.learning_rate
         self.critic_optimizer = torch.optim.Adam(self.critic.parameters(), lr=lr)
@@ -213,6 +246,10 @@ class SAC:
         """:func:`split_observation` as this agent reads observations (with or without the score window)."""
         return split_observation(observation, self.config.score_input)
 
+    def split_batch(self, observations: dict) -> tuple[np.ndarray, np.ndarray | None]:
+        """:meth:`split` for a vector environment's observations (:func:`split_observations`)."""
+        return split_observations(observations, self.config.score_input)
+
     # -- acting: the controller interface (reset, act) and training's noisy samples -------------
     def reset(self) -> None:
         """Start of an episode: a policy remembers nothing between steps, so nothing to do."""
@@ -220,17 +257,23 @@ class SAC:
     @torch.no_grad()
     def act(self, observation: dict) -> np.ndarray:
         """The deterministic action for an observation (evaluation and performance)."""
-        return self.actor.deterministic(self._features(*self.split(observation)))[0].numpy()
+        vector, tactile = self.split(observation)
+        features = self._features(vector[None], None if tactile is None else tactile[None])
+        return self.actor.deterministic(features)[0].cpu().numpy()
 
-    @torch.no_grad()
     def sample(self, vector: np.ndarray, tactile: np.ndarray | None) -> np.ndarray:
         """A noisy action from :meth:`split` inputs (training's behaviour policy)."""
-        action, _, _ = self.actor(self._features(vector, tactile))
-        return action[0].numpy()
+        return self.sample_batch(vector[None], None if tactile is None else tactile[None])[0]
 
-    def _features(self, vector: np.ndarray, tactile: np.ndarray | None) -> torch.Tensor:
-        v = torch.from_numpy(np.asarray(vector, np.float32)).unsqueeze(0)
-        t = None if tactile is None else torch.from_numpy(np.asarray(tactile)).unsqueeze(0)
+    @torch.no_grad()
+    def sample_batch(self, vectors: np.ndarray, tactiles: np.ndarray | None) -> np.ndarray:
+        """Noisy actions for a batch of :meth:`split` inputs, one row per environment."""
+        action, _, _ = self.actor(self._features(vectors, tactiles))
+        return action.cpu().numpy()
+
+    def _features(self, vectors: np.ndarray, tactiles: np.ndarray | None) -> torch.Tensor:
+        v = torch.from_numpy(np.asarray(vectors, np.float32)).to(self.device)
+        t = None if tactiles is None else torch.from_numpy(np.asarray(tactiles)).to(self.device)
         return self.critic.encoder(v, t)
 
     def update(self, batch: dict[str, torch.Tensor]) -> dict[str, float]:
@@ -296,7 +339,7 @@ class SAC:
                 for index, state in optimizer.state_dict()["state"].items():
                     for key, value in state.items():
                         out[f"optim.{name}.{index}.{key}"] = value.reshape(-1) if value.dim() == 0 else value
-        return {k: v.detach().contiguous().clone() for k, v in out.items()}
+        return {k: v.detach().cpu().contiguous().clone() for k, v in out.items()}
 
     def load_tensors(self, tensors: dict[str, torch.Tensor], with_training_state: bool = True) -> None:
         """Load :meth:`tensors`' output; raises ValueError naming the first tensor that does not fit."""

@@ -17,6 +17,7 @@ written model; loading never unpickles anything; a corrupt or foreign file is a 
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import hashlib
 import json
 import os
@@ -52,8 +53,12 @@ LOCK_FILE = ".lock"
 
 
 def config_hash(config) -> str:
-    """A stable digest of a (dataclass) training configuration."""
-    return hashlib.sha256(json.dumps(to_dict(config), sort_keys=True, default=str).encode()).hexdigest()[:12]
+    """A stable digest of a (dataclass) training configuration. Its fields marked
+    ``metadata={"runtime": True}`` say how a run executes, not what it trains (``TrainConfig.envs``,
+    ``device``): they are left out, so that the same training finds the same folder however it runs."""
+    runtime = {f.name for f in dataclasses.fields(config) if f.metadata.get("runtime")}
+    fields = {k: v for k, v in to_dict(config).items() if k not in runtime}
+    return hashlib.sha256(json.dumps(fields, sort_keys=True, default=str).encode()).hexdigest()[:12]
 
 
 def model_dir(root: Path, key: str, config) -> Path:

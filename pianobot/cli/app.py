@@ -27,14 +27,14 @@ from pianobot.env.piano import EnvConfig
 from pianobot.env.rewards import RewardConfig
 from pianobot.errors import PianobotError, PianobotWarning, one_line, quote
 from pianobot.files import atomic_write, check_writable, why
-from pianobot.learn.config import TrainConfig
+from pianobot.learn.config import MAX_ENVS, TrainConfig
 from pianobot.learn.explore import EXPLORATIONS
 from pianobot.music.instrument import HandSpec, KeyboardSpec
 from pianobot.music.load import LoadOptions
 from pianobot.music.metrics import DEFAULT_ONSET_TOLERANCE
 from pianobot.music.phrases import DEFAULT_MAX_NOTES
 from pianobot.music.piece import Piece, parse_pitch, pitch_name
-from pianobot.music.tasks import TASKS
+from pianobot.music.tasks import FAMILIES, MELODY, TASKS
 from pianobot.perform.controllers import CONTROLLERS
 from pianobot.sim.world import WorldConfig
 
@@ -568,9 +568,17 @@ def play(
 def train(
     song: Optional[Path] = typer.Argument(None, help="A .mid file with fingering; leave out with --task."),
     task: Optional[str] = typer.Option(
-        None, "--task", help=f"Train on one of the paper's task families instead: {', '.join(TASKS)}."
+        None,
+        "--task",
+        help=f"Train on a task family instead, a fresh random instance each episode: the paper's {', '.join(TASKS)}, "
+        f"or {MELODY} (random one-hand phrases of up to {DEFAULT_MAX_NOTES} notes in every key, fingered by the "
+        "planner; docs/training.md).",
     ),
-    steps: int = typer.Option(TrainConfig.steps, "--steps", help="Environment steps per phrase, exploration included."),
+    steps: int = typer.Option(
+        TrainConfig.steps,
+        "--steps",
+        help="Environment steps per phrase (of all --envs together), exploration included.",
+    ),
     seed: int = typer.Option(
         TrainConfig.seed, "--seed", help="Seed of the simulation, the exploration and the networks."
     ),
@@ -583,7 +591,22 @@ def train(
     threads: int = typer.Option(
         1, "--threads", help="Torch threads per training process (workers x threads should not exceed the cores)."
     ),
-    control: str = typer.Option(WorldConfig.control, "--control", help="Finger control: velocity or torque."),
+    envs: int = typer.Option(
+        TrainConfig.envs,
+        "--envs",
+        help="Environments each policy's training steps at once: 1 in the training process, more each in a worker "
+        "process of its own.",
+    ),
+    device: str = typer.Option(
+        TrainConfig.device,
+        "--device",
+        help="Where the learner's networks and updates run: auto (cuda when torch sees a GPU, else cpu), cpu or cuda.",
+    ),
+    control: str = typer.Option(
+        WorldConfig.control,
+        "--control",
+        help="Finger control: velocity (joint speeds), position (joint angle targets) or torque.",
+    ),
     reward: str = typer.Option(RewardConfig.kind, "--reward", help="Reward: linear, squared or wasserstein."),
     explore: str = typer.Option(
         TrainConfig.explore, "--explore", help=f"Exploration before learning: {', '.join(EXPLORATIONS)}."
@@ -632,6 +655,7 @@ def train(
     from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 
     from pianobot.agent import store
+    from pianobot.agent.sac import resolve_device
     from pianobot.cli import display
     from pianobot.learn.jobs import phrase_jobs, plan_jobs, run_jobs, run_jobs_on_ray, task_job
     from pianobot.learn.log import LOG_FILE, PLOT_FILE
@@ -642,22 +666,32 @@ def train(
 
     if (song is None) == (task is None):
         raise PianobotError("give a .mid file to train on, or --task NAME (not both)")
-    if task is not None and task not in TASKS:
-        raise PianobotError(f"--task {quote(task)}: choose one of {', '.join(TASKS)}")
+    if task is not None and task not in FAMILIES:
+        raise PianobotError(f"--task {quote(task)}: choose one of {', '.join(FAMILIES)}")
     if workers < 1 or threads < 1:
         raise PianobotError(f"--workers {workers} --threads {threads}: give 1 or more of each")
+    if not 1 <= envs <= MAX_ENVS:
+        raise PianobotError(f"--envs {envs}: give 1 to {MAX_ENVS} environments")
     if cluster not in ("local", "ray"):
         raise PianobotError(f"--cluster {quote(cluster)}: choose local or ray")
+    resolve_device(device)  # a GPU asked for and missing: say so before any work
     cores = os.cpu_count() or 1
-    if cluster == "local" and workers * threads > cores:
+    # the environment workers step while the learner waits for them, and the learner updates while they wait
+    busy = workers * max(threads, envs)
+    if cluster == "local" and busy > cores:
+        asked = f"--workers {workers} x --{'threads' if threads >= envs else 'envs'} {max(threads, envs)}"
         warnings.warn(
             PianobotWarning(
-                f"--workers {workers} x --threads {threads} asks for {workers * threads} busy threads on {cores} cores: "
-                f"torch's thread pools then spin against each other (measured up to 20x slower); keep workers x threads <= {cores}"
+                f"{asked} asks for {busy} busy threads on {cores} cores: torch's thread pools then spin against each "
+                f"other (measured up to 20x slower); keep workers x threads (and workers x envs) <= {cores}"
             )
         )
     if task is not None and workers > 1:
-        warnings.warn(PianobotWarning(f"--task trains one policy: --workers {workers} has nothing to share out"))
+        warnings.warn(
+            PianobotWarning(
+                f"--task trains one policy: --workers {workers} has nothing to share out (--envs steps several environments)"
+            )
+        )
     if json_path is not None and str(json_path) != "-":
         check_writable(json_path)
     console = err if json_path is not None and str(json_path) == "-" else out  # standard output carries the JSON
@@ -686,6 +720,8 @@ def train(
             sac=sac,
             env=env,
             eval_episodes=TASK_EVAL_EPISODES if task is not None else TrainConfig.eval_episodes,
+            envs=envs,
+            device=device,
         )
     if task is not None:
         todo, done = plan_jobs([task_job(task, config, models)], force)

@@ -2,7 +2,9 @@
 
 The ids ``pianobot/Piano-v0`` (give ``piece=``) and one per task family (``pianobot/OneNote-v0``,
 ``pianobot/ThreeNote-v0``, ...) are registered with gymnasium on ``import pianobot``; the
-simulator is imported only when ``gymnasium.make`` builds one.
+simulator is imported only when ``gymnasium.make`` builds one. The ``melody`` family has no id:
+its phrases are fingered by the planner, above this layer; ``pianobot.agent.tasks.make_env("melody",
+config)`` makes its environment.
 """
 
 from __future__ import annotations

@@ -1,5 +1,10 @@
 """A gymnasium environment: the hand plays one phrase (or one random task instance) on the keyboard.
 
+A task family comes as a *sampler*, a function that draws a fingered piece from the
+environment's generator at every reset (``sampler=``); ``task=`` names one of the paper's
+families (:mod:`pianobot.music.tasks`), and :mod:`pianobot.agent.tasks` makes the samplers of
+every family, the ``melody`` phrases included (they need the fingering planner, above this layer).
+
 ``step()`` acts on the physics, then observes, then computes the reward. The episode lasts a
 lead-in (the hand gets ready), the phrase, and a short tail; its end is ``truncated``, never
 ``terminated``: nothing about the state makes the future worthless. ``info`` carries the reward
@@ -28,6 +33,8 @@ says how older records are read):
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import partial
+from typing import Callable
 
 import gymnasium as gym
 import numpy as np
@@ -46,6 +53,8 @@ from pianobot.sim.world import PianoWorld, WorldConfig
 
 JOINT_KINDS = ("abd", "mcp", "pip", "dip")
 """Each finger's joints, in action order."""
+Sampler = Callable[[np.random.Generator], Piece]
+"""Draws one task instance, a fingered piece, from a generator (the environment's ``np_random``)."""
 IDLE_HEIGHT = 0.010
 """At the start the fingertips hover this high (m) over the white keys, 40 mm in from their front."""
 
@@ -178,7 +187,8 @@ class EnvConfig:
 
 
 class PianoEnv(gym.Env):
-    """The hand plays ``piece`` (a phrase), or a fresh random instance of ``task`` at each reset."""
+    """The hand plays ``piece`` (a phrase), or a fresh instance from ``sampler`` (or of the
+    paper's task ``task``) at each reset."""
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": WorldConfig.control_hz}
 
@@ -188,14 +198,21 @@ class PianoEnv(gym.Env):
         task: str | None = None,
         config: EnvConfig = EnvConfig(),
         render_mode: str | None = None,
+        sampler: Sampler | None = None,
     ):
-        if (piece is None) == (task is None):
-            raise ValueError("give exactly one of piece= or task=")
-        if task is not None and task not in TASKS:
-            raise ValueError(f"unknown task {task!r}: choose one of {', '.join(TASKS)}")
+        if [piece, task, sampler].count(None) != 2:
+            raise ValueError("give exactly one of piece=, task= or sampler=")
+        if task is not None:
+            if task not in TASKS:
+                raise ValueError(
+                    f"unknown task {task!r}: choose one of {', '.join(TASKS)} (other families come as a "
+                    "sampler=, from pianobot.agent.tasks)"
+                )
+            sampler = partial(make_task, task, keyboard=config.score_spec.keyboard)
         self.config = config
         self.spec_score = config.score_spec
         self.task = task
+        self.sampler = sampler
         self.render_mode = render_mode
         if piece is not None:
             check_playable(piece, self.spec_score.keyboard, self.spec_score.hand)
@@ -265,8 +282,10 @@ class PianoEnv(gym.Env):
 
     def reset(self, *, seed: int | None = None, options: dict | None = None):
         super().reset(seed=seed)
-        if self.task is not None:
-            self._set_piece(make_task(self.task, self.np_random, self.spec_score.keyboard))
+        if self.sampler is not None:
+            piece = self.sampler(self.np_random)
+            check_playable(piece, self.spec_score.keyboard, self.spec_score.hand)
+            self._set_piece(piece)
         world = self.world
         wrist = float(self.np_random.uniform(0.0, world.width)) if self.config.random_start else world.width / 2
         world.reset(wrist, np.tile(idle_pose(self.config.world), self.n_fingers))

@@ -4,11 +4,14 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from pianobot.agent.config import SACConfig
+from pianobot.agent.config import DEVICES, SACConfig
 from pianobot.config import ConfigError, check_ranges, from_dict
 from pianobot.env.piano import EnvConfig
 from pianobot.errors import PianobotError
 from pianobot.learn.explore import EXPLORATIONS
+
+MAX_ENVS = 256
+"""Most environments one run steps at once (``TrainConfig.envs``)."""
 
 
 @dataclass(frozen=True)
@@ -27,8 +30,17 @@ class TrainConfig:
     """Stop early once an evaluation reaches this note F1 (None: always train ``steps`` steps)."""
     sac: SACConfig = field(default_factory=SACConfig)
     env: EnvConfig = field(default_factory=EnvConfig)
+    envs: int = field(default=1, metadata={"runtime": True})
+    """Environments stepped at once: 1 in the training process (the run is exactly what it always
+    was); more, each in a worker process of its own, all stepping together while the learner waits.
+    How a run executes, not what it trains: left out of the configuration's hash (the model folder)."""
+    device: str = field(default="auto", metadata={"runtime": True})
+    """Where the learner (networks, updates, replay batches) runs: 'auto' (cuda when torch sees a
+    GPU, else cpu), 'cpu' or 'cuda'. Left out of the hash too: a run may resume on another device."""
 
     def __post_init__(self) -> None:
+        if self.device not in DEVICES:
+            raise ValueError(f"device must be one of {', '.join(DEVICES)}; got {self.device!r}")
         if self.explore not in EXPLORATIONS:
             raise ValueError(f"exploration must be one of {', '.join(EXPLORATIONS)}; got {self.explore!r}")
         if self.explore == "scripted" and self.env.world.control != "velocity":
@@ -40,7 +52,12 @@ class TrainConfig:
         if self.until_f1 is not None and not 0.0 < self.until_f1 <= 1.0:
             raise ValueError(f"the note F1 to stop at must lie in (0, 1]; got {self.until_f1}")
         check_ranges(
-            self, steps=(1, 10**9), eval_every=(1, 10**9), eval_episodes=(1, 10_000), checkpoint_every=(1, 10**9)
+            self,
+            steps=(1, 10**9),
+            eval_every=(1, 10**9),
+            eval_episodes=(1, 10_000),
+            checkpoint_every=(1, 10**9),
+            envs=(1, MAX_ENVS),
         )
 
 

@@ -140,8 +140,8 @@ def run_jobs_on_ray(
     jobs: list[PhraseJob], config: TrainConfig, on_progress: Callable[[str, Progress], None], threads: int = 1
 ) -> dict[str, dict]:
     """Train every job as a Ray task: on the cluster ``RAY_ADDRESS`` names (Ray's own convention),
-    or on a local Ray runtime when it is unset. Each task asks for ``threads`` CPUs and trains with
-    as many torch threads; progress comes back through a Ray queue. Every node must see the model
+    or on a local Ray runtime when it is unset. Each task asks for ``threads`` CPUs (or
+    ``config.envs``, when more: its environment workers) and trains with ``threads`` torch threads; progress comes back through a Ray queue. Every node must see the model
     folders at the same path (a shared file system): checkpoints are written and resumed there."""
     try:
         import ray
@@ -153,7 +153,7 @@ def run_jobs_on_ray(
         ray.init(include_dashboard=False, log_to_driver=False, configure_logging=False)
     try:
         queue = Queue()
-        task = ray.remote(num_cpus=threads, max_retries=0)(_run_job)
+        task = ray.remote(num_cpus=max(threads, config.envs), max_retries=0)(_run_job)
         refs = {task.remote(job, config, queue, threads): job for job in jobs}
         pending, results = list(refs), {}
 

@@ -8,25 +8,32 @@ buffer, random generators), so that running the same command again continues exa
 interrupted run stopped. The policy stored at the end is the best one evaluated (SAC's
 evaluations swing by tenths of F1 from one to the next; the last is not always the best).
 Every episode is logged beside the policy (:mod:`pianobot.learn.log`: CSV, TensorBoard, a plot).
+With ``TrainConfig.envs`` > 1 the loop steps that many environments at once, in worker processes
+(:func:`make_envs`); with 1, the default, its one environment in this process, as it always did.
 Training a whole piece (one job per phrase, parallel workers) is :mod:`pianobot.learn.jobs`.
 """
 
 from __future__ import annotations
 
+import contextlib
 import time
 from dataclasses import asdict, dataclass
+from functools import partial
 from pathlib import Path
 from typing import Callable
 
+import gymnasium as gym
 import numpy as np
 import torch
+from gymnasium.vector import AutoresetMode
 
 from pianobot.agent import store
 from pianobot.agent.buffer import ReplayBuffer
 from pianobot.agent.policy import make_agent
-from pianobot.agent.sac import SAC, vector_size
+from pianobot.agent.sac import SAC, resolve_device, vector_size
+from pianobot.agent.tasks import make_env
 from pianobot.config import to_dict
-from pianobot.env.piano import EnvConfig, PianoEnv
+from pianobot.env.piano import EnvConfig
 from pianobot.learn.config import TrainConfig
 from pianobot.learn.explore import Explorer
 from pianobot.learn.log import TrainingLog
@@ -57,12 +64,37 @@ class Progress:
     """True once, when the policy is stored (``step``: the steps it took)."""
 
 
-def make_env(target: Piece | str, env_config: EnvConfig) -> PianoEnv:
-    return (
-        PianoEnv(task=target, config=env_config)
-        if isinstance(target, str)
-        else PianoEnv(piece=target, config=env_config)
-    )
+def make_envs(target: Piece | str, env_config: EnvConfig, count: int) -> gym.vector.VectorEnv:
+    """``count`` environments of a phrase or task family (:func:`~pianobot.agent.tasks.make_env`),
+    stepped together: one in this process (the run is exactly what it always was), more each in a
+    worker process of its own (spawned: they import the simulator, never torch). None resets by
+    itself: the loop begins an environment's next episode once the last one is logged and checkpointed."""
+    factories = [partial(make_env, target, env_config)] * count
+    if count == 1:
+        return gym.vector.SyncVectorEnv(factories, autoreset_mode=AutoresetMode.DISABLED)
+    return gym.vector.AsyncVectorEnv(factories, context="spawn", autoreset_mode=AutoresetMode.DISABLED)
+
+
+def env_generators(envs: gym.vector.VectorEnv) -> list[dict]:
+    """The state of each environment's generator (the hand starts and task instances still to come)."""
+    return [generator.bit_generator.state for generator in envs.get_attr("np_random")]
+
+
+def resume_envs(envs: gym.vector.VectorEnv, states: list[dict] | dict, seed: int, step: int) -> dict:
+    """Begin new episodes where a checkpoint's generators (:func:`env_generators`) left off; the
+    first observations. With one environment a resumed run goes on exactly as an uninterrupted one;
+    with more, the episodes under way at the checkpoint begin anew (docs/training.md). A checkpoint
+    of another number of environments gives generators seeded afresh from ``seed`` and ``step``."""
+    states = states if isinstance(states, list) else [states]  # (checkpoints from before --envs held one)
+    same = len(states) == envs.num_envs
+    envs.reset(seed=seed if same else seed + step)  # makes the generators ...
+    if same:  # ... and sets them where they were
+        generators = [np.random.default_rng() for _ in states]
+        for generator, state in zip(generators, states):
+            generator.bit_generator.state = state
+        envs.set_attr("np_random", generators)
+    observations, _ = envs.reset()
+    return observations
 
 
 def evaluate(
@@ -119,32 +151,41 @@ def train_policy(
     """
     with store.training_lock(folder), TrainingLog(folder) as log:
         store.remove_temporary_files(folder)
-        return _train(target, config, folder, report, stop_after, about, log)
+        device = resolve_device(config.device)
+        with contextlib.closing(make_envs(target, config.env, config.envs)) as envs:
+            return _train(target, config, folder, report, stop_after, about, log, envs, device)
 
 
 def _train(
-    target, config: TrainConfig, folder: Path, report, stop_after: int | None, about: dict | None, log: TrainingLog
+    target,
+    config: TrainConfig,
+    folder: Path,
+    report,
+    stop_after: int | None,
+    about: dict | None,
+    log: TrainingLog,
+    envs: gym.vector.VectorEnv,
+    device: torch.device,
 ) -> dict:
     torch.manual_seed(config.seed)  # before the networks are made: their first weights come from it
-    env_config = config.env
-    env = make_env(target, env_config)
-    agent = make_agent(env, config.sac)
-    space = env.observation_space
+    env_config, n = config.env, config.envs
+    agent = make_agent(envs, config.sac, device)
+    space, action_size = envs.single_observation_space, envs.single_action_space.shape[0]
     tactile_shape = space["tactile"].shape if "tactile" in space.spaces else None
     buffer = ReplayBuffer(
         min(config.sac.buffer_size, config.steps),
         vector_size(space, config.sac.score_input),
         tactile_shape,
-        env.action_space.shape[0],
+        action_size,
     )
     rng = np.random.default_rng(config.seed)
-    explorer = Explorer(config.explore, env.action_space.shape[0], env_config, rng)
+    explorers = [Explorer(config.explore, action_size, env_config, rng) for _ in range(n)]  # one per environment
     step, episode, update_debt, evaluations = 0, 0, 0.0, []
     best, best_tensors = None, None  # the best evaluation so far and its policy's tensors
     seconds_before = 0.0  # wall-clock time spent before an interruption
 
     checkpoint = store.load_checkpoint(folder)
-    if checkpoint is not None:  # continue an interrupted run exactly
+    if checkpoint is not None:  # continue an interrupted run (exactly, with one environment)
         tensors, state, buffer_folder = checkpoint
         agent.load_tensors({k: v for k, v in tensors.items() if not k.startswith(BEST_PREFIX)})
         if state.get("best") is not None:
@@ -161,43 +202,44 @@ def _train(
         )
         agent.updates = state["updates"]
         seconds_before = state.get("seconds", 0.0)
-        env.reset(seed=config.seed)  # creates the env's generator, then restore its state
-        env.np_random.bit_generator.state = state["env_rng"]
-        observation, _ = env.reset()
+        observations = resume_envs(envs, state["env_rng"], config.seed, step)
         report(Progress(step, config.steps, resumed=True))
     else:
-        observation, _ = env.reset(seed=config.seed)
+        observations, _ = envs.reset(seed=config.seed)
         state = {}
     log.start(resumed_at=step if checkpoint is not None else None)
-    explorer.reset()
+    for explorer in explorers:
+        explorer.reset()
     # an evaluation that was due (but waited for exploration to end) stays due
     next_eval = state.get("next_eval", (step // config.eval_every + 1) * config.eval_every)
     next_checkpoint = (step // config.checkpoint_every + 1) * config.checkpoint_every
-    episode_return, losses, final = 0.0, None, None
+    returns, losses, final = np.zeros(n), None, None
     started = time.perf_counter()
 
     while step < config.steps:
-        vector, tactile = agent.split(observation)
-        taught = explorer.teach(observation)  # the scripted pianist's action here, or None
+        # act in every environment: explore (the teacher's action plus noise), then sample the policy
+        vectors, tactiles = agent.split_batch(observations)
+        each = [{k: v[i] for k, v in observations.items()} for i in range(n)]  # each environment's observation
+        taught = [explorer.teach(o) for explorer, o in zip(explorers, each)]  # the scripted pianist's actions, or None
         if step < config.sac.exploration_steps:
-            action = explorer.act(observation, taught)
+            actions = np.stack([explorer.act(o, t) for explorer, o, t in zip(explorers, each, taught)])
         else:
-            action = agent.sample(vector, tactile)
-        observation, reward, terminated, truncated, _ = env.step(action)
-        next_vector, next_tactile = agent.split(observation)
-        buffer.add(vector, tactile, action, reward, terminated, next_vector, next_tactile, expert=taught)
-        episode_return += reward
-        step += 1
+            actions = agent.sample_batch(vectors, tactiles)
+        # step them all (with envs > 1, each in its worker process, at the same time) and store what happened
+        observations, rewards, terminations, truncations, _ = envs.step(actions)
+        next_vectors, next_tactiles = agent.split_batch(observations)
+        buffer.add_batch(vectors, tactiles, actions, rewards, terminations, next_vectors, next_tactiles, taught)
+        returns += rewards
+        step += n
 
         if step > config.sac.exploration_steps:  # learn
-            update_debt += config.sac.update_ratio
+            update_debt += config.sac.update_ratio * n
             while update_debt >= 1.0:
-                losses = agent.update(buffer.sample(config.sac.batch_size, rng))
+                losses = agent.update(buffer.sample(config.sac.batch_size, rng, agent.device))
                 update_debt -= 1.0
 
-        if terminated or truncated:
-            episode += 1
-            report(Progress(step, config.steps, episode_return=episode_return, losses=losses))
+        ended = terminations | truncations
+        if ended.any():  # episodes ended: evaluate if due, log them, checkpoint if due, begin new ones
             figures = None
             if step >= next_eval and step > config.sac.exploration_steps:
                 figures = evaluate(agent, target, env_config, config.eval_episodes)
@@ -208,8 +250,12 @@ def _train(
                 report(Progress(step, config.steps, eval_f1=figures["f1"]))
                 next_eval = (step // config.eval_every + 1) * config.eval_every
             seconds = seconds_before + time.perf_counter() - started
-            log.row(step, episode, seconds, episode_return, losses, figures)
-            episode_return = 0.0
+            logged = figures  # on the first episode's row
+            for i in np.flatnonzero(ended):
+                episode += 1
+                report(Progress(step, config.steps, episode_return=float(returns[i]), losses=losses))
+                log.row(step, episode, seconds, float(returns[i]), losses, logged)
+                returns[i], logged = 0.0, None
             if figures is not None and config.until_f1 is not None and figures["f1"] >= config.until_f1:
                 final = {"step": step, **figures}  # good enough: stop here
                 break
@@ -221,7 +267,7 @@ def _train(
                     "updates": agent.updates,
                     "evaluations": evaluations,
                     "rng": rng.bit_generator.state,
-                    "env_rng": env.np_random.bit_generator.state,
+                    "env_rng": env_generators(envs),
                     "buffer_size": buffer.size,
                     "buffer_cursor": buffer.cursor,
                     "best": best,
@@ -234,13 +280,12 @@ def _train(
                 )
                 next_checkpoint = (step // config.checkpoint_every + 1) * config.checkpoint_every
             if stop_after is not None and step >= stop_after:
-                env.close()
                 return {"interrupted_at": step}
-            observation, _ = env.reset()
-            explorer.reset()
-        elif step % 200 == 0:
+            observations, _ = envs.reset(options={"reset_mask": ended})
+            for i in np.flatnonzero(ended):
+                explorers[i].reset()
+        elif step % 200 < n:
             report(Progress(step, config.steps))
-    env.close()
 
     tensors = agent.tensors(with_training_state=False)
     if final is None:
@@ -250,10 +295,11 @@ def _train(
             final, tensors = best, best_tensors
     manifest = {
         **(about or {}),
-        "target": target if isinstance(target, str) else [asdict(n) for n in target.notes],
+        "target": target if isinstance(target, str) else [asdict(note) for note in target.notes],
         "steps": step,
         "updates": agent.updates,
         "seconds": round(seconds_before + time.perf_counter() - started, 1),  # across interruptions
+        "device": device.type,
         "evaluation": final,
         "evaluations": evaluations,
         "config": to_dict(config),

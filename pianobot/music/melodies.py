@@ -7,6 +7,11 @@ keyboard, in quarters, eighths, dotted quarters with their eighth, triplet eight
 with rests between phrases and notes, at 60–144 bpm, at velocities 20–127 (a phrase's dynamic
 level with accents and swells around it). Notes carry no fingering: finger them with
 :func:`pianobot.pianist.fingering.ensure_fingering`.
+
+Keyword options widen or narrow the draw: ``velocities`` (the dynamics' range), ``chords``
+(two-note chords) and ``max_notes`` (a bound on the notes in all); :func:`random_phrase` uses
+them to draw the phrases of the ``melody`` task family. Left at their defaults they draw
+exactly the melodies they always drew, so every seed keeps its melody.
 """
 
 from __future__ import annotations
@@ -17,6 +22,7 @@ from typing import Callable
 import numpy as np
 
 from pianobot.music.instrument import KeyboardSpec
+from pianobot.music.phrases import DEFAULT_MAX_NOTES
 from pianobot.music.piece import Note, Piece, pitch_name
 
 MAJOR = (0, 2, 4, 5, 7, 9, 11)
@@ -26,6 +32,9 @@ TONICS = ("C", "C#", "D", "Eb", "E", "F", "F#", "G", "Ab", "A", "Bb", "B")
 BPM_RANGE = (60.0, 144.0)
 VELOCITY_RANGE = (20, 127)
 NOTE_RANGE = (8, 16)
+CHORD_INTERVALS = ((2, 0.5), (3, 0.25), (4, 0.25))
+"""The second note of a two-note chord: scale degrees above the melody's (a third, fourth or
+fifth; below it where the keyboard ends), with their probabilities."""
 
 # rhythm cells in beats: each is played as a group of notes
 _CELLS = (
@@ -69,8 +78,15 @@ def random_melody(
     key: MelodyKey | None = None,
     notes: int | None = None,
     bpm: float | None = None,
+    *,
+    velocities: tuple[int, int] = VELOCITY_RANGE,
+    chords: float = 0.0,
+    max_notes: int | None = None,
 ) -> Piece:
-    """One random single-voice melody (see the module docstring); ``key``, ``notes`` and ``bpm`` are drawn when None."""
+    """One random melody (see the module docstring); ``key``, ``notes`` (onsets) and ``bpm`` are
+    drawn when None. ``velocities``: the (lowest, highest) velocity of its dynamics. ``chords``:
+    the chance that a note gets a second note with it (:data:`CHORD_INTERVALS`), a two-note chord,
+    while the melody holds fewer than ``max_notes`` notes in all (None: no bound on chords)."""
     if key is None:
         key = MelodyKey(int(rng.integers(0, 12)), bool(rng.random() < 0.4))
     count = int(rng.integers(NOTE_RANGE[0], NOTE_RANGE[1] + 1)) if notes is None else notes
@@ -113,9 +129,9 @@ def random_melody(
         if rng.random() < 0.15:
             rests[-1] = float(rng.choice([0.5, 1.0]))
 
-    # dynamics: a level per phrase of 4-8 notes, accents and swells around it, within 20-127
-    low, high = VELOCITY_RANGE
-    velocities = []
+    # dynamics: a level per phrase of 4-8 notes, accents and swells around it, within the velocity range
+    low, high = velocities
+    dynamics = []
     level = float(rng.uniform(low, high))
     swell = 0.0
     for i in range(count):
@@ -125,16 +141,64 @@ def random_melody(
         velocity = level + swell * (i % 8) + rng.normal(0, 6)
         if rng.random() < 0.12:
             velocity += float(rng.uniform(15, 35))  # an accent
-        velocities.append(int(np.clip(round(velocity), low, high)))
+        dynamics.append(int(np.clip(round(velocity), low, high)))
 
     # articulation: legato, normal or staccato, as a fraction of the time to the next onset
     out, time = [], 0.0
-    for pitch, length, rest, velocity in zip(pitches, lengths, rests, velocities):
+    for pitch, length, rest, velocity in zip(pitches, lengths, rests, dynamics):
         duration = length * beat
         fraction = float(rng.choice([0.95, 0.8, 0.5], p=[0.4, 0.45, 0.15]))
         out.append(Note(time, pitch, time + max(duration * fraction, 0.06), velocity))
         time += duration + rest * beat
+    if chords > 0:  # drawn after everything else, so that chords=0 keeps every seed's melody
+        out = _with_chords(rng, out, degrees, scale, chords, max_notes)
     return Piece(tuple(out), bpm=bpm)
+
+
+def _with_chords(
+    rng: np.random.Generator, melody: list[Note], degrees: list[int], scale: list[int], chance: float, most: int | None
+) -> list[Note]:
+    """The melody with a second note (:data:`CHORD_INTERVALS`) sounding with some of its notes."""
+    steps, weights = zip(*CHORD_INTERVALS)
+    out = list(melody)
+    for note, degree in zip(melody, degrees):
+        if most is not None and len(out) >= most:
+            break
+        if rng.random() >= chance:
+            continue
+        step = int(rng.choice(steps, p=np.array(weights) / sum(weights)))
+        other = degree + step if degree + step < len(scale) else degree - step
+        out.append(Note(note.onset, scale[other], note.offset, note.velocity))
+    return out
+
+
+PHRASE_VELOCITY_RANGE = (30, 120)
+"""Velocities of the ``melody`` task family's phrases."""
+PHRASE_CHORDS = 0.25
+"""The ``melody`` task family's chance that a note gets a second note with it (a two-note chord)."""
+
+
+def random_phrase(
+    rng: np.random.Generator,
+    keyboard: KeyboardSpec = KeyboardSpec(),
+    key: MelodyKey | None = None,
+    max_notes: int = DEFAULT_MAX_NOTES,
+) -> Piece:
+    """One phrase of the ``melody`` task family (docs/training.md, "The melody task family"): a
+    :func:`random_melody` of 1 to ``max_notes`` onsets (uniform), with two-note chords
+    (:data:`PHRASE_CHORDS`) while it holds fewer than ``max_notes`` notes, at velocities
+    :data:`PHRASE_VELOCITY_RANGE`; the key (``key``, else any of the 24), tempo, motion, rhythm and
+    rests as :func:`random_melody` draws them. Unfingered, like every melody here."""
+    onsets = int(rng.integers(1, max_notes + 1))
+    return random_melody(
+        rng,
+        keyboard,
+        key,
+        notes=onsets,
+        velocities=PHRASE_VELOCITY_RANGE,
+        chords=PHRASE_CHORDS,
+        max_notes=max_notes,
+    )
 
 
 def describe(piece: Piece) -> str:

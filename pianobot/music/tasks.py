@@ -11,6 +11,9 @@ hand position the index, middle and ring fingers lie over three neighbouring whi
 the hand moves at most :data:`MAX_SHIFT` white keys from one position to the next (a jump
 across the whole keyboard between two legato notes is beyond what a 0.5 s score lookahead
 lets a hand prepare). A task instance is drawn from a NumPy generator, so a seed fixes it.
+
+Our ``melody`` family (random one-hand phrases in every key, :data:`MELODY`) needs the fingering
+planner, so :mod:`pianobot.agent.tasks` draws it; this module only names it.
 """
 
 from __future__ import annotations
@@ -21,6 +24,13 @@ from pianobot.music.instrument import KeyboardSpec
 from pianobot.music.piece import Note, Piece
 
 TASKS = ("one-note", "three-note", "six-note", "rhythmic", "chord")
+"""The paper's task families, drawn by :func:`make_task`."""
+MELODY = "melody"
+"""Our family of realistic one-hand phrases (:func:`pianobot.music.melodies.random_phrase`). Its
+instances are fingered by the fingering planner, which lies above the environment, so they are
+drawn by :mod:`pianobot.agent.tasks` and handed to the environment as a sampler."""
+FAMILIES = TASKS + (MELODY,)
+"""Every task family ``pianobot train --task`` trains on."""
 BPM = 60.0
 FINGERS = (2, 3, 4)
 MAX_SHIFT = 4

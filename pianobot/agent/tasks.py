@@ -1,0 +1,65 @@
+"""Task families by name, as the environment takes them: a sampler that draws a fingered piece.
+
+The paper's five families (:mod:`pianobot.music.tasks`) are fingered by construction. The
+``melody`` family draws a phrase with :func:`pianobot.music.melodies.random_phrase` and fingers it
+with the fingering planner (:mod:`pianobot.pianist.fingering`); a phrase the planner says this
+hand cannot play (it reports problems, or raises an error) is drawn again, with the next draw of
+the same generator, so the environment's seed fixes every instance. The environment cannot do
+this itself: the planner lies above it (docs/architecture.md). Training, evaluation and a stored
+policy's manifest (:func:`pianobot.agent.policy.policy_env`) all turn a target into an
+environment with :func:`make_env`.
+"""
+
+from __future__ import annotations
+
+from functools import partial
+
+import numpy as np
+
+from pianobot.env.piano import EnvConfig, PianoEnv, Sampler
+from pianobot.errors import PianobotError
+from pianobot.music.instrument import check_playable
+from pianobot.music.melodies import MelodyKey, random_phrase
+from pianobot.music.piece import Piece
+from pianobot.music.tasks import FAMILIES, MELODY, TASKS, make_task
+from pianobot.pianist.fingering import plan_fingering
+
+MAX_DRAWS = 1_000
+"""Draws of the ``melody`` family before giving up (the planner turns down about 1 in 8: docs/training.md)."""
+
+
+def draw_melody(rng: np.random.Generator, config: EnvConfig = EnvConfig(), key: MelodyKey | None = None) -> Piece:
+    """One instance of the ``melody`` family for the keyboard and hand of ``config``: the first
+    :func:`~pianobot.music.melodies.random_phrase` from ``rng`` (in ``key``, else any) that the
+    planner fingers without problems."""
+    keyboard, hand = config.world.keyboard, config.world.hand
+    for _ in range(MAX_DRAWS):
+        phrase = random_phrase(rng, keyboard.spec, key)
+        try:
+            check_playable(phrase, keyboard.spec, hand.spec)
+            plan = plan_fingering(phrase, keyboard, hand)
+        except PianobotError:  # a chord wider than the hand, notes it cannot get to
+            continue
+        if not plan.problems:  # no note faster than this hand can play it
+            return plan.piece
+    raise PianobotError(
+        f"no melody phrase in {MAX_DRAWS} draws that this hand can play on {keyboard.spec.describe()}: "
+        "widen the keyboard or give the hand more fingers"
+    )
+
+
+def task_sampler(name: str, config: EnvConfig = EnvConfig()) -> Sampler:
+    """The sampler of the task family ``name`` (one of :data:`~pianobot.music.tasks.FAMILIES`)
+    in the environment ``config`` describes: a function from a generator to a fingered piece."""
+    if name == MELODY:
+        return partial(draw_melody, config=config)
+    if name in TASKS:
+        return partial(make_task, name, keyboard=config.world.keyboard.spec)
+    raise ValueError(f"unknown task {name!r}: choose one of {', '.join(FAMILIES)}")
+
+
+def make_env(target: Piece | str, config: EnvConfig) -> PianoEnv:
+    """The environment of a phrase (a Piece), or of a task family (its name): a fresh instance each episode."""
+    if isinstance(target, str):
+        return PianoEnv(sampler=task_sampler(target, config), config=config)
+    return PianoEnv(piece=target, config=config)
