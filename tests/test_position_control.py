@@ -57,3 +57,12 @@ def test_the_scripted_pianist_plays_in_position_control(task):
 def test_torque_control_has_no_scripted_pianist():
     with pytest.raises(ValueError, match="velocity' or 'position'"):
         ScriptedPianist(EnvConfig(tactile=False, world=WorldConfig(control="torque")))
+
+
+def test_the_teacher_explores_in_position_control_but_not_in_torque_control():
+    from pianobot.learn.config import TrainConfig
+
+    TrainConfig(explore="scripted", env=POSITION)  # accepted
+    torque = replace(POSITION, world=WorldConfig(control="torque"))
+    with pytest.raises(ValueError, match="velocity or position control"):
+        TrainConfig(explore="scripted", env=torque)

@@ -513,8 +513,8 @@ def play(
                 raise PianobotError(
                     f"the policies in {models} were trained for another keyboard or hand: use the same --lowest-note/--keys/--thumb"
                 )
-        if missing and config.world.control != "velocity":
-            raise PianobotError("--fallback scripted needs policies trained with --control velocity")
+        if missing and config.world.control == "torque":
+            raise PianobotError("--fallback scripted needs policies trained with --control velocity or position")
 
         def who(env):
             composed = CompositionalController(env, phrases, models, fallback is not None)

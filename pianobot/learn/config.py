@@ -43,8 +43,10 @@ class TrainConfig:
             raise ValueError(f"device must be one of {', '.join(DEVICES)}; got {self.device!r}")
         if self.explore not in EXPLORATIONS:
             raise ValueError(f"exploration must be one of {', '.join(EXPLORATIONS)}; got {self.explore!r}")
-        if self.explore == "scripted" and self.env.world.control != "velocity":
-            raise ValueError("scripted exploration needs velocity control (the scripted pianist drives joint speeds)")
+        if self.explore == "scripted" and self.env.world.control == "torque":
+            raise ValueError(
+                "scripted exploration needs velocity or position control (the scripted pianist has no torques)"
+            )
         if not 0 <= self.sac.exploration_steps < self.steps:
             raise ValueError(
                 f"{self.steps} steps must exceed the {self.sac.exploration_steps} exploration steps, or nothing is learnt"

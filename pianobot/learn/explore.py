@@ -32,7 +32,7 @@ class Explorer:
         if kind not in EXPLORATIONS:
             raise ValueError(f"exploration must be one of {', '.join(EXPLORATIONS)}; got {kind!r}")
         self.kind, self.size, self.rng = kind, action_size, rng
-        self.pianist = ScriptedPianist(config) if kind == "scripted" else None  # needs velocity control
+        self.pianist = ScriptedPianist(config) if kind == "scripted" else None  # needs velocity or position control
         self.previous: np.ndarray | None = None
         self.noise = 0.0
 
