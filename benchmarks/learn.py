@@ -103,10 +103,8 @@ def progress(task: str, seed: int, args) -> dict | None:
             "finished": True,
             **({"check": json.loads(held.read_text())} if held.exists() else {}),
         }
-    state = folder / store.CHECKPOINT_DIR / "state.json"
-    if state.exists():
-        return {**json.loads(state.read_text()), "finished": False}
-    return None
+    state = store.checkpoint_state(folder)
+    return None if state is None else {**state, "finished": False}
 
 
 def main() -> None:

@@ -1,0 +1,216 @@
+"""benchmarks/paper.py: the paper's experiments expand to the right runs, a run resumes, the report
+tables mean ± std, and every policy is judged with the linear reward. One tiny training run
+(300 steps, cut off at its first checkpoint and resumed) serves the slow tests."""
+
+from __future__ import annotations
+
+import sys
+from dataclasses import replace
+from pathlib import Path
+
+import pytest
+import torch
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.append(str(ROOT / "benchmarks"))
+
+import paper  # noqa: E402
+
+from pianobot.agent import store  # noqa: E402
+from pianobot.agent.policy import load_policy  # noqa: E402
+from pianobot.agent.tasks import make_env  # noqa: E402
+from pianobot.env.rewards import RewardConfig  # noqa: E402
+from pianobot.learn.config import TrainConfig  # noqa: E402
+from pianobot.perform.rollout import rollout  # noqa: E402
+
+torch.set_num_threads(1)
+
+ALLOWED = {  # what the arms of an experiment may differ in, setting, task and seed alike
+    "tasks": {"env.tactile"},
+    "rhythm-chord": set(),
+    "rewards": {"env.reward.kind"},
+    "exploration": {"explore"},
+    "control": {"env.world.control"},
+    "fingering": {"env.reward.fingering_gate"},
+}
+TINY = ["--setting", "paper", "--seeds", "1", "--steps", "300", "--exploration-steps", "150"]
+TINY += ["--eval-every", "100", "--eval-episodes", "1", "--check-episodes", "1"]
+
+
+def options(tmp_path, **changes) -> paper.Options:
+    return replace(paper.Options(store=tmp_path, seeds=2), **changes)
+
+
+@pytest.mark.parametrize(
+    "name, runs",
+    [("tasks", 24), ("rhythm-chord", 8), ("rewards", 12), ("exploration", 14), ("control", 8), ("fingering", 8)],
+)
+def test_every_experiment_expands_to_its_arms_settings_tasks_and_seeds(tmp_path, name, runs):
+    expanded = paper.expand(name, options(tmp_path))
+    assert len(expanded) == runs
+    assert {r.setting for r in expanded} == {"paper", "ours"} and {r.seed for r in expanded} == {0, 1}
+    assert paper.expand(str(paper.EXPERIMENTS[name].number), options(tmp_path)) == expanded  # 1-7 name them too
+    groups: dict[tuple, list] = {}
+    for run in expanded:
+        assert len(run.jobs) == 1 and run.jobs[0].target == run.task  # one policy per run, on the task family
+        groups.setdefault((run.setting, run.task, run.seed), []).append(run)
+    for arms in groups.values():
+        assert sorted(r.variant for r in arms) == sorted({r.variant for r in arms})  # each arm once
+        for run in arms[1:]:
+            assert set(paper.differences(run.config, arms[0].config)) <= ALLOWED[name], (run.variant, name)
+
+
+def test_the_tables_arms_are_the_papers():
+    names = {e.name: [(v.name, v.paper_name) for v in e.variants] for e in paper.EXPERIMENTS.values()}
+    assert [n for n, _ in names["rewards"]] == ["linear", "squared", "wasserstein"]
+    assert names["exploration"][:3] == [
+        ("prior", "Prior Explore"),
+        ("repeat", "Uniform Move Hand"),
+        ("uniform", "No Action Repeat"),
+    ]
+    assert paper.experiment_named("1").tasks == ("one-note", "three-note", "six-note")
+    assert paper.experiment_named("2").tasks == ("rhythmic", "chord")
+    assert paper.experiment_named("1").baselines == ("scripted", "random")
+
+
+def test_the_paper_setting_is_plain_sac_without_our_additions(tmp_path):
+    for name in paper.EXPERIMENTS:
+        for run in paper.expand(name, options(tmp_path, seeds=1, settings=("paper",))):
+            config = run.config
+            assert config.explore != "scripted" and config.sac.demo_weight == 0  # no teacher
+            assert config.env.reward.closeness_weight == 0  # no closeness bonus
+            assert not config.env.target_observations and config.sac.score_input  # the paper's observation
+            assert config.sac.learning_rate == 1e-3 and config.sac.initial_alpha == 0.02  # its hyperparameters
+            assert config.sac.exploration_steps == 15_000
+
+
+def test_the_ours_setting_is_pianobots_defaults_but_for_the_arm(tmp_path):
+    for run in paper.expand("rewards", options(tmp_path, seeds=1, settings=("ours",))):
+        base = TrainConfig(steps=run.config.steps, eval_episodes=run.config.eval_episodes)
+        assert set(paper.differences(run.config, base)) <= {"env.reward.kind"}
+    for run in paper.expand("control", options(tmp_path, seeds=1, settings=("ours",))):
+        assert run.config.explore == "prior"  # the scripted teacher has no torques: both arms explore alike
+
+
+def test_steps_default_to_the_papers_budget_and_can_be_set(tmp_path):
+    assert {r.config.steps for r in paper.expand("tasks", options(tmp_path))} == {200_000}  # paper: 2e5
+    assert {r.config.steps for r in paper.expand("rewards", options(tmp_path))} == {paper.ABLATION_STEPS}
+    assert {r.config.steps for r in paper.expand("rewards", options(tmp_path, steps=40_000))} == {40_000}
+    _, parsed = paper.parse(
+        ["rewards", "--seeds", "5", "--setting", "paper", "--steps", "50000", "--tasks", "one-note"]
+    )
+    runs = paper.expand("rewards", parsed)
+    assert len(runs) == 15 and {r.task for r in runs} == {"one-note"} and {r.seed for r in runs} == set(range(5))
+
+
+def test_equal_configurations_share_one_folder_across_experiments(tmp_path):
+    """The paper setting's linear / prior / velocity / gated run is one run in experiments 3-6."""
+    folders = [
+        next(r for r in paper.expand(name, options(tmp_path, seeds=1, settings=("paper",))) if r.variant == arm)
+        .jobs[0]
+        .folder
+        for name, arm in (
+            ("rewards", "linear"),
+            ("exploration", "prior"),
+            ("control", "velocity"),
+            ("fingering", "gate"),
+        )
+    ]
+    assert len(set(folders)) == 1
+
+
+def test_compose_trains_growing_pieces_end_to_end_with_the_same_total_steps(tmp_path):
+    runs = paper.expand("compose", options(tmp_path, steps=20_000))
+    assert len(runs) == 2 * 2 * len(paper.Options.lengths) * 2
+    for setting in paper.SETTINGS:
+        for seed in (0, 1):
+            mine = [r for r in runs if r.setting == setting and r.seed == seed]
+            notes = []
+            for composed, single in zip(mine[::2], mine[1::2]):
+                assert (composed.variant, single.variant) == ("compositional", "end-to-end")
+                assert composed.piece == single.piece
+                assert len(single.jobs) == 1 and len(single.jobs[0].target) == len(single.piece)  # the whole piece
+                assert all(len(job.target) <= 6 for job in composed.jobs)  # phrases
+                assert composed.config.steps == 20_000
+                assert single.config.steps == 20_000 * len(composed.jobs)  # the same total steps
+                assert set(paper.differences(single.config, composed.config)) <= {"steps"}  # nothing else
+                notes.append(len(composed.piece))
+            assert notes == sorted(notes) and len(set(notes)) == len(notes)  # growing pieces
+            assert len({job.folder.parent for r in mine for job in r.jobs}) == 1  # shared phrases train once
+
+
+@pytest.fixture(scope="module")
+def tiny(tmp_path_factory):
+    """The paper setting's squared-reward run of the rewards experiment, 300 steps: cut off after
+    its first checkpoint, then rerun with the same command."""
+    root = tmp_path_factory.mktemp("paper")
+    args = [*TINY, "--store", str(root), "--plots", str(root / "plots"), "--variants", "squared"]
+    _, opts = paper.parse(["rewards", *args])
+    (run,) = paper.expand("rewards", opts)
+    assert run.variant == "squared" and run.config.env.reward.kind == "squared"
+    cut = paper.train_job(run.jobs[0], run.config, "tiny", stop_after=150)
+    assert cut["state"] == "interrupted"
+    return root, args, opts, run
+
+
+def test_a_run_resumes_rather_than_restarts_when_rerun(tiny, capsys):
+    root, args, opts, run = tiny
+    folder = run.jobs[0].folder
+    cut_at = store.checkpoint_state(folder)["step"]
+    assert 150 <= cut_at < 300 and not store.is_trained(folder)
+
+    paper.main(["rewards", *args, "--report", "--check"])  # an unfinished run is reported, its best policy judged
+    printed = capsys.readouterr().out
+    assert f"(at {cut_at} steps)" in printed and "| paper | three-note | squared | 1 / 0 / 1 / 1 |" in printed
+
+    paper.main(["rewards", *args])
+    printed = capsys.readouterr().out
+    assert f"resuming from its checkpoint at step {cut_at}" in printed
+    manifest = store.read_manifest(folder)
+    assert manifest["steps"] == 300 and manifest["evaluations"][0]["step"] <= cut_at  # the evaluations before the cut
+
+    paper.main(["rewards", *args])  # finished: nothing to train again
+    assert "0 to train, 0 runs to evaluate" in capsys.readouterr().out
+
+
+def test_report_tables_a_finished_run_with_mean_and_std(tiny, capsys):
+    root, args, _, run = tiny
+    if not store.is_trained(run.jobs[0].folder):
+        paper.main(["rewards", *args])
+        capsys.readouterr()
+    paper.main(["rewards", *args, "linear", "--report"])  # --variants squared linear
+    printed = capsys.readouterr().out
+    row = next(line for line in printed.splitlines() if line.startswith("| paper | three-note | squared |"))
+    cells = [c.strip() for c in row.strip("|").split("|")]
+    assert cells[3] == "1 / 1 / 1 / 1" and cells[4] == "300"
+    assert " ± 0.00" in cells[5] and " ± 0.000" in cells[6]  # linear return and note F1, one seed
+    assert "| paper | three-note | linear | 0 / 0 / 0 / 1 |" in printed  # not started
+    assert (root / "plots" / "3-rewards.png").stat().st_size > 0
+
+
+def test_a_policy_trained_with_the_squared_reward_is_judged_with_the_linear_one(tiny, monkeypatch):
+    root, args, opts, run = tiny
+    folder = run.jobs[0].folder
+    if not store.is_trained(folder):
+        paper.main(["rewards", *args])
+    built = []
+    real = paper.make_env
+    monkeypatch.setattr(paper, "make_env", lambda target, config: built.append(config) or real(target, config))
+    figures = paper.evaluate_run(run, opts)
+    assert built and all(c.reward == paper.EVAL_REWARD for c in built)
+    assert paper.EVAL_REWARD.kind == "linear" and paper.EVAL_REWARD.closeness_weight == 0
+    assert figures["reward"]["kind"] == "linear" and figures["episodes"] == 1
+
+    def played(reward: RewardConfig) -> float:
+        env = make_env(run.task, replace(run.config.env, reward=reward))
+        return rollout(env, load_policy(folder, env), seed=paper.CHECK_SEED).total_reward
+
+    assert figures["return"] == pytest.approx(played(paper.EVAL_REWARD))
+    assert figures["return"] != pytest.approx(played(run.config.env.reward))  # the squared reward would differ
+
+
+def test_cpu_hours_are_estimated_from_the_measured_training_speed(tmp_path):
+    assert paper.run_minutes(15_000, 15_000) == pytest.approx(4.0)
+    assert paper.run_minutes(40_000, 15_000) == pytest.approx(4.0 + 2.5 * 10.0)
+    hours, policies = paper.estimate(paper.expand("rewards", options(tmp_path, seeds=3)))
+    assert policies == 18 and hours == pytest.approx(18 * paper.run_minutes(100_000, 15_000) / 60)
