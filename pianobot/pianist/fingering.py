@@ -41,7 +41,7 @@ from pianobot.errors import PianobotError
 from pianobot.music.instrument import HandSpec, KeyboardSpec, check_playable
 from pianobot.music.piece import Note, Piece, pitch_name
 from pianobot.pianist.layout import KeyLayout
-from pianobot.pianist.strikes import StrikePlanner
+from pianobot.pianist.strikes import Run, StrikePlanner
 from pianobot.pianist.tuning import PianistTuning
 from pianobot.sim.hand import FINGER_BASE_X, HandConfig
 from pianobot.sim.keyboard import KeyboardConfig, key_boxes, keyboard_width, strike_points
@@ -183,7 +183,7 @@ class Planner:
         time = onset - prev_chord[0].onset
         slow = _INFEASIBLE if in_time else _TOO_FAST
         move = np.abs(self.grid[None, :] - self.grid[:, None])
-        too_fast = np.where(move > self._wrist_limit(time) + 1e-9, slow, 0.0)
+        too_fast = np.where(self._wrist_too_fast(move, time, chord), slow, 0.0)
         blocks = np.empty((len(p_assign), len(self.grid), len(assignments), len(self.grid)))
         for a_p, f_p in enumerate(p_assign):
             for a, f in enumerate(assignments):
@@ -193,9 +193,18 @@ class Planner:
         best = np.argmin(step, axis=0)
         return Reach(chord, step[best, np.arange(step.shape[1])] + local.ravel()), best
 
-    def _wrist_limit(self, time: float) -> float:
-        """Farthest the wrist can move (m) between two onsets ``time`` s apart."""
-        return self.hand.max_wrist_speed * max(0.0, time - SETTLE_TIME)
+    def _wrist_too_fast(self, move: np.ndarray | float, time: float, chord: Sequence[Note]) -> np.ndarray:
+        """Whether the wrist cannot move ``move`` (m) in the ``time`` s before ``chord``'s onset:
+        every move leaves :data:`SETTLE_TIME` for the fingers to lift and settle, and a leap (a
+        move longer than a finger reaches sideways, so the finger cannot aim at its key before
+        the wrist gets there) also leaves the slowest strike of ``chord`` from its ready height:
+        the pianist starts that strike only once its finger is over the key."""
+        speed = self.hand.max_wrist_speed
+        lead = max(self.strikes.ready(Run(self.spec.index(n.pitch), 0, 1, n.velocity))[1] for n in chord)
+        limit = speed * max(0.0, time - SETTLE_TIME)
+        leap_limit = speed * max(0.0, time - SETTLE_TIME - lead * self.strikes.dt)
+        move = np.asarray(move)
+        return (move > limit + 1e-9) | ((move > self.reach.max()) & (move > leap_limit + 1e-9))
 
     def _fast_hop(
         self,
@@ -268,7 +277,7 @@ class Planner:
             distance = abs(wrist[i] - wrist[i - 1])
             velocities = [n.velocity for n in sorted(chords[i], key=lambda n: n.pitch)]
             hop = self._fast_hop(*chosen[i - 1], *chosen[i], time, velocities)
-            if distance > self._wrist_limit(time) + 1e-9 or hop:
+            if self._wrist_too_fast(distance, time, chords[i]) or hop:
                 what = (
                     f"{hop} in {time:.3f} s" if hop else f"the wrist must move {distance * 100:.1f} cm in {time:.3f} s"
                 )
