@@ -246,10 +246,12 @@ def test_train_bad_requests_answer_with_one_line(tmp_path):
     assert_one_line_error(run("train", song, "--task", "one-note"), "not both")
     assert_one_line_error(run("train", "--task", "sonata"), "--task sonata")
     assert_one_line_error(run("train", song, "--steps", "100"), "100 steps must exceed the 15000 exploration steps")
-    assert_one_line_error(run("train", song, "--control", "position"), "--control position", "velocity, torque")
+    assert_one_line_error(run("train", song, "--control", "joint"), "--control joint", "velocity, position, torque")
     assert_one_line_error(run("train", song, "--reward", "cubic"), "--reward cubic", "linear, squared, wasserstein")
     assert_one_line_error(run("train", song, "--explore", "wild"), "exploration must be one of", "'wild'")
-    assert_one_line_error(run("train", song, "--explore", "scripted", "--control", "torque"), "needs velocity control")
+    assert_one_line_error(
+        run("train", song, "--explore", "scripted", "--control", "torque"), "needs velocity or position control"
+    )
     assert_one_line_error(run("train", song, "--until-f1", "1.5"), "note F1 to stop at", "1.5")
     (tmp_path / "file").write_text("x")
     assert_one_line_error(run("train", song, "--models", tmp_path / "file"), "is a file")

@@ -56,6 +56,8 @@ def test_saved_policy_loads_and_acts_the_same(tmp_path):
     tensors = store.load_tensors(tmp_path / "m" / store.POLICY_FILE)
     assert not any(k.startswith(("critic.", "target.", "optim.")) for k in tensors)  # only what acting needs
     assert not any(".conv." in k for k in tensors)  # the tactile convolutions once, under encoder.tactile.0
+    critic = store.load_tensors(tmp_path / "m" / store.CRITIC_FILE)  # beside it: what fine-tuning starts from
+    assert set(critic) == {"log_alpha"} | {k for k in first_agent.critic_tensors() if k.startswith("critic.layers.")}
 
 
 def test_interrupted_training_resumes_to_the_same_state(tmp_path):
@@ -297,6 +299,39 @@ def test_until_f1_stops_at_the_first_good_evaluation(tmp_path, monkeypatch):
     assert whole["steps"] == 400
 
 
+def test_fine_tuning_never_ends_worse_than_its_start_policy(tmp_path, monkeypatch):
+    """The start policy's evaluation at step 0 counts: when no later one beats it, the stored
+    policy and critic are the start's own; a later better one replaces it."""
+    import pianobot.learn.train as train
+
+    def scripted(scores, calls):
+        figures = iter(scores)
+
+        def evaluate(agent, target, env_config, episodes):
+            calls.append(agent.updates)
+            return {"f1": next(figures), "velocity_mae": 1.0, "return": 0.0}
+
+        return evaluate
+
+    config = small(steps=200, eval_every=100)
+    train_policy(PHRASE, config, tmp_path / "start")
+    start = {**store.load_tensors(tmp_path / "start" / store.POLICY_FILE)}
+    start.update(store.load_tensors(tmp_path / "start" / store.CRITIC_FILE))
+    for scores, kept_step in (([0.5, 0.4, 0.2], 0), ([0.5, 0.6, 0.2], 105)):
+        calls: list = []
+        monkeypatch.setattr(train, "evaluate", scripted(scores, calls))
+        folder = tmp_path / f"tuned-{kept_step}"
+        manifest = train_policy(PHRASE, replace(config, finetune_until_f1=0.99), folder, start=tmp_path / "start")
+        assert (
+            calls[0] == 0 and len(calls) == 3
+        )  # the start, before any update; one during training (at an episode end); the final
+        assert [e["step"] for e in manifest["evaluations"]] == [0, 105, 200]
+        assert manifest["evaluation"]["step"] == kept_step and manifest["steps"] == 200
+        kept = {**store.load_tensors(folder / store.POLICY_FILE), **store.load_tensors(folder / store.CRITIC_FILE)}
+        assert set(kept) == set(start)
+        assert all(torch.equal(kept[k], start[k]) for k in start) == (kept_step == 0)
+
+
 def test_the_best_evaluated_policy_is_kept_across_an_interruption(tmp_path, monkeypatch):
     import pianobot.learn.train as train
 
@@ -454,7 +489,7 @@ def test_a_kill_at_any_point_of_a_checkpoint_write_loses_at_most_one_interval(tm
     )
     assert a.keys() == b.keys() and all(torch.equal(a[k], b[k]) for k in a)
     left = sorted(p.name for p in (tmp_path / "killed").iterdir())
-    expected = [store.LOCK_FILE, store.MANIFEST_FILE, store.POLICY_FILE, LOG_FILE, PLOT_FILE]
+    expected = [store.LOCK_FILE, store.MANIFEST_FILE, store.POLICY_FILE, store.CRITIC_FILE, LOG_FILE, PLOT_FILE]
     assert left == sorted(expected + ([TENSORBOARD_DIR] if (tmp_path / "killed" / TENSORBOARD_DIR).is_dir() else []))
     assert _log_without_time(tmp_path / "killed") == _log_without_time(tmp_path / "straight")  # as one run
 

@@ -371,5 +371,31 @@ class SAC:
             template["state"] = state
             optimizer.load_state_dict(template)
 
+    def critic_tensors(self) -> dict[str, torch.Tensor]:
+        """What fine-tuning needs beyond the policy (:meth:`tensors` without training state): the
+        twin Q heads (``critic.layers.*``; their encoder is the policy's ``encoder.*``) and the
+        temperature (``log_alpha``), on the CPU. Stored beside a policy as ``critic.safetensors``."""
+        out = {f"critic.{k}": v for k, v in self.critic.state_dict().items() if not k.startswith("encoder.")}
+        out["log_alpha"] = self.log_alpha.detach().reshape(1)
+        return {k: v.detach().cpu().contiguous().clone() for k, v in out.items()}
+
+    def load_start(self, policy: dict[str, torch.Tensor], critic: dict[str, torch.Tensor] | None) -> None:
+        """Begin training from a stored policy (fine-tuning): actor and encoder from ``policy``;
+        the Q heads and the temperature from ``critic`` (:meth:`critic_tensors`) when given, else
+        as initialised; the target critic a copy of the critic. Adam's moments start fresh. Raises
+        ValueError naming the first tensor that does not fit."""
+        self.load_tensors(policy, with_training_state=False)
+        if critic is not None:
+            heads = {k[len("critic.") :]: v for k, v in critic.items() if k.startswith("critic.")}
+            heads.update({f"encoder.{k}": v for k, v in self.critic.encoder.state_dict().items()})
+            _load_checked(self.critic, heads, "critic.")
+            if "log_alpha" not in critic or critic["log_alpha"].numel() != 1:
+                raise ValueError("tensor log_alpha is missing")
+            if not bool(torch.isfinite(critic["log_alpha"]).all()):
+                raise ValueError("tensor log_alpha holds NaN or infinite values")
+            with torch.no_grad():
+                self.log_alpha.copy_(critic["log_alpha"].reshape(()))
+        self.target.load_state_dict(self.critic.state_dict())
+
     def _optimizers(self) -> dict[str, torch.optim.Optimizer]:
         return {"critic": self.critic_optimizer, "actor": self.actor_optimizer, "alpha": self.alpha_optimizer}

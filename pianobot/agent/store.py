@@ -3,6 +3,7 @@
     models/
       <phrase hash>-<config hash>/
         policy.safetensors      actor + encoder weights (what `play` needs)
+        critic.safetensors      twin Q heads + temperature (what fine-tuning starts from besides)
         manifest.json           phrase, config, steps, evaluation figures, package versions
         checkpoint/<step>/      only while training: full state, so an interrupted run resumes
           state.safetensors     every network, optimiser moment and RNG state
@@ -39,7 +40,13 @@ FORMAT = 2
 """Version of the model files (manifest layout and tensor names). Older versions are upgraded on
 reading (:func:`upgrade_manifest`), so every model a user has keeps playing.
 
-- 2: one tactile image size, ``config.env.tactile_pool``; every tensor stored once.
+- 2: one tactile image size, ``config.env.tactile_pool``; every tensor stored once. Added
+  since, absent from the manifests written before them, where their absence means what those
+  runs did: ``config.from_general`` (false: trained from scratch) and ``start`` (null: the
+  policy training began from, fine-tuning; docs/training.md), ``config.finetune_until_f1``
+  (unused without ``from_general``), ``config.envs`` and ``config.device`` (1, auto); the file
+  ``critic.safetensors`` (missing: the policy cannot pass its critic on to a fine-tuning run,
+  which then begins with fresh Q heads).
 - 1: the agent's ``config.sac.tactile_resolution`` overrode ``config.env.tactile_pool``; the
   policy file held the tactile convolutions twice (``encoder.conv.*`` beside
   ``encoder.tactile.0.*``); manifests written before the finger targets carried velocity and
@@ -47,6 +54,7 @@ reading (:func:`upgrade_manifest`), so every model a user has keeps playing.
   ``target_velocity=False``, ``target_onsets=False`` and ``score_input=True``.
 """
 POLICY_FILE = "policy.safetensors"
+CRITIC_FILE = "critic.safetensors"
 MANIFEST_FILE = "manifest.json"
 CHECKPOINT_DIR = "checkpoint"
 LOCK_FILE = ".lock"
@@ -55,14 +63,31 @@ LOCK_FILE = ".lock"
 def config_hash(config) -> str:
     """A stable digest of a (dataclass) training configuration. Its fields marked
     ``metadata={"runtime": True}`` say how a run executes, not what it trains (``TrainConfig.envs``,
-    ``device``): they are left out, so that the same training finds the same folder however it runs."""
-    runtime = {f.name for f in dataclasses.fields(config) if f.metadata.get("runtime")}
+    ``device``), or ``metadata={"start": True}`` where it begins and when fine-tuning stops
+    (``TrainConfig.from_general``, ``finetune_until_f1``): they are left out, so that the same
+    training finds the same folder however it runs, and a phrase's folder holds one policy for its
+    configuration, fine-tuned or trained from scratch (the manifest's ``start`` says which)."""
+    runtime = {f.name for f in dataclasses.fields(config) if f.metadata.get("runtime") or f.metadata.get("start")}
     fields = {k: v for k, v in to_dict(config).items() if k not in runtime}
     return hashlib.sha256(json.dumps(fields, sort_keys=True, default=str).encode()).hexdigest()[:12]
 
 
 def model_dir(root: Path, key: str, config) -> Path:
     return Path(root) / f"{key}-{config_hash(config)}"
+
+
+def task_key(task: str) -> str:
+    """The key of a task family's policy folders (``task-<name>-<config hash>``)."""
+    return f"task-{task}"
+
+
+def file_digest(path: Path) -> str:
+    """SHA-256 of a file's bytes (hex): which weights a policy is, wherever its folder lies."""
+    digest = hashlib.sha256()
+    with open(path, "rb") as f:
+        for block in iter(lambda: f.read(1 << 20), b""):
+            digest.update(block)
+    return digest.hexdigest()
 
 
 def package_versions() -> dict[str, str]:
@@ -102,10 +127,17 @@ def load_tensors(path: Path) -> dict[str, torch.Tensor]:
         ) from None
 
 
-def save_policy(folder: Path, tensors: dict[str, torch.Tensor], manifest: dict) -> None:
-    """Write weights and manifest; the manifest last, so a folder with a manifest is complete."""
+def save_policy(
+    folder: Path, tensors: dict[str, torch.Tensor], manifest: dict, critic: dict[str, torch.Tensor] | None = None
+) -> None:
+    """Write weights (``critic``: the Q heads and temperature too, :meth:`SAC.critic_tensors`) and
+    manifest; the manifest last, so a folder with a manifest is complete."""
     folder.mkdir(parents=True, exist_ok=True)
     save_tensors(tensors, folder / POLICY_FILE, metadata={"format": str(FORMAT)})
+    if critic:
+        save_tensors(critic, folder / CRITIC_FILE, metadata={"format": str(FORMAT)})
+    else:  # (a forced retrain must not leave an older run's critic beside the new policy)
+        (folder / CRITIC_FILE).unlink(missing_ok=True)
     manifest = {"format": FORMAT, **manifest, "versions": package_versions()}
     atomic_write(folder / MANIFEST_FILE, json.dumps(manifest, indent=2, default=str) + "\n")
 
@@ -121,6 +153,9 @@ def upgrade_manifest(manifest: dict) -> dict:
         env.setdefault("target_onsets", False)
         sac.setdefault("score_input", True)
         manifest["format"] = 2
+    if isinstance(manifest.get("config"), dict):  # fields added within format 2 (see FORMAT)
+        manifest["config"].setdefault("from_general", False)
+    manifest.setdefault("start", None)
     return manifest
 
 

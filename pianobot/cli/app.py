@@ -122,6 +122,12 @@ LowestNote = typer.Option(
 Keys = typer.Option(KeyboardSpec.count, "--keys", help="Number of keys on the keyboard.")
 Thumb = typer.Option(False, "--thumb", help="Let the hand use its thumb (finger 1) too.")
 PhraseNotes = typer.Option(DEFAULT_MAX_NOTES, "--phrase-notes", help="Most notes in one phrase (one policy each).")
+GeneralPolicy = typer.Option(
+    None,
+    "--general-policy",
+    help="The general policy's folder (any trained policy; default: the newest `pianobot train --task melody` "
+    "policy in --models whose environment fits).",
+)
 PlayPhraseNotes = typer.Option(
     None,
     "--phrase-notes",
@@ -424,8 +430,18 @@ def play(
     ),
     models: Path = typer.Option(Path("models"), "--models", help="Folder of the model store (for --controller sac)."),
     fallback: Optional[str] = typer.Option(
-        None, "--fallback", help="'scripted': play phrases that have no trained policy with the scripted pianist."
+        None,
+        "--fallback",
+        help="'scripted': play phrases that have no trained policy with the scripted pianist (when no general policy "
+        "plays them: a phrase's own policy first, then the general policy, then the fallback).",
     ),
+    use_general: bool = typer.Option(
+        True,
+        "--general/--no-general",
+        help="Play phrases without a policy of their own with the general policy (the newest `pianobot train --task "
+        "melody` policy in --models, or --general-policy), when there is one.",
+    ),
+    general_policy: Optional[Path] = GeneralPolicy,
     phrase_notes: Optional[int] = PlayPhraseNotes,
     seed: int = typer.Option(
         0, "--seed", help="Seed of the simulation (the hand's start position) and of the random controller."
@@ -454,11 +470,20 @@ def play(
     """Perform a piece in the simulator; write the played notes (velocities, fingers) and a velocity-error report."""
     from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 
+    from pianobot.agent.general import describe, find_general
+    from pianobot.agent.policy import policy_configs
     from pianobot.cli import display
     from pianobot.music.midi_io import write_midi
     from pianobot.music.phrases import split_phrases
     from pianobot.perform.audio import check_soundfont, write_wav
-    from pianobot.perform.compose import CompositionalController, missing_phrases, shared_env_config, trained_split
+    from pianobot.perform.compose import (
+        GENERAL_SOURCE,
+        CompositionalController,
+        general_for,
+        missing_phrases,
+        shared_env_config,
+        trained_split,
+    )
     from pianobot.perform.perform import PLAY_CONFIG, perform, write_video
     from pianobot.sim.hand import HandConfig
     from pianobot.sim.keyboard import KeyboardConfig
@@ -480,6 +505,10 @@ def play(
         raise PianobotError(f"--controller {quote(controller)}: choose one of {', '.join(CONTROLLERS)}")
     if fallback not in (None, "scripted"):
         raise PianobotError(f"--fallback {quote(fallback)}: the only fallback is 'scripted'")
+    if general_policy is not None and not use_general:
+        raise PianobotError(f"--general-policy {general_policy} and --no-general ask for opposite things: give one")
+    if general_policy is not None:
+        find_general(models, path=general_policy)  # a folder that holds no policy: said before any work
     keyboard, hand = make_instrument(lowest_note, keys, thumb)
     piece = read_song(
         song, make_options(track, tempo, transpose, fingering, hand_part, split, quantize, refinger), keyboard, hand
@@ -487,6 +516,7 @@ def play(
     world = WorldConfig(keyboard=KeyboardConfig(spec=keyboard), hand=HandConfig(spec=hand), gui=gui)
     config = replace(PLAY_CONFIG, world=world)
     sources: dict = {}
+    general = None  # the general policy's folder, when it plays a phrase
     who = controller
     if controller == "sac":
         import torch
@@ -499,25 +529,29 @@ def play(
             out.print(
                 f"[dim]{len(phrases)} phrases of at most {most} note{'s' * (most > 1)}: the split the policies in {said(models)} were trained for[/dim]"
             )
-        if missing and not fallback:
+        trained = shared_env_config(models, phrases)  # the environment of the phrases' own policies
+        if missing and use_general:  # a phrase's own policy, else the general policy, else the fallback
+            general = general_for(models, trained, general_policy)
+        if missing and general is None and not fallback:
             first = missing[0]
             raise PianobotError(
                 f"phrase {first.index} ({' '.join(n.name for n in first.notes)}) of {song.name} has no trained policy in {models}: "
-                f"train it with `pianobot train {song}` (same reading options), add --fallback scripted, "
-                f"or play with --controller scripted"
+                f"train it with `pianobot train {song}` (same reading options), train a general policy with "
+                f"`pianobot train --task melody`, add --fallback scripted, or play with --controller scripted"
             )
-        trained = shared_env_config(models, phrases)
+        if trained is None and general is not None:
+            trained = policy_configs(general)[0]
         if trained is not None:
             config = replace(trained, world=replace(trained.world, gui=gui))
             if trained.world.keyboard.spec != keyboard or trained.world.hand.spec != hand:
                 raise PianobotError(
                     f"the policies in {models} were trained for another keyboard or hand: use the same --lowest-note/--keys/--thumb"
                 )
-        if missing and config.world.control == "torque":
+        if missing and general is None and config.world.control == "torque":
             raise PianobotError("--fallback scripted needs policies trained with --control velocity or position")
 
         def who(env):
-            composed = CompositionalController(env, phrases, models, fallback is not None)
+            composed = CompositionalController(env, phrases, models, fallback is not None, general)
             sources.update({s.phrase.index: s.source for s in composed.sections})
             return composed
 
@@ -541,9 +575,18 @@ def play(
     report = result.report()
     write_midi(result.played, output, name=f"pianobot {controller}: {song.stem}")
     extra = {"phrases": {str(k): v for k, v in sources.items()}} if sources else {}
+    by_general = [k for k, v in sources.items() if v.startswith(GENERAL_SOURCE)]
+    if by_general:
+        extra["general_policy"] = describe(general)
     atomic_write(
         report_path, json.dumps({"controller": controller, "seed": seed, **extra, **report.to_dict()}, indent=2) + "\n"
     )
+    if by_general:
+        out.print(
+            f"[yellow]phrases {', '.join(map(str, by_general))} had no policy of their own and were played by the "
+            f"general policy {said(general)}[/yellow]",
+            soft_wrap=True,  # (one line, the path whole)
+        )
     fallbacks = [k for k, v in sources.items() if "fallback" in v]
     if fallbacks:
         out.print(
@@ -585,8 +628,21 @@ def train(
     until_f1: Optional[float] = typer.Option(
         TrainConfig.until_f1,
         "--until-f1",
-        help="Stop a phrase early once an evaluation reaches this note F1 (e.g. 0.95).",
+        help="Stop a phrase early once an evaluation reaches this note F1 (e.g. 0.95); default: train every step, "
+        f"or, starting from the general policy, stop at {TrainConfig.finetune_until_f1}.",
     ),
+    from_general: bool = typer.Option(
+        TrainConfig.from_general,
+        "--from-general/--no-from-general",
+        help="Start every phrase from the general policy (the newest `pianobot train --task melody` policy in --models "
+        "whose options are this run's, or --general-policy): load its actor, encoder, critic and temperature (Adam "
+        "starts afresh), evaluate it before any training step, and stop the phrase at the first evaluation that "
+        f"reaches note F1 {TrainConfig.finetune_until_f1} (--until-f1 sets another), keeping the best evaluated "
+        "policy: a phrase the general policy already plays costs one evaluation, and none ends worse than the "
+        "general policy plays it. Without a general policy, or with --no-from-general, phrases train from scratch. "
+        "Not used with --task.",
+    ),
+    general_policy: Optional[Path] = GeneralPolicy,
     workers: int = typer.Option(1, "--workers", help="Train this many phrases at once, in separate processes."),
     threads: int = typer.Option(
         1, "--threads", help="Torch threads per training process (workers x threads should not exceed the cores)."
@@ -655,9 +711,10 @@ def train(
     from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 
     from pianobot.agent import store
+    from pianobot.agent.general import find_general
     from pianobot.agent.sac import resolve_device
     from pianobot.cli import display
-    from pianobot.learn.jobs import phrase_jobs, plan_jobs, run_jobs, run_jobs_on_ray, task_job
+    from pianobot.learn.jobs import general_start, phrase_jobs, plan_jobs, run_jobs, run_jobs_on_ray, task_job
     from pianobot.learn.log import LOG_FILE, PLOT_FILE
     from pianobot.learn.train import TASK_EVAL_EPISODES
     from pianobot.music.phrases import split_phrases
@@ -717,12 +774,21 @@ def train(
             seed=seed,
             explore=explore,
             until_f1=until_f1,
+            from_general=from_general and task is None,  # a task family trains from scratch
             sac=sac,
             env=env,
             eval_episodes=TASK_EVAL_EPISODES if task is not None else TrainConfig.eval_episodes,
             envs=envs,
             device=device,
         )
+    if general_policy is not None and (task is not None or not from_general):
+        raise PianobotError(
+            f"--general-policy {general_policy} starts the phrases of a piece: drop it with "
+            f"{'--task' if task is not None else '--no-from-general'}"
+        )
+    if general_policy is not None:
+        find_general(models, path=general_policy)  # a folder that holds no policy: said before any work
+    start = None
     if task is not None:
         todo, done = plan_jobs([task_job(task, config, models)], force)
         label = f"task {task}"
@@ -731,8 +797,22 @@ def train(
             song, make_options(track, tempo, transpose, fingering, hand_part, split, quantize, refinger), keyboard, hand
         )
         phrases = split_phrases(piece, phrase_notes)
-        todo, done = plan_jobs(phrase_jobs(phrases, config, models, piece=song.name), force)
+        jobs = phrase_jobs(phrases, config, models, piece=song.name)
         label = f"{song.name}: {len(phrases)} phrases"
+        if force or not all(store.is_trained(job.folder) for job in jobs):  # (before --force removes a policy)
+            config, start = general_start(config, models, general_policy)
+            if start is not None:
+                console.print(
+                    f"starting every phrase from the general policy {said(start)}: evaluated first, a phrase stops at "
+                    f"note F1 {config.stop_f1} (--no-from-general trains from scratch)",
+                    soft_wrap=True,
+                )
+            elif from_general:
+                console.print(
+                    f"[dim]no general policy in {said(models)} (`pianobot train --task melody` trains one): "
+                    "training from scratch[/dim]"
+                )
+        todo, done = plan_jobs(jobs, force)
     models.mkdir(parents=True, exist_ok=True)
     for job in done:
         console.print(
@@ -771,9 +851,9 @@ def train(
             bar.update(rows[key], completed=progress.step, status=status)
 
         if cluster == "ray":
-            results = run_jobs_on_ray(todo, config, on_progress, threads=threads)
+            results = run_jobs_on_ray(todo, config, on_progress, threads=threads, start=start)
         else:
-            results = run_jobs(todo, config, workers, on_progress, threads=threads)
+            results = run_jobs(todo, config, workers, on_progress, threads=threads, start=start)
     trained = [(job, results.get(job.key) or store.read_manifest(job.folder)) for job in done + todo]
     console.print(display.training_table(trained))
     console.print(f"learning curves: {LOG_FILE} and {PLOT_FILE} in each policy's folder")
@@ -784,7 +864,7 @@ def train(
                 "phrases": job.phrases,
                 "folder": str(job.folder),
                 "trained_now": job in todo,
-                **{k: manifest.get(k) for k in ("steps", "updates", "seconds", "evaluation")},
+                **{k: manifest.get(k) for k in ("steps", "updates", "seconds", "start", "evaluation")},
                 "log": str(job.folder / LOG_FILE),
                 "plot": str(job.folder / PLOT_FILE),
             }

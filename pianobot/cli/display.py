@@ -161,13 +161,25 @@ def print_all(console: Console, tables: list[Table]) -> None:
 def training_table(rows) -> Table:
     """(job, manifest) pairs -> the summary `pianobot train` prints at the end."""
     table = Table(title="trained policies")
-    for column in ("phrase", "used by", "steps", "kept from step", "eval note F1", "velocity MAE", "minutes", "folder"):
+    columns = (
+        "phrase",
+        "used by",
+        "from",
+        "steps",
+        "kept from step",
+        "eval note F1",
+        "velocity MAE",
+        "minutes",
+        "folder",
+    )
+    for column in columns:
         table.add_column(column, overflow="fold")  # piped output is 80 columns wide: wrap, never cut a path
     for job, manifest in rows:
         evaluation = manifest.get("evaluation", {})  # the kept (best evaluated) policy's figures
         table.add_row(
             job.key,
             ", ".join(map(str, job.phrases)),
+            "general" if manifest.get("start") else "scratch",  # (fine-tuned from the general policy, or not)
             str(manifest.get("steps", "-")),
             str(evaluation.get("step", "-")),
             _opt(evaluation.get("f1"), ".3f"),

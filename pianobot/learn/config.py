@@ -27,7 +27,18 @@ class TrainConfig:
     eval_episodes: int = 3
     checkpoint_every: int = 5_000
     until_f1: float | None = None
-    """Stop early once an evaluation reaches this note F1 (None: always train ``steps`` steps)."""
+    """Stop early once an evaluation reaches this note F1 (None: train ``steps`` steps; a run
+    fine-tuned from the general policy stops at ``finetune_until_f1``). See :attr:`stop_f1`."""
+    from_general: bool = field(default=True, metadata={"start": True})
+    """Start each phrase from the general policy (the ``melody`` family's, found in the model store,
+    :mod:`pianobot.agent.general`) when there is one: its actor, encoder, Q heads and temperature,
+    evaluated before the first step. A run without one trains from scratch, and its manifest
+    says ``from_general: false``. Where a run begins, not what it trains: left out of the hash, so
+    a phrase has one folder, fine-tuned or not (the manifest's ``start`` names the policy)."""
+    finetune_until_f1: float | None = field(default=1.0, metadata={"start": True})
+    """When fine-tuning and ``until_f1`` is None: stop once an evaluation reaches this note F1. At
+    1.0, once the policy plays the phrase perfectly from every evaluation hand start, so a phrase
+    the general policy already plays costs one evaluation. Left out of the hash with ``from_general``."""
     sac: SACConfig = field(default_factory=SACConfig)
     env: EnvConfig = field(default_factory=EnvConfig)
     envs: int = field(default=1, metadata={"runtime": True})
@@ -51,8 +62,9 @@ class TrainConfig:
             raise ValueError(
                 f"{self.steps} steps must exceed the {self.sac.exploration_steps} exploration steps, or nothing is learnt"
             )
-        if self.until_f1 is not None and not 0.0 < self.until_f1 <= 1.0:
-            raise ValueError(f"the note F1 to stop at must lie in (0, 1]; got {self.until_f1}")
+        for stop in (self.until_f1, self.finetune_until_f1):
+            if stop is not None and not 0.0 < stop <= 1.0:
+                raise ValueError(f"the note F1 to stop at must lie in (0, 1]; got {stop}")
         check_ranges(
             self,
             steps=(1, 10**9),
@@ -61,6 +73,14 @@ class TrainConfig:
             checkpoint_every=(1, 10**9),
             envs=(1, MAX_ENVS),
         )
+
+    @property
+    def stop_f1(self) -> float | None:
+        """The note F1 at which an evaluation ends the run: ``until_f1``, else, fine-tuning,
+        ``finetune_until_f1``; None: never early."""
+        if self.until_f1 is not None:
+            return self.until_f1
+        return self.finetune_until_f1 if self.from_general else None
 
 
 def config_from_manifest(manifest: dict) -> TrainConfig:

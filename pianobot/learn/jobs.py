@@ -1,5 +1,6 @@
 """Training a whole piece: one job per distinct phrase (or one for a task family), run one after
-another or in parallel worker processes, each skipped when its policy is already stored."""
+another or in parallel worker processes, each skipped when its policy is already stored; every
+phrase begins from the general policy when there is one (:func:`general_start`)."""
 
 from __future__ import annotations
 
@@ -7,13 +8,14 @@ import os
 import threading
 import time
 from concurrent.futures import ProcessPoolExecutor
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Callable
 
 import torch
 
 from pianobot.agent import store
+from pianobot.agent.general import find_general
 from pianobot.errors import PianobotError
 from pianobot.learn.train import Progress, TrainConfig, train_policy
 from pianobot.music.phrases import Phrase
@@ -50,7 +52,9 @@ def _exit_with_parent(parent: int, every: float = 0.5) -> None:
     threading.Thread(target=watch, daemon=True, name="exit-with-parent").start()
 
 
-def _run_job(job: PhraseJob, config: TrainConfig, queue=None, threads: int | None = None) -> dict:
+def _run_job(
+    job: PhraseJob, config: TrainConfig, queue=None, threads: int | None = None, start: Path | None = None
+) -> dict:
     if threads is not None:
         torch.set_num_threads(threads)
 
@@ -58,7 +62,26 @@ def _run_job(job: PhraseJob, config: TrainConfig, queue=None, threads: int | Non
         if queue is not None:
             queue.put((job.key, progress))
 
-    return train_policy(job.target, config, job.folder, report, about=job.about())
+    return train_policy(job.target, config, job.folder, report, about=job.about(), start=start)
+
+
+def general_start(config: TrainConfig, models: Path, path: Path | None = None) -> tuple[TrainConfig, Path | None]:
+    """Where a piece's phrases begin: (``config``, the general policy's folder) when
+    ``config.from_general`` asks for it and there is one (``path``, else the newest ``task-melody``
+    policy in ``models`` whose environment and networks are the run's); else (``config`` with
+    ``from_general`` off, None): from scratch. A general policy that does not fit is a one-line
+    error naming the option that differs."""
+    if not config.from_general:
+        return config, None
+    folder = find_general(
+        models,
+        config.env,
+        config.sac,
+        path,
+        ours="this run",
+        remedy="give the same option to start from it, or --no-from-general to train from scratch",
+    )
+    return (config, folder) if folder is not None else (replace(config, from_general=False), None)
 
 
 def phrase_jobs(phrases: list[Phrase], config: TrainConfig, root: Path, piece: str = "") -> list[PhraseJob]:
@@ -75,7 +98,7 @@ def phrase_jobs(phrases: list[Phrase], config: TrainConfig, root: Path, piece: s
 
 def task_job(task: str, config: TrainConfig, root: Path) -> PhraseJob:
     """The one job of a task family."""
-    key = f"task-{task}"
+    key = store.task_key(task)
     return PhraseJob(key, task, store.model_dir(root, key, config), [0], f"task {task}")
 
 
@@ -88,7 +111,7 @@ def plan_jobs(jobs: list[PhraseJob], force: bool) -> tuple[list[PhraseJob], list
             done.append(job)
         else:
             if force and job.folder.exists():
-                for name in (store.POLICY_FILE, store.MANIFEST_FILE):
+                for name in (store.POLICY_FILE, store.CRITIC_FILE, store.MANIFEST_FILE):
                     (job.folder / name).unlink(missing_ok=True)
             todo.append(job)
     return todo, done
@@ -100,15 +123,22 @@ def run_jobs(
     workers: int,
     on_progress: Callable[[str, Progress], None],
     threads: int = 1,
+    start: Path | None = None,
 ) -> dict[str, dict]:
     """Train every job, ``workers`` at a time in separate processes (1: in this process), each with
-    ``threads`` torch threads (more threads than cores makes torch's thread pools spin against each other)."""
+    ``threads`` torch threads (more threads than cores makes torch's thread pools spin against each
+    other), each from the policy ``start`` when given (:func:`general_start`)."""
     results: dict[str, dict] = {}
     if workers <= 1 or len(jobs) <= 1:
         torch.set_num_threads(threads)
         for job in jobs:
             results[job.key] = train_policy(
-                job.target, config, job.folder, lambda p, key=job.key: on_progress(key, p), about=job.about()
+                job.target,
+                config,
+                job.folder,
+                lambda p, key=job.key: on_progress(key, p),
+                about=job.about(),
+                start=start,
             )
         return results
     import multiprocessing
@@ -119,7 +149,7 @@ def run_jobs(
     with ProcessPoolExecutor(
         max_workers=workers, mp_context=context, initializer=_exit_with_parent, initargs=(os.getpid(),)
     ) as pool:
-        futures = {pool.submit(_run_job, job, config, queue, threads): job for job in jobs}
+        futures = {pool.submit(_run_job, job, config, queue, threads, start): job for job in jobs}
         pending = set(futures)
         while pending:
             while not queue.empty():
@@ -137,7 +167,11 @@ def run_jobs(
 
 
 def run_jobs_on_ray(
-    jobs: list[PhraseJob], config: TrainConfig, on_progress: Callable[[str, Progress], None], threads: int = 1
+    jobs: list[PhraseJob],
+    config: TrainConfig,
+    on_progress: Callable[[str, Progress], None],
+    threads: int = 1,
+    start: Path | None = None,
 ) -> dict[str, dict]:
     """Train every job as a Ray task: on the cluster ``RAY_ADDRESS`` names (Ray's own convention),
     or on a local Ray runtime when it is unset. Each task asks for ``threads`` CPUs (or
@@ -154,7 +188,7 @@ def run_jobs_on_ray(
     try:
         queue = Queue()
         task = ray.remote(num_cpus=max(threads, config.envs), max_retries=0)(_run_job)
-        refs = {task.remote(job, config, queue, threads): job for job in jobs}
+        refs = {task.remote(job, config, queue, threads, start): job for job in jobs}
         pending, results = list(refs), {}
 
         def drain() -> None:

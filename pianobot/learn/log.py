@@ -2,7 +2,8 @@
 
 - ``training.csv``: one row per episode: step, wall-clock seconds, the episode's return, the last
   update's losses, temperature, entropy and Q, and, where an evaluation ran, its note F1,
-  velocity error and return;
+  velocity error and return (a fine-tuning run's evaluation of its start policy, before any
+  episode, is a row of its own at step 0, episode 0, without a return);
 - ``tensorboard/``: the same as TensorBoard scalars, when ``tensorboard`` is installed
   (``pip install pianobot[tensorboard]``);
 - ``learning.png``: the learning curves, drawn when the run ends.
@@ -95,6 +96,18 @@ class TrainingLog:
                 if key not in ("step", "episode") and value is not None:
                     self.board.add_scalar(key.replace("eval_", "eval/"), value, step)
 
+    def evaluation(self, step: int, seconds: float, evaluation: dict) -> None:
+        """An evaluation before any episode (a fine-tuning run's start policy, at step 0): a row of
+        its own, with no return or losses."""
+        values = {"step": step, "episode": 0, "seconds": round(seconds, 2)}
+        values.update({f"eval_{k}": evaluation[k] for k in ("f1", "velocity_mae", "return")})
+        self.writer.writerow(values)
+        self.file.flush()
+        if self.board is not None:
+            for key, value in values.items():
+                if key.startswith("eval_") and value is not None:
+                    self.board.add_scalar(key.replace("eval_", "eval/"), value, step)
+
     def plot(self) -> Path:
         """Draw the learning curves from the log to ``learning.png`` beside it."""
         import matplotlib
@@ -104,10 +117,10 @@ class TrainingLog:
 
         with open(self.folder / LOG_FILE, newline="") as log:
             rows = list(csv.DictReader(log))
-        steps = [int(r["step"]) for r in rows]
         evaluated = [r for r in rows if r["eval_f1"]]
         figure, (returns, f1) = plt.subplots(2, 1, figsize=(7, 5), sharex=True)
-        returns.plot(steps, [float(r["return"]) for r in rows], lw=0.8)
+        episodes = [r for r in rows if r["return"]]  # (a start policy's evaluation has no return)
+        returns.plot([int(r["step"]) for r in episodes], [float(r["return"]) for r in episodes], lw=0.8)
         returns.set_ylabel("episode return")
         f1.plot([int(r["step"]) for r in evaluated], [float(r["eval_f1"]) for r in evaluated], marker="o")
         f1.set_ylabel("evaluation note F1")

@@ -7,6 +7,10 @@ evaluate every ``eval_every`` steps; at the first episode end after every
 buffer, random generators), so that running the same command again continues exactly where an
 interrupted run stopped. The policy stored at the end is the best one evaluated (SAC's
 evaluations swing by tenths of F1 from one to the next; the last is not always the best).
+Given a ``start`` policy (fine-tuning from the general policy, :mod:`pianobot.agent.general`),
+the agent begins with its weights, evaluates them before the first step, and that evaluation
+counts: the stored policy is never worse than the start (and is the start itself when it
+already reaches :attr:`TrainConfig.stop_f1`).
 Every episode is logged beside the policy (:mod:`pianobot.learn.log`: CSV, TensorBoard, a plot).
 With ``TrainConfig.envs`` > 1 the loop steps that many environments at once, in worker processes
 (:func:`make_envs`); with 1, the default, its one environment in this process, as it always did.
@@ -17,7 +21,7 @@ from __future__ import annotations
 
 import contextlib
 import time
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 from functools import partial
 from pathlib import Path
 from typing import Callable
@@ -27,13 +31,14 @@ import numpy as np
 import torch
 from gymnasium.vector import AutoresetMode
 
-from pianobot.agent import store
+from pianobot.agent import general, store
 from pianobot.agent.buffer import ReplayBuffer
 from pianobot.agent.policy import make_agent
 from pianobot.agent.sac import SAC, resolve_device, vector_size
 from pianobot.agent.tasks import make_env
 from pianobot.config import to_dict
 from pianobot.env.piano import EnvConfig
+from pianobot.errors import PianobotError
 from pianobot.learn.config import TrainConfig
 from pianobot.learn.explore import Explorer
 from pianobot.learn.log import TrainingLog
@@ -124,8 +129,20 @@ BEST_PREFIX = "best."
 
 
 def best_policy_tensors(checkpoint_tensors: dict[str, torch.Tensor]) -> dict[str, torch.Tensor]:
-    """The best evaluated policy's tensors in a checkpoint, under their own names."""
+    """The best evaluated policy's tensors in a checkpoint, under their own names (its critic's
+    too, ``critic.*`` and ``log_alpha``, in checkpoints written since policies keep one)."""
     return {k[len(BEST_PREFIX) :]: v for k, v in checkpoint_tensors.items() if k.startswith(BEST_PREFIX)}
+
+
+def kept_tensors(agent: SAC, critic: bool = True) -> dict[str, torch.Tensor]:
+    """What a stored policy keeps of the agent: actor and encoder, and (``critic``) Q heads and temperature."""
+    return {**agent.tensors(with_training_state=False), **(agent.critic_tensors() if critic else {})}
+
+
+def split_kept(tensors: dict[str, torch.Tensor]) -> tuple[dict[str, torch.Tensor], dict[str, torch.Tensor]]:
+    """:func:`kept_tensors` as (policy file, critic file) tensors."""
+    policy = {k: v for k, v in tensors.items() if k.startswith(("actor.", "encoder."))}
+    return policy, {k: v for k, v in tensors.items() if k not in policy}
 
 
 def better(figures: dict, than: dict | None) -> bool:
@@ -142,18 +159,25 @@ def train_policy(
     report: Callable[[Progress], None] = lambda p: None,
     stop_after: int | None = None,
     about: dict | None = None,
+    start: Path | None = None,
 ) -> dict:
     """Train one policy for a phrase (a Piece) or a task family (its name); store it in ``folder``.
 
     ``stop_after`` ends the run after that many steps as an interruption would (tests);
-    ``about`` goes into the manifest (piece, phrase hash, ...). One run at a time may train
-    into a folder (a second one is refused while the first holds it).
+    ``about`` goes into the manifest (piece, phrase hash, ...). ``start``: a stored policy's
+    folder to begin from (the general policy; ``config.from_general`` must be on): its weights
+    are evaluated before the first step and training stops at ``config.stop_f1``. Without one
+    the run trains from scratch and its manifest says ``from_general: false``. A resumed run
+    goes on from its checkpoint, which knows where it began. One run at a time may train into a
+    folder (a second one is refused while the first holds it).
     """
+    if start is not None and not config.from_general:
+        raise ValueError("a start policy was given to a run with from_general=False")
     with store.training_lock(folder), TrainingLog(folder) as log:
         store.remove_temporary_files(folder)
         device = resolve_device(config.device)
         with contextlib.closing(make_envs(target, config.env, config.envs)) as envs:
-            return _train(target, config, folder, report, stop_after, about, log, envs, device)
+            return _train(target, config, folder, report, stop_after, about, log, envs, device, start)
 
 
 def _train(
@@ -166,6 +190,7 @@ def _train(
     log: TrainingLog,
     envs: gym.vector.VectorEnv,
     device: torch.device,
+    start: Path | None,
 ) -> dict:
     torch.manual_seed(config.seed)  # before the networks are made: their first weights come from it
     env_config, n = config.env, config.envs
@@ -203,10 +228,26 @@ def _train(
         agent.updates = state["updates"]
         seconds_before = state.get("seconds", 0.0)
         observations = resume_envs(envs, state["env_rng"], config.seed, step)
+        began = state.get("start")  # where the interrupted run began (checkpoints before fine-tuning: scratch)
         report(Progress(step, config.steps, resumed=True))
     else:
+        began = None
+        if start is not None:  # fine-tuning: the start policy's actor, encoder, Q heads and temperature
+            began = general.describe(start)
+            try:
+                agent.load_start(*general.start_tensors(start))
+            except ValueError as e:
+                raise PianobotError(
+                    f"the policy {start} does not fit this run's networks ({e}): train with its options, or from scratch"
+                ) from None
         observations, _ = envs.reset(seed=config.seed)
         state = {}
+    config = replace(config, from_general=began is not None)  # what the manifest records: how it began
+
+    def critic_learnt() -> bool:  # (a start policy without a critic, kept before any update, passes on none)
+        return agent.updates > 0 or bool(began and began["critic"])
+
+    started = time.perf_counter()
     log.start(resumed_at=step if checkpoint is not None else None)
     for explorer in explorers:
         explorer.reset()
@@ -214,9 +255,17 @@ def _train(
     next_eval = state.get("next_eval", (step // config.eval_every + 1) * config.eval_every)
     next_checkpoint = (step // config.checkpoint_every + 1) * config.checkpoint_every
     returns, losses, final = np.zeros(n), None, None
-    started = time.perf_counter()
 
-    while step < config.steps:
+    if began is not None and checkpoint is None:  # evaluate the start before any step: it counts
+        figures = evaluate(agent, target, env_config, config.eval_episodes)
+        evaluations.append({"step": 0, **figures})
+        best, best_tensors = {"step": 0, **figures}, kept_tensors(agent, critic_learnt())
+        log.evaluation(0, time.perf_counter() - started, figures)
+        report(Progress(0, config.steps, eval_f1=figures["f1"]))
+        if config.stop_f1 is not None and figures["f1"] >= config.stop_f1:
+            final = {"step": 0, **figures}  # it plays the phrase already: no step taken
+
+    while final is None and step < config.steps:
         # act in every environment: explore (the teacher's action plus noise), then sample the policy
         vectors, tactiles = agent.split_batch(observations)
         each = [{k: v[i] for k, v in observations.items()} for i in range(n)]  # each environment's observation
@@ -246,7 +295,7 @@ def _train(
                 temperature = {k: round(losses[k], 4) for k in ("alpha", "entropy")} if losses else {}
                 evaluations.append({"step": step, **figures, **temperature})
                 if better(figures, best):
-                    best, best_tensors = {"step": step, **figures}, agent.tensors(with_training_state=False)
+                    best, best_tensors = {"step": step, **figures}, kept_tensors(agent, critic_learnt())
                 report(Progress(step, config.steps, eval_f1=figures["f1"]))
                 next_eval = (step // config.eval_every + 1) * config.eval_every
             seconds = seconds_before + time.perf_counter() - started
@@ -256,7 +305,7 @@ def _train(
                 report(Progress(step, config.steps, episode_return=float(returns[i]), losses=losses))
                 log.row(step, episode, seconds, float(returns[i]), losses, logged)
                 returns[i], logged = 0.0, None
-            if figures is not None and config.until_f1 is not None and figures["f1"] >= config.until_f1:
+            if figures is not None and config.stop_f1 is not None and figures["f1"] >= config.stop_f1:
                 final = {"step": step, **figures}  # good enough: stop here
                 break
             if step >= next_checkpoint and step < config.steps:
@@ -273,6 +322,7 @@ def _train(
                     "best": best,
                     "next_eval": next_eval,
                     "seconds": seconds,
+                    "start": began,
                 }
                 kept = {BEST_PREFIX + k: v for k, v in (best_tensors or {}).items()}
                 store.save_checkpoint(
@@ -287,7 +337,7 @@ def _train(
         elif step % 200 < n:
             report(Progress(step, config.steps))
 
-    tensors = agent.tensors(with_training_state=False)
+    tensors = kept_tensors(agent, critic_learnt())
     if final is None:
         final = {"step": step, **evaluate(agent, target, env_config, config.eval_episodes)}
         evaluations.append(final)
@@ -300,11 +350,13 @@ def _train(
         "updates": agent.updates,
         "seconds": round(seconds_before + time.perf_counter() - started, 1),  # across interruptions
         "device": device.type,
+        "start": began,
         "evaluation": final,
         "evaluations": evaluations,
         "config": to_dict(config),
     }
-    store.save_policy(folder, tensors, manifest)
+    policy, critic = split_kept(tensors)
+    store.save_policy(folder, policy, manifest, critic=critic)
     store.drop_checkpoint(folder)
     log.plot()
     report(Progress(step, config.steps, finished=True))

@@ -8,6 +8,13 @@ onset tolerance of phrase k-1's last note has run out (a strike up to 50 ms late
 its policy keeps the hand until then), or one lead-in before phrase k's first note, whichever is
 later, but at the latest one step before phrase k's first onset; the hand is wherever the
 previous policy left it.
+
+Who plays a phrase: its own policy (stored under its phrase hash); else the general policy
+(:mod:`pianobot.agent.general`), which sees the phrase exactly as an own policy would (its
+own masked window and finger targets, as the ``melody`` family's phrases were seen in
+training); else, when asked (``fallback``), the scripted pianist. All of them play in one
+simulation, so the policies must share one environment (:func:`shared_env_config`,
+:func:`general_for`).
 """
 
 from __future__ import annotations
@@ -20,6 +27,7 @@ from pathlib import Path
 import numpy as np
 
 from pianobot.agent import store
+from pianobot.agent.general import find_general
 from pianobot.agent.policy import load_policy, policy_configs
 from pianobot.env.piano import EnvConfig, PianoEnv
 from pianobot.errors import PianobotError
@@ -29,6 +37,9 @@ from pianobot.music.piece import Piece
 from pianobot.music.tensor import score_tensor
 from pianobot.perform.rollout import Controller
 from pianobot.pianist.scripted import ScriptedPianist
+
+GENERAL_SOURCE = "general policy"
+"""How a section played by the general policy names its source (then the folder's name)."""
 
 
 @dataclass
@@ -44,7 +55,7 @@ class Section:
     """The phrase's own score tensor (steps x keys x channels), from its first onset."""
     controller: Controller
     source: str
-    """'policy <folder name>' or 'scripted (fallback)'."""
+    """'policy <folder name>' (its own), 'general policy <folder name>' or 'scripted (fallback)'."""
 
     def rows(self, begin: int, end: int) -> np.ndarray:
         """Env steps ``begin`` to ``end`` of the performance's score as this phrase's policy sees
@@ -97,15 +108,31 @@ def shared_env_config(models: Path, phrases: list[Phrase]) -> EnvConfig | None:
     return configs.pop() if configs else None
 
 
-class CompositionalController:
-    """Acts with the controller of the section the current step falls in."""
+def general_for(models: Path, phrases_env: EnvConfig | None, path: Path | None = None) -> Path | None:
+    """The general policy to play phrases without a policy of their own (``path``, else the newest
+    ``task-melody`` policy in ``models``), or None. With ``phrases_env`` (the environment of the
+    piece's own phrase policies, :func:`shared_env_config`) it must have been trained in the same
+    one, or it is refused in one line naming the option that differs."""
+    return find_general(
+        models,
+        phrases_env,
+        path=path,
+        ours="the phrase policies of this piece",
+        remedy="play with --no-general (and --fallback scripted), or train the general policy or the phrases with the same options",
+    )
 
-    def __init__(self, env: PianoEnv, phrases: list[Phrase], models: Path, fallback: bool):
+
+class CompositionalController:
+    """Acts with the controller of the section the current step falls in: the phrase's own
+    policy, else the ``general`` policy (a folder), else (``fallback``) the scripted pianist."""
+
+    def __init__(self, env: PianoEnv, phrases: list[Phrase], models: Path, fallback: bool, general: Path | None = None):
         spec = env.spec_score
         lead = env.lead_steps
         grace = math.ceil(DEFAULT_ONSET_TOLERANCE * spec.control_hz - 1e-9)  # steps a strike may come late
         self.sections: list[Section] = []
         previous_last_onset = None
+        general_agent = None  # loaded once, shared by every phrase it plays (a policy keeps no state)
         for phrase in phrases:
             start = lead + spec.step_of(phrase.start)
             if previous_last_onset is None:
@@ -117,6 +144,9 @@ class CompositionalController:
             folder = find_policy(models, phrase)
             if folder is not None:
                 controller, source = load_policy(folder, env), f"policy {folder.name}"
+            elif general is not None:
+                general_agent = general_agent or load_policy(general, env)
+                controller, source = general_agent, f"{GENERAL_SOURCE} {Path(general).name}"
             elif fallback:
                 controller, source = ScriptedPianist(env.config), "scripted (fallback)"
             else:  # checked before simulating; kept as a guard

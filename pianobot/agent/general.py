@@ -1,0 +1,151 @@
+"""The general policy: one policy trained on the ``melody`` task family (random one-hand phrases,
+docs/training.md), which plays the phrases that have no policy of their own and is where the
+training of a new phrase begins (fine-tuning).
+
+Where it lives: in the model store, where ``pianobot train --task melody`` puts it (folder
+``task-melody-<config hash>``); ``pianobot play`` and ``pianobot train`` take the newest such
+folder whose environment is the one they need, and ``--general-policy DIR`` names another (any
+trained policy folder). It sees a phrase as a phrase's own policy does: the sliding score window
+of that phrase alone, and its finger targets (:mod:`pianobot.perform.compose`).
+
+A general policy and the phrases it plays or starts must share one environment (the
+observations and actions it was trained with): :func:`difference` names the first field in which
+two configurations differ, and :func:`find_general` refuses, in one line naming the option to
+change, a general policy that does not fit.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from pianobot.agent import store
+from pianobot.agent.config import SACConfig
+from pianobot.agent.policy import policy_configs
+from pianobot.config import to_dict
+from pianobot.env.piano import EnvConfig
+from pianobot.errors import PianobotError
+from pianobot.music.tasks import MELODY
+
+if TYPE_CHECKING:
+    import torch
+
+GENERAL_TASK = MELODY
+"""The task family whose policy is the general policy."""
+GENERAL_KEY = store.task_key(GENERAL_TASK)
+"""Its folders' key in the model store: ``task-melody-<config hash>``."""
+
+NETWORK_FIELDS = ("hidden", "score_input", "score_features", "tactile_channels", "tactile_features")
+"""The :class:`SACConfig` fields that shape the networks: a start policy's must be the run's."""
+
+OPTIONS = {
+    "env.tactile": "--tactile/--no-tactile",
+    "env.actuated": "--joints",
+    "env.world.control": "--control",
+    "env.world.keyboard.spec": "--lowest-note/--keys",
+    "env.world.hand.spec": "--thumb",
+    "env.reward.kind": "--reward",
+    "env.reward.fingering_gate": "--fingering-gate/--no-fingering-gate",
+    "sac.": "the agent's network settings (SACConfig)",
+}
+"""The command-line option that sets a configuration field (by dotted prefix)."""
+
+
+def _difference(ours: Any, theirs: Any, path: str) -> tuple[str, Any, Any] | None:
+    if isinstance(ours, dict) and isinstance(theirs, dict):
+        for key in list(ours) + [k for k in theirs if k not in ours]:
+            found = _difference(ours.get(key), theirs.get(key), f"{path}.{key}")
+            if found is not None:
+                return found
+        return None
+    return None if ours == theirs else (path, ours, theirs)
+
+
+def difference(
+    ours: EnvConfig, theirs: EnvConfig, our_sac: SACConfig | None = None, their_sac: SACConfig | None = None
+) -> tuple[str, Any, Any] | None:
+    """The first field (dotted path, our value, theirs) in which two environments differ, or
+    (given both) two agents' networks; None when a policy of one fits the other. Whether the
+    simulation is shown (``world.gui``) does not count."""
+    mine, yours = to_dict(ours), to_dict(theirs)
+    mine["world"].pop("gui"), yours["world"].pop("gui")
+    found = _difference(mine, yours, "env")
+    if found is None and our_sac is not None and their_sac is not None:
+        nets = [{k: v for k, v in to_dict(c).items() if k in NETWORK_FIELDS} for c in (our_sac, their_sac)]
+        found = _difference(nets[0], nets[1], "sac")
+    return found
+
+
+def option_for(path: str) -> str:
+    """The command-line option behind a configuration field (its dotted path), else the path."""
+    return next((option for prefix, option in OPTIONS.items() if path.startswith(prefix)), f"config.{path}")
+
+
+def _show(value: Any) -> str:
+    if isinstance(value, dict):
+        return ", ".join(f"{k} {_show(v)}" for k, v in value.items())
+    if isinstance(value, (list, tuple)):
+        return ",".join(map(str, value))
+    return str(value).lower() if isinstance(value, bool) else str(value)
+
+
+def explain(folder: Path, found: tuple[str, Any, Any], ours: str) -> str:
+    """'the general policy F was trained with PATH X, OURS with Y (OPTION)'."""
+    path, mine, theirs = found
+    return (
+        f"the general policy {folder} was trained with {path} {_show(theirs)}, {ours} with {_show(mine)} "
+        f"({option_for(path)})"
+    )
+
+
+def find_general(
+    models: Path,
+    env: EnvConfig | None = None,
+    sac: SACConfig | None = None,
+    path: Path | None = None,
+    ours: str = "this run",
+    remedy: str = "",
+) -> Path | None:
+    """The general policy's folder: ``path`` when given (any trained policy), else the newest
+    ``task-melody`` policy in ``models`` that fits ``env`` (and ``sac``'s networks, when given),
+    else None when there is none. One that does not fit is refused: a one-line
+    :class:`PianobotError` naming the first field that differs (and its option) and ``remedy``."""
+    if path is not None:
+        if not store.is_trained(Path(path)):
+            raise PianobotError(
+                f"--general-policy {path}: not a trained policy folder (one holding {store.POLICY_FILE} and "
+                f"{store.MANIFEST_FILE}, e.g. {Path(models) / GENERAL_KEY}-<config hash>)"
+            )
+        candidates = [Path(path)]
+    else:
+        candidates = store.find_policies(models, GENERAL_KEY)
+    if not candidates:
+        return None
+    if env is None:
+        return candidates[0]
+    first = None
+    for folder in candidates:
+        their_env, their_sac = policy_configs(folder)
+        found = difference(env, their_env, sac, their_sac if sac is not None else None)
+        if found is None:
+            return folder
+        first = first or (folder, found)
+    folder, found = first
+    raise PianobotError(explain(folder, found, ours) + (f": {remedy}" if remedy else ""))
+
+
+def describe(folder: Path) -> dict:
+    """What a manifest records of the policy a run started from, or a performance used: its
+    folder, the SHA-256 of its weights, and whether it passed on a critic."""
+    return {
+        "path": str(folder),
+        "sha256": store.file_digest(Path(folder) / store.POLICY_FILE),
+        "critic": (Path(folder) / store.CRITIC_FILE).exists(),
+    }
+
+
+def start_tensors(folder: Path) -> tuple[dict[str, torch.Tensor], dict[str, torch.Tensor] | None]:
+    """(policy tensors, critic tensors or None where the folder has none) to begin training from."""
+    folder = Path(folder)
+    critic = folder / store.CRITIC_FILE
+    return store.load_tensors(folder / store.POLICY_FILE), store.load_tensors(critic) if critic.exists() else None

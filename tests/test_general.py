@@ -1,0 +1,208 @@
+"""The general policy (issue 20, items 2 and 3): `play` uses it for phrases without a policy of
+their own, and `train` starts every phrase from it (fine-tuning). A tiny policy trained on the
+`melody` family stands in for the real one, which a long run trains."""
+
+import csv
+import json
+import shutil
+from dataclasses import replace
+from pathlib import Path
+
+import pytest
+import torch
+from typer.testing import CliRunner
+
+from pianobot.agent import store
+from pianobot.agent.general import GENERAL_KEY, describe
+from pianobot.cli.app import app
+from pianobot.music.midi_io import write_midi
+from pianobot.music.piece import Note, Piece
+
+EXAMPLES = Path(__file__).parent.parent / "examples" / "midi"
+MODELS = Path(__file__).parent.parent / "models"
+ONE_NOTE_POLICY = MODELS / "5755063dc478979f-080639abf744"  # committed: plays one-note.mid at F1 1.0
+QUICK = ("--steps", "60", "--exploration-steps", "30", "--no-tactile")
+
+
+def run(*args):
+    return CliRunner().invoke(app, [str(a) for a in args])
+
+
+def one_line_error(result, *words):
+    assert result.exit_code == 2, result.output
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: "), result.output
+    for word in words:
+        assert word in lines[0], lines[0]
+
+
+@pytest.fixture(scope="module")
+def general(tmp_path_factory) -> Path:
+    """A tiny `pianobot train --task melody` policy (without touch), as the store keeps it."""
+    models = tmp_path_factory.mktemp("general")
+    result = run("train", "--task", "melody", *QUICK, "--models", models)
+    assert result.exit_code == 0, result.output
+    (folder,) = models.glob(f"{GENERAL_KEY}-*")
+    assert (folder / store.CRITIC_FILE).exists()  # it passes its critic on
+    return folder
+
+
+@pytest.fixture
+def models(tmp_path, general) -> Path:
+    """A model store of this test's own, holding the general policy."""
+    shutil.copytree(general, tmp_path / "models" / general.name)
+    return tmp_path / "models"
+
+
+def manifest_of(folder: Path) -> dict:
+    return json.loads((folder / store.MANIFEST_FILE).read_text())
+
+
+def test_train_starts_each_phrase_from_the_general_policy_unless_told_not_to(models):
+    """`train song.mid` fine-tunes from the general policy in the store and records it;
+    `--no-from-general` trains from scratch; a general policy of other options is refused."""
+    general = next(models.glob(f"{GENERAL_KEY}-*"))
+    result = run("train", EXAMPLES / "one-note.mid", *QUICK, "--models", models, "--json", "-")
+    assert result.exit_code == 0, result.output
+    assert "starting every phrase from the general policy" in result.stderr
+    (policy,) = json.loads(result.stdout)["policies"]
+    manifest = manifest_of(Path(policy["folder"]))
+    assert manifest["start"] == describe(general) == policy["start"]
+    assert manifest["start"]["sha256"] == store.file_digest(general / store.POLICY_FILE)
+    assert manifest["config"]["from_general"] is True
+    assert manifest["evaluations"][0]["step"] == 0  # the general policy, evaluated before any step
+    assert manifest["steps"] == 60  # (a tiny general policy does not play the phrase: it trained on)
+    assert (Path(policy["folder"]) / store.CRITIC_FILE).exists()
+
+    scratch = run("train", EXAMPLES / "one-note.mid", *QUICK, "--models", models, "--no-from-general", "--force")
+    assert scratch.exit_code == 0, scratch.output
+    assert "general policy" not in scratch.output
+    manifest = manifest_of(Path(policy["folder"]))  # the same folder: where a run begins is not in its hash
+    assert manifest["start"] is None and manifest["config"]["from_general"] is False
+    assert all(e["step"] > 0 for e in manifest["evaluations"])
+
+    # the general policy has no touch; this run would have it
+    tactile = run("train", EXAMPLES / "one-note.mid", "--steps", "60", "--exploration-steps", "30", "--models", models)
+    one_line_error(tactile, str(general), "env.tactile false", "this run with true", "--tactile", "--no-from-general")
+    wrong = run("train", EXAMPLES / "one-note.mid", *QUICK, "--general-policy", models / "nothing", "--models", models)
+    one_line_error(wrong, "--general-policy", "not a trained policy folder")
+    with_task = run("train", "--task", "melody", *QUICK, "--general-policy", general, "--models", models)
+    one_line_error(with_task, "--general-policy", "--task")
+
+
+def test_fine_tuning_begins_with_the_general_weights_and_resumes_knowing_it(tmp_path, general, monkeypatch):
+    """The step-0 evaluation is the general policy's own on the phrase (same weights, same figures),
+    it is logged, and a run interrupted after it resumes to a manifest that names its start."""
+    import pianobot.learn.train as train
+    from pianobot.agent.policy import load_policy
+    from pianobot.agent.tasks import make_env
+    from pianobot.learn.config import config_from_manifest
+    from pianobot.learn.log import LOG_FILE
+    from pianobot.learn.train import evaluate, train_policy
+
+    phrase = Piece((Note(0.0, 64, 0.5, 80, 3),), bpm=60)
+    base = config_from_manifest(store.read_manifest(general))  # its environment and networks
+    config = replace(
+        base,
+        steps=80,
+        eval_every=10_000,
+        eval_episodes=2,
+        checkpoint_every=40,
+        from_general=True,
+        sac=replace(base.sac, exploration_steps=30, batch_size=16),
+    )
+    seen = []
+
+    def recording(agent, target, env_config, episodes):
+        seen.append({**agent.tensors(with_training_state=False), **agent.critic_tensors()})
+        return evaluate(agent, target, env_config, episodes)
+
+    monkeypatch.setattr(train, "evaluate", recording)
+    folder = tmp_path / "phrase"
+    assert "interrupted_at" in train_policy(phrase, config, folder, stop_after=40, start=general)
+    started = {**store.load_tensors(general / store.POLICY_FILE), **store.load_tensors(general / store.CRITIC_FILE)}
+    assert seen and set(seen[0]) == set(started) and all(torch.equal(seen[0][k], started[k]) for k in started)
+    alone = evaluate(load_policy(general, make_env(phrase, config.env)), phrase, config.env, 2)
+    with open(folder / LOG_FILE, newline="") as log:
+        first = next(csv.DictReader(log))
+    assert first["step"] == "0" and float(first["eval_f1"]) == alone["f1"] and first["return"] == ""
+
+    manifest = train_policy(phrase, config, folder)  # resumed: the checkpoint knows where it began
+    assert len(seen) == 2  # the start once, the final evaluation once: no second step-0 evaluation
+    assert manifest["evaluations"][0] == {"step": 0, **alone}
+    assert manifest["start"] == describe(general) and manifest["config"]["from_general"] is True
+    assert manifest["steps"] == 80 and (folder / "learning.png").exists()
+    if manifest["evaluation"]["step"] == 0:  # the start played best: it is what was kept
+        kept = store.load_tensors(folder / store.POLICY_FILE)
+        assert all(torch.equal(kept[k], started[k]) for k in kept)
+    assert (manifest["evaluation"]["f1"], manifest["evaluation"]["return"]) >= (alone["f1"], alone["return"])
+
+
+def test_a_phrase_the_start_policy_already_plays_costs_one_evaluation(tmp_path):
+    """The committed one-note policy plays its phrase perfectly: fine-tuning from it stops at
+    step 0 and stores its very weights (no critic: it has none to pass on)."""
+    from pianobot.agent.policy import policy_target
+    from pianobot.learn.config import config_from_manifest
+    from pianobot.learn.train import train_policy
+
+    trained = config_from_manifest(store.read_manifest(ONE_NOTE_POLICY))  # (with --until-f1 0.95)
+    config = replace(trained, from_general=True, until_f1=None)  # fine-tuning's own stop: note F1 1.0
+    manifest = train_policy(policy_target(ONE_NOTE_POLICY), config, tmp_path / "m", start=ONE_NOTE_POLICY)
+    assert manifest["steps"] == 0 and manifest["updates"] == 0
+    assert manifest["evaluations"] == [manifest["evaluation"]] and manifest["evaluation"]["f1"] == 1.0
+    assert manifest["evaluation"]["step"] == 0 and manifest["start"]["path"] == str(ONE_NOTE_POLICY)
+    stored, start = (store.load_tensors(f / store.POLICY_FILE) for f in (tmp_path / "m", ONE_NOTE_POLICY))
+    assert set(stored) == set(start) and all(torch.equal(stored[k], start[k]) for k in start)
+    assert not (tmp_path / "m" / store.CRITIC_FILE).exists()
+    # --until-f1 0.95 stops there too; a target it does not reach trains on
+    assert config.stop_f1 == 1.0 and replace(config, until_f1=0.95).stop_f1 == 0.95
+    assert replace(config, from_general=False).stop_f1 is None
+
+
+def test_play_uses_a_phrases_own_policy_then_the_general_policy_and_says_so(tmp_path, models):
+    general = next(models.glob(f"{GENERAL_KEY}-*"))
+    trained = run("train", EXAMPLES / "one-note.mid", *QUICK, "--no-from-general", "--models", models)
+    assert trained.exit_code == 0, trained.output
+    song = write_midi(Piece((Note(0.0, 64, 1.0, 80, 3), Note(3.0, 67, 4.0, 70, 4)), bpm=60), tmp_path / "song.mid")
+    args = ("play", song, "-o", tmp_path / "out.mid", "--models", models, "--phrase-notes", "1")
+    result = run(*args)  # phrase 0 is one-note.mid's note: its own policy; phrase 1 has none
+    assert result.exit_code == 0, result.output
+    assert f"phrases 1 had no policy of their own and were played by the general policy {general}" in result.output
+    report = json.loads((tmp_path / "out.report.json").read_text())
+    assert report["phrases"]["0"].startswith("policy 5755063dc478979f-")
+    assert report["phrases"]["1"] == f"general policy {general.name}"
+    assert report["general_policy"] == describe(general)
+
+    # own policy > general policy > scripted fallback: without the general policy, as before
+    one_line_error(run(*args, "--no-general"), "phrase 1 (G4)", "--fallback scripted", "pianobot train --task melody")
+    fallback = run(*args, "--no-general", "--fallback", "scripted")
+    assert fallback.exit_code == 0, fallback.output
+    report = json.loads((tmp_path / "out.report.json").read_text())
+    assert report["phrases"]["1"] == "scripted (fallback)" and "general_policy" not in report
+    one_line_error(run(*args, "--no-general", "--general-policy", general), "--general-policy", "--no-general")
+
+    # a general policy trained in another environment than the phrase policies is refused
+    other = run(*args, "--general-policy", ONE_NOTE_POLICY)
+    one_line_error(other, f"the general policy {ONE_NOTE_POLICY} was trained with env.", "--no-general")
+
+
+def test_play_with_only_the_general_policy_plays_every_phrase_in_its_environment(tmp_path, models):
+    general = next(models.glob(f"{GENERAL_KEY}-*"))
+    result = run("play", EXAMPLES / "three-note.mid", "-o", tmp_path / "out.mid", "--models", models)
+    assert result.exit_code == 0, result.output
+    report = json.loads((tmp_path / "out.report.json").read_text())
+    assert report["phrases"] == {"0": f"general policy {general.name}"}
+
+
+def test_the_options_default_to_the_training_configuration_and_say_what_they_do():
+    import typer.main
+
+    from pianobot.learn.config import TrainConfig
+
+    commands = typer.main.get_command(app).commands
+    train = {p.name: p for p in commands["train"].params}
+    assert train["from_general"].default is TrainConfig.from_general is True
+    assert train["until_f1"].default is TrainConfig.until_f1 is None and TrainConfig.finetune_until_f1 == 1.0
+    assert "evaluate it before any training step" in train["from_general"].help
+    play = {p.name: p.default for p in commands["play"].params}
+    assert play["use_general"] is True and play["general_policy"] is None
