@@ -261,6 +261,11 @@ class SAC:
         features = self._features(vector[None], None if tactile is None else tactile[None])
         return self.actor.deterministic(features)[0].cpu().numpy()
 
+    @torch.no_grad()
+    def act_batch(self, vectors: np.ndarray, tactiles: np.ndarray | None) -> np.ndarray:
+        """Deterministic actions for a batch of :meth:`split` inputs, one row per environment."""
+        return self.actor.deterministic(self._features(vectors, tactiles)).cpu().numpy()
+
     def sample(self, vector: np.ndarray, tactile: np.ndarray | None) -> np.ndarray:
         """A noisy action from :meth:`split` inputs (training's behaviour policy)."""
         return self.sample_batch(vector[None], None if tactile is None else tactile[None])[0]

@@ -27,7 +27,7 @@ from pianobot.env.piano import EnvConfig
 from pianobot.env.rewards import RewardConfig
 from pianobot.errors import PianobotError, PianobotWarning, one_line, quote
 from pianobot.files import atomic_write, check_writable, why
-from pianobot.learn.config import MAX_ENVS, TrainConfig
+from pianobot.learn.config import LEARNERS, MAX_ENVS, DaggerConfig, TrainConfig
 from pianobot.learn.explore import EXPLORATIONS
 from pianobot.music.instrument import HandSpec, KeyboardSpec
 from pianobot.music.load import LoadOptions
@@ -625,6 +625,13 @@ def train(
     seed: int = typer.Option(
         TrainConfig.seed, "--seed", help="Seed of the simulation, the exploration and the networks."
     ),
+    learner: str = typer.Option(
+        TrainConfig.learner,
+        "--learner",
+        help="How policies learn: sac (Soft Actor-Critic from the rewards, the paper's) or dagger (imitating the "
+        f"scripted pianist in rounds of {DaggerConfig.round_steps} steps, every step labelled with its action; "
+        "needs --control velocity or position; docs/training.md).",
+    ),
     until_f1: Optional[float] = typer.Option(
         TrainConfig.until_f1,
         "--until-f1",
@@ -729,6 +736,8 @@ def train(
         raise PianobotError(f"--workers {workers} --threads {threads}: give 1 or more of each")
     if not 1 <= envs <= MAX_ENVS:
         raise PianobotError(f"--envs {envs}: give 1 to {MAX_ENVS} environments")
+    if learner not in LEARNERS:
+        raise PianobotError(f"--learner {quote(learner)}: choose one of {', '.join(LEARNERS)}")
     if cluster not in ("local", "ray"):
         raise PianobotError(f"--cluster {quote(cluster)}: choose local or ray")
     resolve_device(device)  # a GPU asked for and missing: say so before any work
@@ -772,6 +781,7 @@ def train(
         config = TrainConfig(
             steps=steps,
             seed=seed,
+            learner=learner,
             explore=explore,
             until_f1=until_f1,
             from_general=from_general and task is None,  # a task family trains from scratch

@@ -12,6 +12,36 @@ from pianobot.learn.explore import EXPLORATIONS
 
 MAX_ENVS = 256
 """Most environments one run steps at once (``TrainConfig.envs``)."""
+LEARNERS = ("sac", "dagger")
+"""How a policy learns (``TrainConfig.learner``): Soft Actor-Critic from rewards (the paper), or
+DAgger, imitating the scripted pianist (:mod:`pianobot.learn.dagger`)."""
+
+
+@dataclass(frozen=True)
+class DaggerConfig:
+    """The settings of DAgger (``TrainConfig.learner = 'dagger'``), with their defaults."""
+
+    round_steps: int = 20_000
+    """Environment steps gathered in a round, before the policy learns from all gathered so far."""
+    updates_per_step: float = 0.5
+    """Gradient steps of behaviour cloning at a round's end, per environment step of the round."""
+    batch_size: int = 256
+    learning_rate: float = 1e-3
+    """Adam's step size, over the actor and the encoder, at the run's start; it falls along a
+    cosine to ``final_learning_rate`` at its last step (a cloned policy must be precise: docs/training.md)."""
+    final_learning_rate: float = 3e-5
+    teacher_share: float = 0.5
+    """In round r an episode is played by the teacher with probability ``teacher_share ** r``
+    (round 0: every one), else by the policy; the teacher labels every step either way."""
+    dataset_size: int = 500_000
+    """Steps kept to learn from (the oldest go first); at most the run's steps are held in memory."""
+
+    def __post_init__(self) -> None:
+        check_ranges(self, round_steps=(1, 10**9), batch_size=(1, 1 << 16), dataset_size=(1, 10**8))
+        if not (self.updates_per_step > 0 and 0 < self.final_learning_rate <= self.learning_rate):
+            raise ValueError("updates_per_step must be above 0, and 0 < final_learning_rate <= learning_rate")
+        if not 0 <= self.teacher_share <= 1:
+            raise ValueError(f"teacher_share must lie in [0, 1]; got {self.teacher_share}")
 
 
 @dataclass(frozen=True)
@@ -21,6 +51,10 @@ class TrainConfig:
     steps: int = 50_000
     """Environment steps, exploration included."""
     seed: int = 0
+    learner: str = "sac"
+    """'sac' (the paper: Soft Actor-Critic, :mod:`pianobot.learn.train`) or 'dagger' (imitating
+    the scripted pianist, :mod:`pianobot.learn.dagger`; ``explore`` and ``sac``'s learning
+    settings then go unused, its networks' shape still counts)."""
     explore: str = "scripted"
     """'uniform', 'repeat', 'prior' (the paper's best) or 'scripted' (ours)."""
     eval_every: int = 5_000
@@ -40,6 +74,7 @@ class TrainConfig:
     1.0, once the policy plays the phrase perfectly from every evaluation hand start, so a phrase
     the general policy already plays costs one evaluation. Left out of the hash with ``from_general``."""
     sac: SACConfig = field(default_factory=SACConfig)
+    dagger: DaggerConfig = field(default_factory=DaggerConfig)
     env: EnvConfig = field(default_factory=EnvConfig)
     envs: int = field(default=1, metadata={"runtime": True})
     """Environments stepped at once: 1 in the training process (the run is exactly what it always
@@ -52,13 +87,19 @@ class TrainConfig:
     def __post_init__(self) -> None:
         if self.device not in DEVICES:
             raise ValueError(f"device must be one of {', '.join(DEVICES)}; got {self.device!r}")
+        if self.learner not in LEARNERS:
+            raise ValueError(f"learner must be one of {', '.join(LEARNERS)}; got {self.learner!r}")
+        if self.learner == "dagger" and self.env.world.control == "torque":
+            raise ValueError(
+                "the dagger learner needs velocity or position control (the scripted pianist has no torques)"
+            )
         if self.explore not in EXPLORATIONS:
             raise ValueError(f"exploration must be one of {', '.join(EXPLORATIONS)}; got {self.explore!r}")
-        if self.explore == "scripted" and self.env.world.control == "torque":
+        if self.learner == "sac" and self.explore == "scripted" and self.env.world.control == "torque":
             raise ValueError(
                 "scripted exploration needs velocity or position control (the scripted pianist has no torques)"
             )
-        if not 0 <= self.sac.exploration_steps < self.steps:
+        if self.learner == "sac" and not 0 <= self.sac.exploration_steps < self.steps:
             raise ValueError(
                 f"{self.steps} steps must exceed the {self.sac.exploration_steps} exploration steps, or nothing is learnt"
             )

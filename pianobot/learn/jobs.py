@@ -17,6 +17,7 @@ import torch
 from pianobot.agent import store
 from pianobot.agent.general import find_general
 from pianobot.errors import PianobotError
+from pianobot.learn.dagger import dagger_policy
 from pianobot.learn.train import Progress, TrainConfig, train_policy
 from pianobot.music.phrases import Phrase
 from pianobot.music.piece import Piece
@@ -52,6 +53,12 @@ def _exit_with_parent(parent: int, every: float = 0.5) -> None:
     threading.Thread(target=watch, daemon=True, name="exit-with-parent").start()
 
 
+def learner(config: TrainConfig) -> Callable[..., dict]:
+    """The training loop of ``config.learner``: :func:`~pianobot.learn.train.train_policy` (SAC)
+    or :func:`~pianobot.learn.dagger.dagger_policy`; both take the same arguments."""
+    return dagger_policy if config.learner == "dagger" else train_policy
+
+
 def _run_job(
     job: PhraseJob, config: TrainConfig, queue=None, threads: int | None = None, start: Path | None = None
 ) -> dict:
@@ -62,7 +69,7 @@ def _run_job(
         if queue is not None:
             queue.put((job.key, progress))
 
-    return train_policy(job.target, config, job.folder, report, about=job.about(), start=start)
+    return learner(config)(job.target, config, job.folder, report, about=job.about(), start=start)
 
 
 def general_start(config: TrainConfig, models: Path, path: Path | None = None) -> tuple[TrainConfig, Path | None]:
@@ -132,7 +139,7 @@ def run_jobs(
     if workers <= 1 or len(jobs) <= 1:
         torch.set_num_threads(threads)
         for job in jobs:
-            results[job.key] = train_policy(
+            results[job.key] = learner(config)(
                 job.target,
                 config,
                 job.folder,

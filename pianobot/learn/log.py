@@ -33,6 +33,7 @@ COLUMNS = (
     "alpha",
     "entropy",
     "q",
+    "cloning_loss",
     "eval_f1",
     "eval_velocity_mae",
     "eval_return",
@@ -96,10 +97,10 @@ class TrainingLog:
                 if key not in ("step", "episode") and value is not None:
                     self.board.add_scalar(key.replace("eval_", "eval/"), value, step)
 
-    def evaluation(self, step: int, seconds: float, evaluation: dict) -> None:
-        """An evaluation before any episode (a fine-tuning run's start policy, at step 0): a row of
-        its own, with no return or losses."""
-        values = {"step": step, "episode": 0, "seconds": round(seconds, 2)}
+    def evaluation(self, step: int, seconds: float, evaluation: dict, episode: int = 0) -> None:
+        """An evaluation that no episode's end carries (a fine-tuning run's start policy, at step 0;
+        a DAgger round's end, after ``episode`` episodes): a row of its own, with no return or losses."""
+        values = {"step": step, "episode": episode, "seconds": round(seconds, 2)}
         values.update({f"eval_{k}": evaluation[k] for k in ("f1", "velocity_mae", "return")})
         self.writer.writerow(values)
         self.file.flush()
