@@ -105,3 +105,26 @@ def test_train_envs_and_device_options(tmp_path, monkeypatch):
     assert result.exit_code == 0, result.output
     manifest = json.loads((Path(json.loads(result.stdout)["policies"][0]["folder"]) / "manifest.json").read_text())
     assert manifest["device"] == "cpu"
+
+
+def test_train_with_the_dagger_learner_in_rounds_of_round_steps(tmp_path):
+    """`--learner dagger --round-steps N`: the stored policy's manifest says so, and it learnt in
+    rounds of N steps (each ending in an evaluation); bad values are one line and exit code 2."""
+    song = EXAMPLES / "one-note.mid"
+    result = run(
+        "train", song, "--steps", "100", "--learner", "dagger", "--round-steps", "40", "--no-tactile",
+        "--models", tmp_path, "--json", "-",
+    )  # fmt: skip
+    assert result.exit_code == 0, result.output
+    manifest = json.loads((Path(json.loads(result.stdout)["policies"][0]["folder"]) / "manifest.json").read_text())
+    assert manifest["config"]["learner"] == "dagger" and manifest["config"]["dagger"]["round_steps"] == 40
+    rounds = [e["round"] for e in manifest["evaluations"] if "round" in e]
+    assert rounds == [1, 2, 3]  # rounds end at the first episode ends after 40, 80 and 100 steps
+    for args, words in (
+        (("--learner", "ppo"), ("--learner ppo", "sac, dagger")),
+        (("--learner", "dagger", "--round-steps", "0"), ("--round-steps 0",)),
+        (("--learner", "dagger", "--control", "torque", "--explore", "prior"), ("velocity or position",)),
+    ):
+        result = run("train", song, *QUICK, *args, "--models", tmp_path / "bad")
+        assert result.exit_code == 2 and len(result.stderr.strip().splitlines()) == 1, result.output
+        assert all(word in result.stderr for word in words), result.stderr

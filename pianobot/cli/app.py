@@ -632,6 +632,12 @@ def train(
         f"scripted pianist in rounds of {DaggerConfig.round_steps} steps, every step labelled with its action; "
         "needs --control velocity or position; docs/training.md).",
     ),
+    round_steps: int = typer.Option(
+        DaggerConfig.round_steps,
+        "--round-steps",
+        help="With --learner dagger: environment steps gathered in a round, after which the policy learns from every "
+        "step gathered so far and is evaluated (a round ends at the first episode end after them).",
+    ),
     until_f1: Optional[float] = typer.Option(
         TrainConfig.until_f1,
         "--until-f1",
@@ -775,6 +781,8 @@ def train(
             tactile=tactile,
             actuated=tuple(j.strip() for j in joints.split(",") if j.strip()),
         )
+    with option("--round-steps", round_steps):
+        DaggerConfig(round_steps=round_steps)
     with option("--exploration-steps", exploration_steps):
         sac = SACConfig(exploration_steps=exploration_steps)
     with option():
@@ -782,6 +790,7 @@ def train(
             steps=steps,
             seed=seed,
             learner=learner,
+            dagger=DaggerConfig(round_steps=round_steps),
             explore=explore,
             until_f1=until_f1,
             from_general=from_general and task is None,  # a task family trains from scratch

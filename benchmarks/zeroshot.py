@@ -1,0 +1,189 @@
+"""The general policy on pieces it was never trained on, beside the scripted pianist (its teacher).
+
+    python benchmarks/zeroshot.py [--general DIR] [--melodies 50] [--seed 2026] [--per-task 10]
+                                  [--json out.json] [--plot docs/zeroshot.png]
+
+Three sets, each played in one continuous simulation per piece, from hand start 0:
+
+- ``examples``: the one-hand example songs (their own fingering), split into phrases as
+  ``pianobot play`` splits them, every phrase played by the general policy (no phrase policy is
+  looked up: a model store with nothing in it but the general policy);
+- ``melodies``: ``--melodies`` random melodies of 8 to 16 notes in every key
+  (:func:`pianobot.music.melodies.random_melody`, 60-144 bpm, velocities 20-127), drawn with
+  generators seeded ``[--seed, index, draw]`` (no training run draws from these: the melody task
+  family draws from the environment's generator, the melody benchmark from ``[tonic, index, draw]``),
+  fingered by the planner; a melody it says this hand cannot play at its tempo is drawn again;
+- ``tasks``: ``--per-task`` instances of each of the paper's task families (seeds 0, 1, ...).
+
+For each piece: note F1, velocity MAE (matched notes, MIDI units) and per-step key-press F1 (the
+paper's frame-level measure), for the general policy and for the scripted pianist on the same
+piece (the ceiling); a Markdown table per set (means; the general policy's share of the scripted
+pianist's note F1) and, with ``--plot``, a figure of every piece's note F1 for both.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+import torch
+
+from pianobot.agent.general import find_general
+from pianobot.agent.policy import policy_configs
+from pianobot.music.instrument import HandSpec, KeyboardSpec
+from pianobot.music.load import LoadOptions, load_piece
+from pianobot.music.melodies import describe, random_melody
+from pianobot.music.metrics import key_press_f1
+from pianobot.music.phrases import DEFAULT_MAX_NOTES, split_phrases
+from pianobot.music.piece import Piece
+from pianobot.music.tasks import TASKS, make_task
+from pianobot.perform.compose import CompositionalController
+from pianobot.perform.perform import PLAY_CONFIG, perform
+from pianobot.pianist.fingering import ensure_fingering
+
+EXAMPLES = ("c-major-scale", "mary", "ode-to-joy", "twinkle", "one-note", "three-note", "six-note", "rhythmic", "chord")
+"""The one-hand example songs in examples/midi (the recordings and the five-finger piece need a
+hand part reduced or five fingers)."""
+MELODY_DRAWS = 50
+
+
+def figures(reference: Piece, rollout) -> dict:
+    report = rollout.report()
+    return {
+        "f1": report.f1,
+        "velocity_mae": report.velocity_mae,
+        "step_f1": key_press_f1(reference, rollout.played)[2],
+    }
+
+
+def play_both(piece: Piece, general: Path, empty: Path) -> dict:
+    """The general policy's and the scripted pianist's figures on ``piece``."""
+    env_config, _ = policy_configs(general)
+    phrases = split_phrases(piece, DEFAULT_MAX_NOTES)
+    policy = perform(piece, lambda env: CompositionalController(env, phrases, empty, False, general), env_config)
+    scripted = perform(piece, "scripted", PLAY_CONFIG)
+    return {"notes": len(piece), "general": figures(piece, policy), "scripted": figures(piece, scripted)}
+
+
+def example_set(root: Path) -> list[tuple[str, Piece]]:
+    """The example songs as ``pianobot play`` reads them: their own fingering, else the planner's."""
+    pieces = [(name, load_piece(root / f"{name}.mid", LoadOptions())) for name in EXAMPLES]
+    return [(name, ensure_fingering(piece, KeyboardSpec(), HandSpec())[0]) for name, piece in pieces]
+
+
+def melody_set(count: int, seed: int) -> tuple[list[tuple[str, Piece]], int]:
+    """``count`` playable random melodies, and how many draws the planner turned down."""
+    out, rejected = [], 0
+    for index in range(count):
+        for draw in range(MELODY_DRAWS):
+            piece = random_melody(np.random.default_rng([seed, index, draw]), KeyboardSpec())
+            fingered, plan = ensure_fingering(piece, KeyboardSpec(), HandSpec())
+            if plan is None or not plan.problems:
+                out.append((describe(fingered), fingered))
+                break
+            rejected += 1
+        else:
+            raise RuntimeError(f"no playable melody for index {index} in {MELODY_DRAWS} draws")
+    return out, rejected
+
+
+def task_set(per_task: int) -> list[tuple[str, Piece]]:
+    return [
+        (f"{task} #{seed}", make_task(task, np.random.default_rng(seed), KeyboardSpec()))
+        for task in TASKS
+        for seed in range(per_task)
+    ]
+
+
+def summary(rows: list[dict]) -> dict:
+    def mean(who: str, key: str) -> float:
+        values = [r[who][key] for r in rows if r[who][key] is not None]
+        return float(np.mean(values)) if values else float("nan")
+
+    out = {who: {k: mean(who, k) for k in ("f1", "velocity_mae", "step_f1")} for who in ("general", "scripted")}
+    out["pieces"], out["notes"] = len(rows), sum(r["notes"] for r in rows)
+    out["share"] = out["general"]["f1"] / out["scripted"]["f1"]
+    out["at_least_0.9"] = sum(r["general"]["f1"] >= 0.9 for r in rows)
+    return out
+
+
+def table(results: dict[str, list[dict]]) -> str:
+    lines = [
+        "| set | pieces | notes | note F1 general | note F1 scripted | general / scripted | pieces at F1 >= 0.9 "
+        "| velocity MAE general | velocity MAE scripted | per-step F1 general | per-step F1 scripted |",
+        "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |",
+    ]
+    for name, rows in results.items():
+        s = summary(rows)
+        g, c = s["general"], s["scripted"]
+        lines.append(
+            f"| {name} | {s['pieces']} | {s['notes']} | {g['f1']:.3f} | {c['f1']:.3f} | {100 * s['share']:.0f} % | "
+            f"{s['at_least_0.9']}/{s['pieces']} | {g['velocity_mae']:.1f} | {c['velocity_mae']:.1f} | "
+            f"{g['step_f1']:.3f} | {c['step_f1']:.3f} |"
+        )
+    return "\n".join(lines)
+
+
+def plot(results: dict[str, list[dict]], path: str) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    figure, axes = plt.subplots(1, len(results), figsize=(4.2 * len(results), 3.6), squeeze=False)
+    for axis, (name, rows) in zip(axes[0], results.items()):
+        x = np.arange(len(rows))
+        axis.scatter(x, [r["scripted"]["f1"] for r in rows], s=14, marker="s", label="scripted pianist", alpha=0.7)
+        axis.scatter(x, [r["general"]["f1"] for r in rows], s=14, label="general policy", alpha=0.8)
+        axis.set_title(f"{name} ({len(rows)})")
+        axis.set_ylim(-0.05, 1.05)
+        axis.set_xlabel("piece")
+        axis.axhline(0.9, color="grey", lw=0.6, ls="--")
+    axes[0][0].set_ylabel("note F1")
+    axes[0][0].legend(loc="lower left", fontsize=8)
+    figure.tight_layout()
+    figure.savefig(path, dpi=90)
+    plt.close(figure)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--general", type=Path, help="the general policy's folder (default: the newest in --models)")
+    parser.add_argument("--models", type=Path, default=Path("models"), help="model store to find it in")
+    parser.add_argument("--examples", type=Path, default=Path("examples/midi"), help="folder of the example songs")
+    parser.add_argument("--melodies", type=int, default=50, help="random melodies (default 50)")
+    parser.add_argument("--seed", type=int, default=2026, help="first entry of the melodies' generator seeds")
+    parser.add_argument("--per-task", type=int, default=10, help="instances of each paper task family (default 10)")
+    parser.add_argument("--json", help="write every piece's figures here")
+    parser.add_argument("--plot", help="draw every piece's note F1 to this PNG")
+    args = parser.parse_args()
+    torch.set_num_threads(1)
+    general = find_general(args.models, path=args.general)
+    if general is None:
+        raise SystemExit(
+            f"no general policy in {args.models}: train one with `pianobot train --task melody` or give --general"
+        )
+    began = time.perf_counter()
+    melodies, rejected = melody_set(args.melodies, args.seed)
+    sets = {"examples": example_set(args.examples), "melodies": melodies, "tasks": task_set(args.per_task)}
+    results: dict[str, list[dict]] = {}
+    with tempfile.TemporaryDirectory() as empty:
+        for name, pieces in sets.items():
+            results[name] = [{"piece": label, **play_both(piece, general, Path(empty))} for label, piece in pieces]
+    print(f"general policy: {general}\n")
+    print(table(results))
+    print(f"\nMelodies the planner said this hand cannot play at their tempo, drawn again: {rejected}.")
+    print(f"{time.perf_counter() - began:.0f} s")
+    if args.json:
+        with open(args.json, "w") as f:
+            json.dump({"general": str(general), "rejected": rejected, **results}, f, indent=1)
+    if args.plot:
+        plot(results, args.plot)
+
+
+if __name__ == "__main__":
+    main()
