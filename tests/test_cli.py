@@ -533,3 +533,15 @@ def test_committed_policies_play_their_example_from_a_fresh_checkout(tmp_path, s
         assert all(source.startswith("policy ") for source in report["phrases"].values())
         f1s.append(report["f1"])
     assert sum(f1s) / 3 >= 0.9, f1s
+
+
+@pytest.mark.parametrize("song", ["mary", "ode-to-joy", "c-major-scale"])
+def test_the_committed_general_policy_plays_unseen_songs_from_a_fresh_checkout(tmp_path, song):
+    """No phrase of these songs has a policy of its own: `play` uses the general policy committed
+    in models/ (trained by `--learner dagger`, models/README.md) for every one, and says so."""
+    result = run("play", EXAMPLES / f"{song}.mid", "-o", tmp_path / "o.mid", "--models", MODELS)
+    assert result.exit_code == 0, result.output
+    report = json.loads((tmp_path / "o.report.json").read_text())
+    assert report["phrases"] and all(s.startswith("general policy task-melody-") for s in report["phrases"].values())
+    assert report["general_policy"]["path"].endswith(tuple(p.name for p in MODELS.glob("task-melody-*")))
+    assert report["f1"] >= 0.9, report["f1"]
