@@ -135,3 +135,11 @@ def test_a_start_policy_that_already_plays_the_phrase_costs_one_evaluation(tmp_p
     sac = replace(config, learner="sac", finetune_until_f1=1.0, steps=100)
     manifest = train_policy(PHRASE, sac, tmp_path / "sac", start=tmp_path / "general")
     assert manifest["start"]["critic"] is False and manifest["evaluations"][0]["step"] == 0
+
+
+def test_the_dagger_settings_name_a_dagger_runs_folder_and_not_a_sac_runs():
+    rounds = DaggerConfig(round_steps=1000)
+    assert store.config_hash(TrainConfig()) == store.config_hash(TrainConfig(dagger=rounds))  # SAC: unused
+    dagger = TrainConfig(learner="dagger")
+    assert store.config_hash(dagger) != store.config_hash(TrainConfig())
+    assert store.config_hash(dagger) != store.config_hash(replace(dagger, dagger=rounds))
