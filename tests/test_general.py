@@ -86,8 +86,24 @@ def test_train_starts_each_phrase_from_the_general_policy_unless_told_not_to(mod
     one_line_error(tactile, str(general), "env.tactile false", "this run with true", "--tactile", "--no-from-general")
     wrong = run("train", EXAMPLES / "one-note.mid", *QUICK, "--general-policy", models / "nothing", "--models", models)
     one_line_error(wrong, "--general-policy", "not a trained policy folder")
-    with_task = run("train", "--task", "melody", *QUICK, "--general-policy", general, "--models", models)
-    one_line_error(with_task, "--general-policy", "--task")
+    unused = run("train", EXAMPLES / "one-note.mid", *QUICK, "--no-from-general", "--general-policy", general)
+    one_line_error(unused, "--general-policy", "--no-from-general")
+
+
+def test_train_task_with_general_policy_continues_that_policy(tmp_path, general):
+    """`train --task melody --general-policy P` goes on training P on the family (evaluated
+    first, its start recorded); without the option a task family trains from scratch."""
+    models = tmp_path / "models"
+    result = run("train", "--task", "melody", *QUICK, "--general-policy", general, "--models", models, "--json", "-")
+    assert result.exit_code == 0, result.output
+    assert "continuing the policy" in result.stderr
+    (policy,) = json.loads(result.stdout)["policies"]
+    manifest = manifest_of(Path(policy["folder"]))
+    assert manifest["start"] == describe(general) and manifest["config"]["from_general"] is True
+    assert manifest["evaluations"][0]["step"] == 0
+    scratch = run("train", "--task", "melody", *QUICK, "--models", models, "--force")
+    assert scratch.exit_code == 0, scratch.output
+    assert manifest_of(Path(policy["folder"]))["start"] is None
 
 
 def test_fine_tuning_begins_with_the_general_weights_and_resumes_knowing_it(tmp_path, general, monkeypatch):

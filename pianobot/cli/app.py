@@ -653,9 +653,14 @@ def train(
         f"reaches note F1 {TrainConfig.finetune_until_f1} (--until-f1 sets another), keeping the best evaluated "
         "policy: a phrase the general policy already plays costs one evaluation, and none ends worse than the "
         "general policy plays it. Without a general policy, or with --no-from-general, phrases train from scratch. "
-        "Not used with --task.",
+        "With --task only with --general-policy.",
     ),
-    general_policy: Optional[Path] = GeneralPolicy,
+    general_policy: Optional[Path] = typer.Option(
+        None,
+        "--general-policy",
+        help="The policy to start from (any trained policy; default: the newest `pianobot train --task melody` "
+        "policy in --models whose options fit). With --task: that policy's training goes on, on the task family.",
+    ),
     workers: int = typer.Option(1, "--workers", help="Train this many phrases at once, in separate processes."),
     threads: int = typer.Option(
         1, "--threads", help="Torch threads per training process (workers x threads should not exceed the cores)."
@@ -793,24 +798,25 @@ def train(
             dagger=DaggerConfig(round_steps=round_steps),
             explore=explore,
             until_f1=until_f1,
-            from_general=from_general and task is None,  # a task family trains from scratch
+            # a task family trains from scratch, or continues the policy --general-policy names
+            from_general=from_general and (task is None or general_policy is not None),
             sac=sac,
             env=env,
             eval_episodes=TASK_EVAL_EPISODES if task is not None else TrainConfig.eval_episodes,
             envs=envs,
             device=device,
         )
-    if general_policy is not None and (task is not None or not from_general):
-        raise PianobotError(
-            f"--general-policy {general_policy} starts the phrases of a piece: drop it with "
-            f"{'--task' if task is not None else '--no-from-general'}"
-        )
+    if general_policy is not None and not from_general:
+        raise PianobotError(f"--general-policy {general_policy} is where training starts: drop it or --no-from-general")
     if general_policy is not None:
         find_general(models, path=general_policy)  # a folder that holds no policy: said before any work
     start = None
     if task is not None:
         todo, done = plan_jobs([task_job(task, config, models)], force)
         label = f"task {task}"
+        if general_policy is not None and todo:
+            config, start = general_start(config, models, general_policy)
+            console.print(f"continuing the policy {said(start)} on {said(label)}: evaluated first", soft_wrap=True)
     else:
         piece = read_song(
             song, make_options(track, tempo, transpose, fingering, hand_part, split, quantize, refinger), keyboard, hand
