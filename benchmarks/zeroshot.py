@@ -1,7 +1,7 @@
 """The general policy on pieces it was never trained on, beside the scripted pianist (its teacher).
 
     python benchmarks/zeroshot.py [--general DIR] [--melodies 50] [--seed 2026] [--per-task 10]
-                                  [--json out.json] [--plot docs/zeroshot.png]
+                                  [--sets examples melodies tasks] [--json out.json] [--plot docs/zeroshot.png]
 
 Three sets, each played in one continuous simulation per piece, from hand start 0:
 
@@ -18,7 +18,10 @@ Three sets, each played in one continuous simulation per piece, from hand start 
 For each piece: note F1, velocity MAE (matched notes, MIDI units) and per-step key-press F1 (the
 paper's frame-level measure), for the general policy and for the scripted pianist on the same
 piece (the ceiling); a Markdown table per set (means; the general policy's share of the scripted
-pianist's note F1) and, with ``--plot``, a figure of every piece's note F1 for both.
+pianist's note F1), for the melodies the share of notes the general policy played by phrase and by
+onset within a phrase (where it loses notes), and, with ``--plot``, a figure of every piece's
+note F1 for both. Another ``--seed`` gives a validation set, e.g. to choose among checkpoints
+without looking at the test set.
 """
 
 from __future__ import annotations
@@ -49,6 +52,7 @@ EXAMPLES = ("c-major-scale", "mary", "ode-to-joy", "twinkle", "one-note", "three
 """The one-hand example songs in examples/midi (the recordings and the five-finger piece need a
 hand part reduced or five fingers)."""
 MELODY_DRAWS = 50
+SETS = ("examples", "melodies", "tasks")
 
 
 def figures(reference: Piece, rollout) -> dict:
@@ -60,13 +64,44 @@ def figures(reference: Piece, rollout) -> dict:
     }
 
 
+def placed_hits(phrases, rollout) -> list[tuple[int, int, bool]]:
+    """For every note of the piece: (its phrase's index, its onset's index within the phrase,
+    whether it was played), to see where a performance loses notes."""
+    played = {(r.reference.pitch, r.reference.onset) for r in rollout.report().rows if r.reference and r.played}
+    out = []
+    for phrase in phrases:
+        onsets = sorted({note.onset for note in phrase.notes})
+        out += [(phrase.index, onsets.index(n.onset), (n.pitch, n.onset) in played) for n in phrase.notes]
+    return out
+
+
 def play_both(piece: Piece, general: Path, empty: Path) -> dict:
     """The general policy's and the scripted pianist's figures on ``piece``."""
     env_config, _ = policy_configs(general)
     phrases = split_phrases(piece, DEFAULT_MAX_NOTES)
     policy = perform(piece, lambda env: CompositionalController(env, phrases, empty, False, general), env_config)
     scripted = perform(piece, "scripted", PLAY_CONFIG)
-    return {"notes": len(piece), "general": figures(piece, policy), "scripted": figures(piece, scripted)}
+    return {
+        "notes": len(piece),
+        "general": {**figures(piece, policy), "hits": placed_hits(phrases, policy)},
+        "scripted": figures(piece, scripted),
+    }
+
+
+def where_table(rows: list[dict]) -> str:
+    """The share of notes the general policy played, by phrase and by onset within a phrase."""
+    hits = [hit for row in rows for hit in row["general"]["hits"]]
+    lines = [
+        "| notes | " + " | ".join(f"{k + 1}" for k in range(DEFAULT_MAX_NOTES)) + " |",
+        "| --- |" + " ---: |" * DEFAULT_MAX_NOTES,
+    ]
+    for label, position in (("phrase", 0), ("onset within its phrase", 1)):
+        cells = []
+        for k in range(DEFAULT_MAX_NOTES):
+            played = [ok for *place, ok in hits if place[position] == k]
+            cells.append(f"{np.mean(played):.2f} ({len(played)})" if played else "")
+        lines.append(f"| played, by {label} | " + " | ".join(cells) + " |")
+    return "\n".join(lines)
 
 
 def example_set(root: Path) -> list[tuple[str, Piece]]:
@@ -158,6 +193,7 @@ def main() -> None:
     parser.add_argument("--melodies", type=int, default=50, help="random melodies (default 50)")
     parser.add_argument("--seed", type=int, default=2026, help="first entry of the melodies' generator seeds")
     parser.add_argument("--per-task", type=int, default=10, help="instances of each paper task family (default 10)")
+    parser.add_argument("--sets", nargs="+", choices=SETS, default=list(SETS), help="which sets to play (default all)")
     parser.add_argument("--json", help="write every piece's figures here")
     parser.add_argument("--plot", help="draw every piece's note F1 to this PNG")
     args = parser.parse_args()
@@ -169,13 +205,21 @@ def main() -> None:
         )
     began = time.perf_counter()
     melodies, rejected = melody_set(args.melodies, args.seed)
-    sets = {"examples": example_set(args.examples), "melodies": melodies, "tasks": task_set(args.per_task)}
+    every = {
+        "examples": lambda: example_set(args.examples),
+        "melodies": lambda: melodies,
+        "tasks": lambda: task_set(args.per_task),
+    }
+    sets = {name: every[name]() for name in SETS if name in args.sets}
     results: dict[str, list[dict]] = {}
     with tempfile.TemporaryDirectory() as empty:
         for name, pieces in sets.items():
             results[name] = [{"piece": label, **play_both(piece, general, Path(empty))} for label, piece in pieces]
     print(f"general policy: {general}\n")
     print(table(results))
+    if "melodies" in results:
+        print("\nRandom melodies: the share of notes the general policy played (count), by place\n")
+        print(where_table(results["melodies"]))
     print(f"\nMelodies the planner said this hand cannot play at their tempo, drawn again: {rejected}.")
     print(f"{time.perf_counter() - began:.0f} s")
     if args.json:

@@ -1,0 +1,35 @@
+"""benchmarks/zeroshot.py's breakdown of where the general policy loses notes (by phrase and by
+onset within a phrase): the figure the docs use to tell weak phrases from weak hand-overs."""
+
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.append(str(ROOT / "benchmarks"))
+
+import zeroshot  # noqa: E402
+
+from pianobot.music.phrases import split_phrases  # noqa: E402
+from pianobot.music.piece import Note, Piece  # noqa: E402
+from pianobot.perform.rollout import Rollout  # noqa: E402
+
+
+def test_placed_hits_name_each_missed_note_by_its_phrase_and_onset():
+    # 8 quarter notes, the 4th and the 2nd-to-last left out, one extra note and one late note
+    notes = tuple(Note(0.5 * i, 60 + i, 0.5 * i + 0.4, 80, 1 + i % 5) for i in range(8))
+    reference = Piece(notes)
+    phrases = split_phrases(reference, 6)
+    late = Note(notes[1].onset + 0.2, notes[1].pitch, notes[1].offset + 0.2, 80)  # 200 ms late: a miss
+    played = Piece(tuple(n for i, n in enumerate(notes) if i not in (1, 3, 6)) + (late, Note(0.1, 50, 0.3, 80)))
+    hits = zeroshot.placed_hits(phrases, Rollout(reference, played, 0.0, 0))
+
+    assert len(hits) == 8
+    missed = [(phrase, onset) for phrase, onset, ok in hits if not ok]
+    where = {n: (p.index, sorted(x.onset for x in p.notes).index(n.onset)) for p in phrases for n in p.notes}
+    assert missed == [where[notes[i]] for i in (1, 3, 6)]
+
+    table = zeroshot.where_table([{"general": {"hits": hits}}])
+    by_phrase, by_onset = ([cell.strip() for cell in line.split("|")[2:-1]] for line in table.splitlines()[-2:])
+    assert [len(p.notes) for p in phrases] == [4, 4]
+    assert by_phrase[:2] == ["0.50 (4)", "0.75 (4)"] and by_phrase[2:] == [""] * 4
+    assert by_onset[:4] == ["1.00 (2)", "0.50 (2)", "0.50 (2)", "0.50 (2)"]
