@@ -23,10 +23,9 @@ class DaggerConfig:
 
     round_steps: int = 20_000
     """Environment steps gathered in a round, before the policy learns from all gathered so far."""
-    updates_per_step: float = 1.0
-    """Gradient steps of behaviour cloning at a round's end, per environment step of the round. At 0.5
-    the general policy's cloning loss rose to 2.8e-3 as the policy's own episodes filled the data,
-    seven times what a strike survives (docs/training.md)."""
+    updates_per_step: float = 0.5
+    """Gradient steps of behaviour cloning at a round's end, per environment step of the round (1.0
+    lowered the training loss but not the error on unseen states: docs/history.md)."""
     batch_size: int = 256
     learning_rate: float = 1e-3
     """Adam's step size, over the actor and the encoder, at the run's start; it falls along a
