@@ -92,7 +92,7 @@ def where_table(rows: list[dict]) -> str:
     """The share of notes the general policy played, by phrase and by onset within a phrase."""
     hits = [hit for row in rows for hit in row["general"]["hits"]]
     lines = [
-        "| notes | " + " | ".join(f"{k + 1}" for k in range(DEFAULT_MAX_NOTES)) + " |",
+        "| place | " + " | ".join(f"{k + 1}" for k in range(DEFAULT_MAX_NOTES)) + " |",
         "| --- |" + " ---: |" * DEFAULT_MAX_NOTES,
     ]
     for label, position in (("phrase", 0), ("onset within its phrase", 1)):
