@@ -91,13 +91,14 @@ def play_both(piece: Piece, general: Path, empty: Path) -> dict:
 def where_table(rows: list[dict]) -> str:
     """The share of notes the general policy played, by phrase and by onset within a phrase."""
     hits = [hit for row in rows for hit in row["general"]["hits"]]
+    columns = 1 + max((max(phrase, onset) for phrase, onset, _ in hits), default=0)
     lines = [
-        "| place | " + " | ".join(f"{k + 1}" for k in range(DEFAULT_MAX_NOTES)) + " |",
-        "| --- |" + " ---: |" * DEFAULT_MAX_NOTES,
+        "| place | " + " | ".join(f"{k + 1}" for k in range(columns)) + " |",
+        "| --- |" + " ---: |" * columns,
     ]
     for label, position in (("phrase", 0), ("onset within its phrase", 1)):
         cells = []
-        for k in range(DEFAULT_MAX_NOTES):
+        for k in range(columns):
             played = [ok for *place, ok in hits if place[position] == k]
             cells.append(f"{np.mean(played):.2f} ({len(played)})" if played else "")
         lines.append(f"| played, by {label} | " + " | ".join(cells) + " |")
@@ -204,7 +205,7 @@ def main() -> None:
             f"no general policy in {args.models}: train one with `pianobot train --task melody` or give --general"
         )
     began = time.perf_counter()
-    melodies, rejected = melody_set(args.melodies, args.seed)
+    melodies, rejected = melody_set(args.melodies, args.seed) if "melodies" in args.sets else ([], 0)
     every = {
         "examples": lambda: example_set(args.examples),
         "melodies": lambda: melodies,
@@ -220,7 +221,8 @@ def main() -> None:
     if "melodies" in results:
         print("\nRandom melodies: the share of notes the general policy played (count), by place\n")
         print(where_table(results["melodies"]))
-    print(f"\nMelodies the planner said this hand cannot play at their tempo, drawn again: {rejected}.")
+    if "melodies" in results:
+        print(f"\nMelodies the planner said this hand cannot play at their tempo, drawn again: {rejected}.")
     print(f"{time.perf_counter() - began:.0f} s")
     if args.json:
         with open(args.json, "w") as f:

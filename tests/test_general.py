@@ -105,6 +105,14 @@ def test_train_task_with_general_policy_continues_that_policy(tmp_path, general)
     assert scratch.exit_code == 0, scratch.output
     assert manifest_of(Path(policy["folder"]))["start"] is None
 
+    # the same options train into the start's own folder: refused before --force deletes it
+    files = {f.name: f.read_bytes() for f in general.iterdir() if f.is_file()}
+    itself = run(
+        "train", "--task", "melody", *QUICK, "--general-policy", general, "--models", general.parent, "--force"
+    )
+    one_line_error(itself, "--general-policy", "the folder this run trains into", "copy it")
+    assert {f.name: f.read_bytes() for f in general.iterdir() if f.is_file()} == files
+
 
 def test_fine_tuning_begins_with_the_general_weights_and_resumes_knowing_it(tmp_path, general, monkeypatch):
     """The step-0 evaluation is the general policy's own on the phrase (same weights, same figures),

@@ -205,6 +205,15 @@ def make_instrument(lowest_note: str, keys: int, thumb: bool) -> tuple[KeyboardS
     return KeyboardSpec(lowest=parse_pitch(lowest_note), count=keys), hand
 
 
+def refuse_training_into(start: Path | None, jobs) -> None:
+    """One line, before any work, when the policy to start from is a folder this run trains into
+    (the same options, so the same hash): ``--force`` would delete it before it is read."""
+    if start is not None and any(job.folder.resolve() == Path(start).resolve() for job in jobs):
+        raise PianobotError(
+            f"--general-policy {start} is the folder this run trains into: copy it elsewhere and start from the copy"
+        )
+
+
 # -- commands --------------------------------------------------------------------------------
 @app.command()
 @friendly
@@ -653,13 +662,14 @@ def train(
         f"reaches note F1 {TrainConfig.finetune_until_f1} (--until-f1 sets another), keeping the best evaluated "
         "policy: a phrase the general policy already plays costs one evaluation, and none ends worse than the "
         "general policy plays it. Without a general policy, or with --no-from-general, phrases train from scratch. "
-        "With --task only with --general-policy.",
+        "With --task: on only when --general-policy is given.",
     ),
     general_policy: Optional[Path] = typer.Option(
         None,
         "--general-policy",
         help="The policy to start from (any trained policy; default: the newest `pianobot train --task melody` "
-        "policy in --models whose options fit). With --task: that policy's training goes on, on the task family.",
+        "policy in --models whose options fit). With --task there is no default: a task family trains from scratch, "
+        "or, given this, that policy's training goes on, on the family.",
     ),
     workers: int = typer.Option(1, "--workers", help="Train this many phrases at once, in separate processes."),
     threads: int = typer.Option(
@@ -807,22 +817,28 @@ def train(
             device=device,
         )
     if general_policy is not None and not from_general:
-        raise PianobotError(f"--general-policy {general_policy} is where training starts: drop it or --no-from-general")
+        raise PianobotError(
+            f"--general-policy {general_policy} and --no-from-general ask for opposite things: give one of them"
+        )
     if general_policy is not None:
         find_general(models, path=general_policy)  # a folder that holds no policy: said before any work
     start = None
     if task is not None:
-        todo, done = plan_jobs([task_job(task, config, models)], force)
+        job = task_job(task, config, models)
+        refuse_training_into(general_policy, [job])
+        todo, done = plan_jobs([job], force)
         label = f"task {task}"
         if general_policy is not None and todo:
             config, start = general_start(config, models, general_policy)
-            console.print(f"continuing the policy {said(start)} on {said(label)}: evaluated first", soft_wrap=True)
+            if store.checkpoint_state(job.folder) is None:  # (else the run resumes, and says so)
+                console.print(f"continuing the policy {said(start)} on {said(label)}: evaluated first", soft_wrap=True)
     else:
         piece = read_song(
             song, make_options(track, tempo, transpose, fingering, hand_part, split, quantize, refinger), keyboard, hand
         )
         phrases = split_phrases(piece, phrase_notes)
         jobs = phrase_jobs(phrases, config, models, piece=song.name)
+        refuse_training_into(general_policy, jobs)
         label = f"{song.name}: {len(phrases)} phrases"
         if force or not all(store.is_trained(job.folder) for job in jobs):  # (before --force removes a policy)
             config, start = general_start(config, models, general_policy)
