@@ -135,6 +135,22 @@ def task_set(per_task: int) -> list[tuple[str, Piece]]:
     ]
 
 
+def chosen_sets(
+    names: list[str], examples: Path, melodies: int, seed: int, per_task: int
+) -> tuple[dict[str, list[tuple[str, Piece]]], int]:
+    """The pieces of the sets ``names`` (in :data:`SETS` order), and how many melody draws the
+    planner turned down (0 without the melodies); a set left out is not even drawn."""
+    sets, rejected = {}, 0
+    for name in (n for n in SETS if n in names):
+        if name == "examples":
+            sets[name] = example_set(examples)
+        elif name == "melodies":
+            sets[name], rejected = melody_set(melodies, seed)
+        else:
+            sets[name] = task_set(per_task)
+    return sets, rejected
+
+
 def summary(rows: list[dict]) -> dict:
     def mean(who: str, key: str) -> float:
         values = [r[who][key] for r in rows if r[who][key] is not None]
@@ -205,13 +221,7 @@ def main() -> None:
             f"no general policy in {args.models}: train one with `pianobot train --task melody` or give --general"
         )
     began = time.perf_counter()
-    melodies, rejected = melody_set(args.melodies, args.seed) if "melodies" in args.sets else ([], 0)
-    every = {
-        "examples": lambda: example_set(args.examples),
-        "melodies": lambda: melodies,
-        "tasks": lambda: task_set(args.per_task),
-    }
-    sets = {name: every[name]() for name in SETS if name in args.sets}
+    sets, rejected = chosen_sets(args.sets, args.examples, args.melodies, args.seed, args.per_task)
     results: dict[str, list[dict]] = {}
     with tempfile.TemporaryDirectory() as empty:
         for name, pieces in sets.items():
@@ -221,7 +231,6 @@ def main() -> None:
     if "melodies" in results:
         print("\nRandom melodies: the share of notes the general policy played (count), by place\n")
         print(where_table(results["melodies"]))
-    if "melodies" in results:
         print(f"\nMelodies the planner said this hand cannot play at their tempo, drawn again: {rejected}.")
     print(f"{time.perf_counter() - began:.0f} s")
     if args.json:

@@ -37,3 +37,13 @@ def test_placed_hits_name_each_missed_note_by_its_phrase_and_onset():
     # a long piece's ninth phrase gets a column of its own
     table = zeroshot.where_table([{"general": {"hits": hits + [(8, 0, True)]}}])
     assert table.splitlines()[-2].split("|")[-2].strip() == "1.00 (1)"
+
+
+def test_sets_plays_only_the_sets_named_and_draws_no_others():
+    """`--sets`: only the named sets are built, in the benchmark's order; melodies left out are not drawn."""
+    sets, rejected = zeroshot.chosen_sets(["tasks", "examples"], ROOT / "examples" / "midi", 50, 2026, 1)
+    assert list(sets) == ["examples", "tasks"] and rejected == 0
+    assert [name for name, _ in sets["examples"]] == list(zeroshot.EXAMPLES)
+    assert len(sets["tasks"]) == len(zeroshot.TASKS)
+    melodies, _ = zeroshot.chosen_sets(["melodies"], ROOT / "examples" / "midi", 2, 2026, 1)
+    assert list(melodies) == ["melodies"] and len(melodies["melodies"]) == 2

@@ -24,8 +24,7 @@ class DaggerConfig:
     round_steps: int = 20_000
     """Environment steps gathered in a round, before the policy learns from all gathered so far."""
     updates_per_step: float = 0.5
-    """Gradient steps of behaviour cloning at a round's end, per environment step of the round (1.0
-    lowered the training loss but not the error on unseen states: docs/history.md)."""
+    """Gradient steps of behaviour cloning at a round's end, per environment step of the round."""
     batch_size: int = 256
     learning_rate: float = 1e-3
     """Adam's step size, over the actor and the encoder, at the run's start; it falls along a
