@@ -143,3 +143,39 @@ def test_the_dagger_settings_name_a_dagger_runs_folder_and_not_a_sac_runs():
     dagger = TrainConfig(learner="dagger")
     assert store.config_hash(dagger) != store.config_hash(TrainConfig())
     assert store.config_hash(dagger) != store.config_hash(replace(dagger, dagger=rounds))
+
+
+def test_the_fingers_actor_reads_each_fingers_own_values_and_learns_by_imitation(tmp_path):
+    """SACConfig(actor='fingers'): finger f's actions come from finger f's joints, speeds and
+    target (one network for all fingers), the run stores it, and the store gives it back."""
+    torch.manual_seed(0)
+    fingers = replace(NETS, actor="fingers")
+    env = make_env(PHRASE, EnvConfig(tactile=True, actuated=("mcp", "pip")))  # 2 joints a finger, then the wrist
+    agent = make_agent(env, fingers)
+    assert not agent.actor.reads_features
+    first, own = agent.actor.finger[0], 2 + 2 * 4 + 6  # wrist, a finger's 4 angles and 4 speeds, its target
+    with torch.no_grad():  # blind the shared network to the finger's index and the whole-vector context
+        first.weight[:, own:] = 0
+    observation, _ = env.reset(seed=0)
+    vector, tactile = agent.split(observation)
+    slices = [(2, 4), (14, 4), (26, 6)]  # (start, width per finger): angles, speeds, targets (after the wrist)
+    nudged = vector.copy()
+    nudged[26 + 6 : 26 + 12] += 0.5  # finger 1's target
+    swapped = vector.copy()  # fingers 0 and 1 trade their values
+    for start, width in slices:
+        swapped[start : start + width] = vector[start + width : start + 2 * width]
+        swapped[start + width : start + 2 * width] = vector[start : start + width]
+    before, after, traded = agent.act_batch(np.stack([vector, nudged, swapped]), np.stack([tactile] * 3))
+    changed = np.abs(after - before) > 1e-6
+    assert changed[2:4].all() and not changed[[0, 1, 4, 5]].any()  # finger 1's two joints move, fingers 0 and 2 do not
+    # one network plays every finger: with their values traded, fingers 0 and 1 trade their actions
+    assert np.allclose(traded[0:2], before[2:4], atol=1e-6) and np.allclose(traded[2:4], before[0:2], atol=1e-6)
+    assert np.allclose(traded[4:6], before[4:6], atol=1e-6)
+
+    manifest = dagger_policy(PHRASE, small(sac=fingers), tmp_path / "m")
+    assert manifest["config"]["sac"]["actor"] == "fingers" and manifest["updates"] > 0
+    stored = load_policy(tmp_path / "m", make_env(PHRASE, small().env))
+    assert type(stored.actor).__name__ == "FingerActor"
+    assert store.config_hash(small()) != store.config_hash(small(sac=fingers))  # its own folder
+    with pytest.raises(ValueError, match="finger target"):
+        make_agent(make_env(PHRASE, EnvConfig(target_observations=False)), fingers)

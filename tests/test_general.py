@@ -230,3 +230,26 @@ def test_the_options_default_to_the_training_configuration_and_say_what_they_do(
     assert "evaluate it before any training step" in train["from_general"].help
     play = {p.name: p.default for p in commands["play"].params}
     assert play["use_general"] is True and play["general_policy"] is None
+
+
+def test_a_phrase_trained_from_the_general_policy_takes_its_actor(tmp_path):
+    """A general policy with the 'fingers' actor starts phrases with it (--actor left out); an
+    --actor that differs from it is refused in one line, an unknown one too."""
+    models = tmp_path / "models"
+    result = run("train", "--task", "melody", *QUICK, "--actor", "fingers", "--models", models)
+    assert result.exit_code == 0, result.output
+    (general,) = models.glob(f"{GENERAL_KEY}-*")
+    assert manifest_of(general)["config"]["sac"]["actor"] == "fingers"
+    result = run("train", EXAMPLES / "one-note.mid", *QUICK, "--models", models, "--json", "-")
+    assert result.exit_code == 0, result.output
+    (policy,) = json.loads(result.stdout)["policies"]
+    manifest = manifest_of(Path(policy["folder"]))
+    assert manifest["start"]["path"] == str(general) and manifest["config"]["sac"]["actor"] == "fingers"
+    mlp = run("train", EXAMPLES / "one-note.mid", *QUICK, "--actor", "mlp", "--models", models, "--force")
+    one_line_error(mlp, "sac.actor fingers", "this run with mlp", "--no-from-general")
+    scratch = run("train", EXAMPLES / "one-note.mid", *QUICK, "--no-from-general", "--force", "--models", models)
+    assert scratch.exit_code == 0, scratch.output
+    assert manifest_of(Path(policy["folder"]))["config"]["sac"]["actor"] == "mlp"  # from scratch: the default
+    one_line_error(
+        run("train", "--task", "melody", *QUICK, "--actor", "cnn"), "--actor cnn", "choose one of mlp, fingers"
+    )

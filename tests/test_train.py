@@ -273,7 +273,7 @@ def test_behaviour_cloning_pulls_the_actor_towards_demonstrations():
         for _ in range(150):
             agent.update(batch)
         with torch.no_grad():
-            mean = agent.actor.deterministic(agent.critic.encoder(batch["vector"], None))
+            mean = agent.actor.deterministic(agent.critic.encoder(batch["vector"], None), batch["vector"])
         return float((mean.numpy() - target).__abs__().mean())
 
     cloned, unflagged, off = error_after_updates(1.0, 1.0), error_after_updates(1.0, 0.0), error_after_updates(0.0, 1.0)

@@ -6,6 +6,8 @@ from dataclasses import dataclass
 
 DEVICES = ("auto", "cpu", "cuda")
 """Where the learner can run (``TrainConfig.device``): 'auto' is cuda when torch sees a GPU, else cpu."""
+ACTORS = ("mlp", "fingers")
+"""The actor's networks (``SACConfig.actor``)."""
 
 
 @dataclass(frozen=True)
@@ -29,6 +31,14 @@ class SACConfig:
     """Polyak factor of the target critic."""
     hidden: int = 256
     """Width of the MLP layers."""
+    actor: str = "mlp"
+    """The actor's networks. 'mlp' (the paper's): a two-layer MLP over the encoder's features (vector
+    and touch). 'fingers': one three-layer MLP shared by the fingers, each finger reading its own
+    joints, joint speeds and finger target, which finger it is, and the whole observation vector,
+    and a three-layer MLP for the wrist; it reads the observation vector itself, not the encoder
+    (so neither touch nor the score window), and needs the finger targets. What one finger learns
+    to do for a key serves the others: imitating the scripted pianist, it plays melodies it never
+    saw far better than the 'mlp' actor (docs/benchmarks.md, "The general policy on unseen pieces")."""
     score_input: bool = False
     """Feed the score window (L keys x 5 channels x lookahead steps, the paper's input) to the
     networks. Off by default: the finger targets in the observation say, for each finger, where
@@ -74,5 +84,7 @@ class SACConfig:
             raise ValueError(
                 "exploration_steps, demo_weight and demo_q_weight cannot be negative, initial_alpha must be above 0"
             )
+        if self.actor not in ACTORS:
+            raise ValueError(f"actor {self.actor!r} must be one of {', '.join(ACTORS)}")
         if not self.log_std_bounds[0] < self.log_std_bounds[1]:
             raise ValueError(f"log_std_bounds {self.log_std_bounds} must rise")

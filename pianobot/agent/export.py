@@ -1,7 +1,7 @@
 """A stored policy as an ONNX graph, for running it on a robot or in any ONNX runtime.
 
 The graph is the deterministic policy: inputs ``vector`` (batch, V) float32, the observation
-vector in the order docs/models.md gives, and, for a policy with touch, ``tactile`` (batch, 2,
+vector in the order docs/models.md gives, and, for a policy whose actor reads touch, ``tactile`` (batch, 2,
 fingers, rows, cols) uint8; output ``action`` (batch, A) in [-1, 1]. The policy's manifest goes
 into the graph's metadata (``pianobot_manifest``), so the file says how it was trained and which
 environment it expects.
@@ -31,7 +31,8 @@ class DeterministicPolicy(nn.Module):
         self.encoder, self.actor = agent.critic.encoder, agent.actor
 
     def forward(self, vector: torch.Tensor, tactile: torch.Tensor | None = None) -> torch.Tensor:
-        return self.actor.deterministic(self.encoder(vector, tactile))
+        features = self.encoder(vector, tactile) if self.actor.reads_features else None
+        return self.actor.deterministic(features, vector)
 
 
 def export_onnx(folder: Path, path: Path) -> Path:
@@ -52,6 +53,8 @@ def export_onnx(folder: Path, path: Path) -> Path:
     finally:
         env.close()
     vector, tactile = agent.split(observation)
+    if not agent.actor.reads_features:
+        tactile = None  # the actor reads the vector alone
     inputs = (torch.from_numpy(vector)[None],) + (() if tactile is None else (torch.from_numpy(tactile)[None],))
     names = ["vector"] + ([] if tactile is None else ["tactile"])
     tmp = temporary_beside(path)

@@ -35,7 +35,7 @@ GENERAL_TASK = MELODY
 GENERAL_KEY = store.task_key(GENERAL_TASK)
 """Its folders' key in the model store: ``task-melody-<config hash>``."""
 
-NETWORK_FIELDS = ("hidden", "score_input", "score_features", "tactile_channels", "tactile_features")
+NETWORK_FIELDS = ("hidden", "actor", "score_input", "score_features", "tactile_channels", "tactile_features")
 """The :class:`SACConfig` fields that shape the networks: a start policy's must be the run's."""
 
 OPTIONS = {

@@ -2,7 +2,7 @@
 :mod:`pianobot.learn.dagger`). Not in the paper.
 
 One gradient step moves the actor and the encoder together (in SAC the encoder learns from the
-critic alone): the loss is the squared error of the deterministic action (tanh of the mean) to
+critic alone; an actor that does not read the encoder, ``SACConfig.actor`` 'fingers', moves alone): the loss is the squared error of the deterministic action (tanh of the mean) to
 the teacher's, averaged over action dimensions. A strike fails once the finger joints' speeds
 stray about 0.02 from the teacher's (docs/benchmarks.md, "How precise must a policy be?"), so the
 loss worth reaching is around 4e-4. The policy's spread (its log standard deviation) is pulled
@@ -27,7 +27,9 @@ class Imitation:
 
     def __init__(self, agent: SAC, learning_rate: float):
         self.agent = agent
-        parameters = list(agent.critic.encoder.parameters()) + list(agent.actor.parameters())
+        parameters = list(agent.actor.parameters())
+        if agent.actor.reads_features:
+            parameters = list(agent.critic.encoder.parameters()) + parameters
         self.optimizer = torch.optim.Adam(parameters, lr=learning_rate)
 
     def set_learning_rate(self, learning_rate: float) -> None:
@@ -37,8 +39,8 @@ class Imitation:
     def update(self, batch: dict[str, torch.Tensor]) -> dict[str, float]:
         """One step on a batch whose ``expert`` rows are the teacher's actions (every row must have one)."""
         agent = self.agent
-        features = agent.critic.encoder(batch["vector"], batch["tactile"])
-        mean, log_std = agent.actor.net(features).chunk(2, dim=-1)
+        features = agent.critic.encoder(batch["vector"], batch["tactile"]) if agent.actor.reads_features else None
+        mean, log_std = agent.actor.heads(features, batch["vector"])
         cloning = (torch.tanh(mean) - batch["expert"]).pow(2).mean()
         low, high = agent.actor.log_std_bounds
         squashed = low + 0.5 * (high - low) * (torch.tanh(log_std) + 1)  # as the actor bounds it

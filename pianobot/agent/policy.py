@@ -31,13 +31,21 @@ if TYPE_CHECKING:
 def make_agent(env, config: SACConfig, device: str | torch.device = "cpu") -> SAC:
     """A fresh agent, on ``device``, for the observation and action spaces of ``env`` (a
     :class:`PianoEnv`, or a gymnasium vector of them)."""
-    from pianobot.agent.sac import SAC, score_size, vector_size  # torch: only once an agent is built
+    from pianobot.agent.sac import SAC, finger_layout, score_size, vector_size  # torch: only once an agent is built
 
     space = getattr(env, "single_observation_space", env.observation_space)
     actions = getattr(env, "single_action_space", env.action_space)
     tactile = space["tactile"].shape if "tactile" in space.spaces else None
     score = config.score_input
-    return SAC(vector_size(space, score), score_size(space, score), tactile, actions.shape[0], config, device)
+    return SAC(
+        vector_size(space, score),
+        score_size(space, score),
+        tactile,
+        actions.shape[0],
+        config,
+        device,
+        finger_layout(space),
+    )
 
 
 def policy_configs(folder: Path) -> tuple[EnvConfig, SACConfig]:

@@ -15,6 +15,7 @@ from the paper's and why.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 import torch
@@ -142,7 +143,11 @@ class Critic(nn.Module):
 
 
 class Actor(nn.Module):
-    """A tanh-squashed Gaussian policy over the critic encoder's features."""
+    """A tanh-squashed Gaussian policy; :meth:`heads` gives the mean and (unbounded) log standard
+    deviation of each action. This one ('mlp') is a two-layer MLP over the encoder's features."""
+
+    reads_features = True
+    """Whether :meth:`heads` reads the encoder's features (else only the observation vector)."""
 
     def __init__(self, feature_dim: int, action_dim: int, config: SACConfig):
         super().__init__()
@@ -152,9 +157,14 @@ class Actor(nn.Module):
         )
         self.log_std_bounds = config.log_std_bounds
 
-    def forward(self, features: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+    def heads(self, features: torch.Tensor | None, vector: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+        return self.net(features).chunk(2, dim=-1)
+
+    def forward(
+        self, features: torch.Tensor | None, vector: torch.Tensor
+    ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
         """(sampled action, its log-probability, the deterministic action: tanh of the mean)."""
-        mean, log_std = self.net(features).chunk(2, dim=-1)
+        mean, log_std = self.heads(features, vector)
         low, high = self.log_std_bounds
         log_std = low + 0.5 * (high - low) * (torch.tanh(log_std) + 1)
         std = log_std.exp()
@@ -166,10 +176,80 @@ class Actor(nn.Module):
         log_prob = log_prob - (2 * (math.log(2) - raw - F.softplus(-2 * raw))).sum(-1)
         return action, log_prob, torch.tanh(mean)
 
-    def deterministic(self, features: torch.Tensor) -> torch.Tensor:
+    def deterministic(self, features: torch.Tensor | None, vector: torch.Tensor) -> torch.Tensor:
         """The policy's action without noise: tanh of the mean."""
-        mean, _ = self.net(features).chunk(2, dim=-1)
-        return torch.tanh(mean)
+        return torch.tanh(self.heads(features, vector)[0])
+
+
+def _mlp(inputs: int, outputs: int, hidden: int, layers: int = 3) -> nn.Sequential:
+    modules: list[nn.Module] = []
+    for _ in range(layers):
+        modules += [nn.Linear(inputs, hidden), nn.ReLU()]
+        inputs = hidden
+    return nn.Sequential(*modules, nn.Linear(inputs, outputs))
+
+
+@dataclass(frozen=True)
+class FingerLayout:
+    """Where each finger's values lie in the observation vector (after the score window): the
+    wrist (2 values), then ``fingers * joints`` joint angles, as many joint speeds, and
+    ``fingers * target_width`` finger targets, finger by finger (:class:`~pianobot.env.piano.PianoEnv`)."""
+
+    fingers: int
+    joints: int
+    """Joints per finger (observed, actuated or not)."""
+    target_width: int
+
+
+def finger_layout(observation_space) -> FingerLayout | None:
+    """The :class:`FingerLayout` of an environment's observations; None without finger targets."""
+    if "targets" not in observation_space.spaces:
+        return None
+    fingers, width = observation_space["targets"].shape
+    return FingerLayout(fingers, observation_space["joints"].shape[0] // fingers, width)
+
+
+class FingerActor(Actor):
+    """The 'fingers' actor: one MLP shared by the fingers gives each finger's actions from its own
+    joints, joint speeds and target, its one-hot index and the whole observation vector; an MLP
+    over the vector gives the wrist's. It reads the vector itself, after the score window (no
+    touch, no score window). Actions are finger by finger, then the wrist, as the environment's."""
+
+    reads_features = False
+
+    def __init__(self, vector_dim: int, score_dim: int, action_dim: int, layout: FingerLayout, config: SACConfig):
+        nn.Module.__init__(self)
+        self.layout, self.score_dim = layout, score_dim
+        self.per_finger = (action_dim - 1) // layout.fingers
+        if self.per_finger * layout.fingers + 1 != action_dim:
+            raise ValueError(f"{action_dim} actions are not {layout.fingers} fingers' alike plus the wrist")
+        context = vector_dim - score_dim
+        own = 2 + 2 * layout.joints + layout.target_width + layout.fingers
+        self.finger = _mlp(own + context, 2 * self.per_finger, config.hidden)
+        self.wrist = _mlp(context, 2, config.hidden)
+        self.register_buffer("which", torch.eye(layout.fingers), persistent=False)
+        self.log_std_bounds = config.log_std_bounds
+
+    def heads(self, features: torch.Tensor | None, vector: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+        v = vector[:, self.score_dim :]
+        batch, (fingers, joints, width) = (
+            v.shape[0],
+            (self.layout.fingers, self.layout.joints, self.layout.target_width),
+        )
+        at = 2 + fingers * joints
+        own = [
+            v[:, None, :2].expand(batch, fingers, 2),
+            v[:, 2:at].reshape(batch, fingers, joints),
+            v[:, at : at + fingers * joints].reshape(batch, fingers, joints),
+            v[:, at + fingers * joints : at + fingers * (joints + width)].reshape(batch, fingers, width),
+            self.which.expand(batch, fingers, fingers),
+            v[:, None, :].expand(batch, fingers, v.shape[1]),
+        ]
+        out = self.finger(torch.cat(own, dim=-1))  # (batch, fingers, 2 * per_finger)
+        finger_mean, finger_log_std = out.chunk(2, dim=-1)
+        wrist_mean, wrist_log_std = self.wrist(v).chunk(2, dim=-1)
+        mean = torch.cat([finger_mean.reshape(batch, -1), wrist_mean], dim=1)
+        return mean, torch.cat([finger_log_std.reshape(batch, -1), wrist_log_std], dim=1)
 
 
 def _load_checked(module: nn.Module, state: dict[str, torch.Tensor], prefix: str) -> None:
@@ -220,14 +300,24 @@ class SAC:
         action_dim: int,
         config: SACConfig = SACConfig(),
         device: str | torch.device = "cpu",
+        layout: FingerLayout | None = None,
     ):
+        """``layout``: where the fingers' values lie in the vector (:func:`finger_layout`), which
+        the 'fingers' actor needs."""
         self.config = config
         self.device = torch.device(device)
         self.critic = Critic(vector_dim, score_dim, tactile_shape, action_dim, config).to(self.device)
         self.target = Critic(vector_dim, score_dim, tactile_shape, action_dim, config).to(self.device)
         self.target.load_state_dict(self.critic.state_dict())
         self.target.requires_grad_(False)
-        self.actor = Actor(self.critic.encoder.out_dim, action_dim, config).to(self.device)
+        if config.actor == "fingers":
+            if layout is None:
+                raise ValueError(
+                    "the 'fingers' actor reads each finger's target: it needs the finger target observations"
+                )
+            self.actor: Actor = FingerActor(vector_dim, score_dim, action_dim, layout, config).to(self.device)
+        else:
+            self.actor = Actor(self.critic.encoder.out_dim, action_dim, config).to(self.device)
         self.log_alpha = torch.tensor(math.log(config.initial_alpha), device=self.device, requires_grad=True)
         self.target_entropy = -config.target_entropy_scale * action_dim
         lr = config.learning_rate
@@ -258,13 +348,12 @@ class SAC:
     def act(self, observation: dict) -> np.ndarray:
         """The deterministic action for an observation (evaluation and performance)."""
         vector, tactile = self.split(observation)
-        features = self._features(vector[None], None if tactile is None else tactile[None])
-        return self.actor.deterministic(features)[0].cpu().numpy()
+        return self.act_batch(vector[None], None if tactile is None else tactile[None])[0]
 
     @torch.no_grad()
     def act_batch(self, vectors: np.ndarray, tactiles: np.ndarray | None) -> np.ndarray:
         """Deterministic actions for a batch of :meth:`split` inputs, one row per environment."""
-        return self.actor.deterministic(self._features(vectors, tactiles)).cpu().numpy()
+        return self.actor.deterministic(*self._actor_inputs(vectors, tactiles)).cpu().numpy()
 
     def sample(self, vector: np.ndarray, tactile: np.ndarray | None) -> np.ndarray:
         """A noisy action from :meth:`split` inputs (training's behaviour policy)."""
@@ -273,21 +362,28 @@ class SAC:
     @torch.no_grad()
     def sample_batch(self, vectors: np.ndarray, tactiles: np.ndarray | None) -> np.ndarray:
         """Noisy actions for a batch of :meth:`split` inputs, one row per environment."""
-        action, _, _ = self.actor(self._features(vectors, tactiles))
+        action, _, _ = self.actor(*self._actor_inputs(vectors, tactiles))
         return action.cpu().numpy()
 
-    def _features(self, vectors: np.ndarray, tactiles: np.ndarray | None) -> torch.Tensor:
+    def _actor_inputs(
+        self, vectors: np.ndarray, tactiles: np.ndarray | None
+    ) -> tuple[torch.Tensor | None, torch.Tensor]:
+        """(the encoder's features, or None for an actor that does not read them; the vector) as tensors."""
         v = torch.from_numpy(np.asarray(vectors, np.float32)).to(self.device)
+        if not self.actor.reads_features:
+            return None, v
         t = None if tactiles is None else torch.from_numpy(np.asarray(tactiles)).to(self.device)
-        return self.critic.encoder(v, t)
+        return self.critic.encoder(v, t), v
 
     def update(self, batch: dict[str, torch.Tensor]) -> dict[str, float]:
         """One gradient step on critic, actor and temperature from a replay batch."""
         alpha = self.alpha.detach()
         now = self.critic.encoder(batch["vector"], batch["tactile"])
         with torch.no_grad():
-            after = self.critic.encoder(batch["next_vector"], batch["next_tactile"])
-            next_action, next_log_prob, _ = self.actor(after)
+            after = (
+                self.critic.encoder(batch["next_vector"], batch["next_tactile"]) if self.actor.reads_features else None
+            )
+            next_action, next_log_prob, _ = self.actor(after, batch["next_vector"])
             target_features = self.target.encoder(batch["next_vector"], batch["next_tactile"])
             next_q = self.target.q(target_features, next_action).min(dim=0).values - alpha * next_log_prob
             target_q = batch["reward"] + self.config.discount * (1.0 - batch["terminated"]) * next_q
@@ -299,7 +395,7 @@ class SAC:
         self.critic_optimizer.step()
 
         features = now.detach()
-        action, log_prob, mean_action = self.actor(features)
+        action, log_prob, mean_action = self.actor(features if self.actor.reads_features else None, batch["vector"])
         self.critic.layers.requires_grad_(False)  # the actor's loss needs no gradient for the critic
         actor_q = self.critic.q(features, action).min(dim=0).values
         actor_loss = (alpha * log_prob - actor_q).mean()

@@ -68,12 +68,15 @@ def config_hash(config) -> str:
     training finds the same folder however it runs, and a phrase's folder holds one policy for its
     configuration, fine-tuned or trained from scratch (the manifest's ``start`` says which).
     A SAC run (``TrainConfig.learner`` 'sac') leaves out ``learner`` and the DAgger settings it
-    does not use, so that its folder keeps the name it had before there was another learner."""
+    does not use, so that its folder keeps the name it had before there was another learner; an
+    agent with the default actor (``SACConfig.actor`` 'mlp') leaves out ``sac.actor`` likewise."""
     runtime = {f.name for f in dataclasses.fields(config) if f.metadata.get("runtime") or f.metadata.get("start")}
     fields = {k: v for k, v in to_dict(config).items() if k not in runtime}
     if fields.get("learner") == "sac":
         fields.pop("learner")
         fields.pop("dagger", None)
+    if isinstance(fields.get("sac"), dict) and fields["sac"].get("actor") == "mlp":
+        fields["sac"] = {k: v for k, v in fields["sac"].items() if k != "actor"}
     return hashlib.sha256(json.dumps(fields, sort_keys=True, default=str).encode()).hexdigest()[:12]
 
 

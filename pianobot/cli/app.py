@@ -22,7 +22,7 @@ from rich.console import Console
 from rich.markup import escape
 
 from pianobot import __version__
-from pianobot.agent.config import SACConfig
+from pianobot.agent.config import ACTORS, SACConfig
 from pianobot.env.piano import EnvConfig
 from pianobot.env.rewards import RewardConfig
 from pianobot.errors import PianobotError, PianobotWarning, one_line, quote
@@ -698,6 +698,12 @@ def train(
     exploration_steps: int = typer.Option(
         SACConfig.exploration_steps, "--exploration-steps", help="Steps of exploration before learning starts."
     ),
+    actor: Optional[str] = typer.Option(
+        None,
+        "--actor",
+        help=f"The actor's networks: {' or '.join(ACTORS)} (one MLP shared by the fingers; docs/training.md). "
+        f"Default: the start policy's when training from one, else {SACConfig.actor}.",
+    ),
     tactile: bool = typer.Option(
         EnvConfig.tactile, "--tactile/--no-tactile", help="Observe the fingertips' tactile images."
     ),
@@ -798,8 +804,10 @@ def train(
         )
     with option("--round-steps", round_steps):
         DaggerConfig(round_steps=round_steps)
+    if actor is not None and actor not in ACTORS:
+        raise PianobotError(f"--actor {quote(actor)}: choose one of {', '.join(ACTORS)}")
     with option("--exploration-steps", exploration_steps):
-        sac = SACConfig(exploration_steps=exploration_steps)
+        sac = SACConfig(exploration_steps=exploration_steps, actor=actor or SACConfig.actor)
     with option():
         config = TrainConfig(
             steps=steps,
@@ -829,7 +837,7 @@ def train(
         todo, done = plan_jobs([job], force)
         label = f"task {task}"
         if general_policy is not None and todo:
-            config, start = general_start(config, models, general_policy)
+            config, start = general_start(config, models, general_policy, networks_given=actor is not None)
             if store.checkpoint_state(job.folder) is None:  # (else the run resumes, and says so)
                 console.print(f"continuing the policy {said(start)} on {said(label)}: evaluated first", soft_wrap=True)
     else:
@@ -841,7 +849,7 @@ def train(
         refuse_training_into(general_policy, jobs)
         label = f"{song.name}: {len(phrases)} phrases"
         if force or not all(store.is_trained(job.folder) for job in jobs):  # (before --force removes a policy)
-            config, start = general_start(config, models, general_policy)
+            config, start = general_start(config, models, general_policy, networks_given=actor is not None)
             if start is not None:
                 console.print(
                     f"starting every phrase from the general policy {said(start)}: evaluated first, a phrase stops at "

@@ -15,7 +15,8 @@ from typing import Callable
 import torch
 
 from pianobot.agent import store
-from pianobot.agent.general import find_general
+from pianobot.agent.general import NETWORK_FIELDS, find_general
+from pianobot.agent.policy import policy_configs
 from pianobot.errors import PianobotError
 from pianobot.learn.dagger import dagger_policy
 from pianobot.learn.train import Progress, TrainConfig, train_policy
@@ -72,23 +73,31 @@ def _run_job(
     return learner(config)(job.target, config, job.folder, report, about=job.about(), start=start)
 
 
-def general_start(config: TrainConfig, models: Path, path: Path | None = None) -> tuple[TrainConfig, Path | None]:
+def general_start(
+    config: TrainConfig, models: Path, path: Path | None = None, networks_given: bool = False
+) -> tuple[TrainConfig, Path | None]:
     """Where a piece's phrases begin: (``config``, the general policy's folder) when
     ``config.from_general`` asks for it and there is one (``path``, else the newest ``task-melody``
-    policy in ``models`` whose environment and networks are the run's); else (``config`` with
-    ``from_general`` off, None): from scratch. A general policy that does not fit is a one-line
-    error naming the option that differs."""
+    policy in ``models`` whose environment is the run's); else (``config`` with ``from_general``
+    off, None): from scratch. A run that starts from a policy takes its networks
+    (:data:`~pianobot.agent.general.NETWORK_FIELDS`), unless ``networks_given`` (an option set them):
+    then they must be the policy's. A general policy that does not fit is a one-line error naming
+    the option that differs."""
     if not config.from_general:
         return config, None
     folder = find_general(
         models,
         config.env,
-        config.sac,
+        config.sac if networks_given else None,
         path,
         ours="this run",
         remedy="give the same option to start from it, or --no-from-general to train from scratch",
     )
-    return (config, folder) if folder is not None else (replace(config, from_general=False), None)
+    if folder is None:
+        return replace(config, from_general=False), None
+    _, theirs = policy_configs(folder)
+    networks = {name: getattr(theirs, name) for name in NETWORK_FIELDS}
+    return replace(config, sac=replace(config.sac, **networks)), folder
 
 
 def phrase_jobs(phrases: list[Phrase], config: TrainConfig, root: Path, piece: str = "") -> list[PhraseJob]:
