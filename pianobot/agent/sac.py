@@ -142,23 +142,19 @@ class Critic(nn.Module):
         return self.layers[2](x).squeeze(-1)
 
 
-class Actor(nn.Module):
-    """A tanh-squashed Gaussian policy; :meth:`heads` gives the mean and (unbounded) log standard
-    deviation of each action. This one ('mlp') is a two-layer MLP over the encoder's features."""
+class GaussianActor(nn.Module):
+    """A tanh-squashed Gaussian policy; a subclass's :meth:`heads` gives the mean and (unbounded)
+    log standard deviation of each action."""
 
     reads_features = True
     """Whether :meth:`heads` reads the encoder's features (else only the observation vector)."""
 
-    def __init__(self, feature_dim: int, action_dim: int, config: SACConfig):
+    def __init__(self, config: SACConfig):
         super().__init__()
-        h = config.hidden
-        self.net = nn.Sequential(
-            nn.Linear(feature_dim, h), nn.ReLU(), nn.Linear(h, h), nn.ReLU(), nn.Linear(h, 2 * action_dim)
-        )
         self.log_std_bounds = config.log_std_bounds
 
     def heads(self, features: torch.Tensor | None, vector: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
-        return self.net(features).chunk(2, dim=-1)
+        raise NotImplementedError
 
     def forward(
         self, features: torch.Tensor | None, vector: torch.Tensor
@@ -179,6 +175,20 @@ class Actor(nn.Module):
     def deterministic(self, features: torch.Tensor | None, vector: torch.Tensor) -> torch.Tensor:
         """The policy's action without noise: tanh of the mean."""
         return torch.tanh(self.heads(features, vector)[0])
+
+
+class Actor(GaussianActor):
+    """The 'mlp' actor (the paper's): a two-layer MLP over the encoder's features."""
+
+    def __init__(self, feature_dim: int, action_dim: int, config: SACConfig):
+        super().__init__(config)
+        h = config.hidden
+        self.net = nn.Sequential(
+            nn.Linear(feature_dim, h), nn.ReLU(), nn.Linear(h, h), nn.ReLU(), nn.Linear(h, 2 * action_dim)
+        )
+
+    def heads(self, features: torch.Tensor | None, vector: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+        return self.net(features).chunk(2, dim=-1)
 
 
 def _mlp(inputs: int, outputs: int, hidden: int, layers: int = 3) -> nn.Sequential:
@@ -209,7 +219,7 @@ def finger_layout(observation_space) -> FingerLayout | None:
     return FingerLayout(fingers, observation_space["joints"].shape[0] // fingers, width)
 
 
-class FingerActor(Actor):
+class FingerActor(GaussianActor):
     """The 'fingers' actor: one MLP shared by the fingers gives each finger's actions from its own
     joints, joint speeds and target, its one-hot index and the whole observation vector; an MLP
     over the vector gives the wrist's. It reads the vector itself, after the score window (no
@@ -218,7 +228,7 @@ class FingerActor(Actor):
     reads_features = False
 
     def __init__(self, vector_dim: int, score_dim: int, action_dim: int, layout: FingerLayout, config: SACConfig):
-        nn.Module.__init__(self)
+        super().__init__(config)
         self.layout, self.score_dim = layout, score_dim
         self.per_finger = (action_dim - 1) // layout.fingers
         if self.per_finger * layout.fingers + 1 != action_dim:
@@ -228,7 +238,6 @@ class FingerActor(Actor):
         self.finger = _mlp(own + context, 2 * self.per_finger, config.hidden)
         self.wrist = _mlp(context, 2, config.hidden)
         self.register_buffer("which", torch.eye(layout.fingers), persistent=False)
-        self.log_std_bounds = config.log_std_bounds
 
     def heads(self, features: torch.Tensor | None, vector: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
         v = vector[:, self.score_dim :]
@@ -315,7 +324,7 @@ class SAC:
                 raise ValueError(
                     "the 'fingers' actor reads each finger's target: it needs the finger target observations"
                 )
-            self.actor: Actor = FingerActor(vector_dim, score_dim, action_dim, layout, config).to(self.device)
+            self.actor: GaussianActor = FingerActor(vector_dim, score_dim, action_dim, layout, config).to(self.device)
         else:
             self.actor = Actor(self.critic.encoder.out_dim, action_dim, config).to(self.device)
         self.log_alpha = torch.tensor(math.log(config.initial_alpha), device=self.device, requires_grad=True)
