@@ -47,3 +47,40 @@ def test_the_model_format_page_runs_a_policy_as_pianobot_does():
             assert np.allclose(ours, theirs, atol=1e-6), (ours, theirs)
             observation, *_ = env.step(ours)
     env.close()
+
+
+def test_the_model_format_page_runs_a_finger_shared_policy_as_pianobot_does(tmp_path):
+    """The same reader on a policy with the 'fingers' actor (trained briefly here), two joints a finger."""
+    from dataclasses import replace
+
+    import numpy as np
+
+    import pianobot
+    from pianobot.agent.config import SACConfig
+    from pianobot.env.piano import EnvConfig
+    from pianobot.learn.config import DaggerConfig, TrainConfig
+    from pianobot.learn.dagger import dagger_policy
+
+    source = re.findall(r"```python\n(.*?)```", (ROOT / "docs" / "models.md").read_text(), re.S)
+    namespace: dict = {}
+    exec(compile(source[-1], "docs/models.md", "exec"), namespace)
+    phrase = pianobot.Piece((pianobot.Note(0.0, 64, 0.5, 80, 3),), bpm=60)
+    sac = SACConfig(hidden=16, actor="fingers")
+    config = TrainConfig(
+        learner="dagger",
+        steps=70,
+        eval_episodes=1,
+        sac=sac,
+        dagger=DaggerConfig(round_steps=70, batch_size=16),
+        env=EnvConfig(tactile=False, actuated=("mcp", "pip")),
+    )
+    for name, run in (("plain", config), ("score", replace(config, sac=replace(sac, score_input=True)))):
+        dagger_policy(phrase, run, tmp_path / name)
+        env = pianobot.PianoEnv(piece=phrase, config=run.env)
+        policy = pianobot.load_policy(tmp_path / name, env)
+        observation, _ = env.reset(seed=0)
+        for _ in range(10):
+            ours, theirs = policy.act(observation), namespace["act"](tmp_path / name, observation)
+            assert ours.shape == (7,) and np.allclose(ours, theirs, atol=1e-6), (ours, theirs)
+            observation, *_ = env.step(ours)
+        env.close()

@@ -47,3 +47,33 @@ def test_the_export_command(tmp_path):
     bad = CliRunner().invoke(app, ["export", str(tmp_path), "-o", str(tmp_path / "q.onnx")])
     assert bad.exit_code == 2 and "holds no manifest.json" in bad.stderr
     assert CliRunner().invoke(app, ["export", str(folder), "-o", str(tmp_path / "p.txt")]).exit_code == 2
+
+
+def test_a_finger_shared_policy_exports_with_the_vector_alone(tmp_path):
+    from pianobot.agent.config import SACConfig
+    from pianobot.agent.export import export_onnx
+    from pianobot.env.piano import EnvConfig
+    from pianobot.learn.config import DaggerConfig, TrainConfig
+    from pianobot.learn.dagger import dagger_policy
+
+    phrase = pianobot.Piece((pianobot.Note(0.0, 64, 0.5, 80, 3),), bpm=60)
+    config = TrainConfig(
+        learner="dagger",
+        steps=70,
+        eval_episodes=1,
+        sac=SACConfig(hidden=16, actor="fingers"),
+        dagger=DaggerConfig(round_steps=70, batch_size=16),
+        env=EnvConfig(tactile=True),  # touch observed, but this actor does not read it
+    )
+    dagger_policy(phrase, config, tmp_path / "m")
+    session = ort.InferenceSession(str(export_onnx(tmp_path / "m", tmp_path / "p.onnx")))
+    assert [i.name for i in session.get_inputs()] == ["vector"]
+    env = pianobot.PianoEnv(piece=phrase, config=config.env)
+    policy = pianobot.load_policy(tmp_path / "m", env)
+    observation, _ = env.reset(seed=1)
+    for _ in range(10):
+        vector, _ = policy.split(observation)
+        action = session.run(None, {"vector": np.stack([vector] * 3)})[0]
+        assert action.shape == (3, 13) and np.allclose(action[1], policy.act(observation), atol=1e-5)
+        observation, *_ = env.step(action[0])
+    env.close()

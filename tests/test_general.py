@@ -233,8 +233,10 @@ def test_the_options_default_to_the_training_configuration_and_say_what_they_do(
 
 
 def test_a_phrase_trained_from_the_general_policy_takes_its_actor(tmp_path):
-    """A general policy with the 'fingers' actor starts phrases with it (--actor left out); an
-    --actor that differs from it is refused in one line, an unknown one too."""
+    """A general policy with the 'fingers' actor starts phrases with it (--actor left out), in a
+    folder its networks name; an --actor that differs from it is refused in one line, an unknown one too."""
+    from pianobot.learn.config import config_from_manifest
+
     models = tmp_path / "models"
     result = run("train", "--task", "melody", *QUICK, "--actor", "fingers", "--models", models)
     assert result.exit_code == 0, result.output
@@ -245,11 +247,21 @@ def test_a_phrase_trained_from_the_general_policy_takes_its_actor(tmp_path):
     (policy,) = json.loads(result.stdout)["policies"]
     manifest = manifest_of(Path(policy["folder"]))
     assert manifest["start"]["path"] == str(general) and manifest["config"]["sac"]["actor"] == "fingers"
+    assert Path(policy["folder"]).name.endswith(
+        store.config_hash(config_from_manifest(manifest))
+    )  # its networks name it
     mlp = run("train", EXAMPLES / "one-note.mid", *QUICK, "--actor", "mlp", "--models", models, "--force")
-    one_line_error(mlp, "sac.actor fingers", "this run with mlp", "--no-from-general")
-    scratch = run("train", EXAMPLES / "one-note.mid", *QUICK, "--no-from-general", "--force", "--models", models)
+    one_line_error(mlp, "sac.actor fingers", "this run with mlp", "--actor", "--no-from-general")
+    kept = (Path(policy["folder"]) / store.POLICY_FILE).read_bytes()
+    scratch = run("train", EXAMPLES / "one-note.mid", *QUICK, "--no-from-general", "--models", models, "--json", "-")
     assert scratch.exit_code == 0, scratch.output
-    assert manifest_of(Path(policy["folder"]))["config"]["sac"]["actor"] == "mlp"  # from scratch: the default
+    (other,) = json.loads(scratch.stdout)["policies"]  # from scratch, the default actor: a folder of its own
+    assert other["trained_now"] and other["folder"] != policy["folder"]
+    assert manifest_of(Path(other["folder"]))["config"]["sac"]["actor"] == "mlp"
+    assert (Path(policy["folder"]) / store.POLICY_FILE).read_bytes() == kept
+    # continuing the fingers policy with its own options would train into its folder: refused
+    itself = run("train", "--task", "melody", *QUICK, "--general-policy", general, "--models", models, "--force")
+    one_line_error(itself, "--general-policy", "the folder this run trains into")
     one_line_error(
         run("train", "--task", "melody", *QUICK, "--actor", "cnn"), "--actor cnn", "choose one of mlp, fingers"
     )

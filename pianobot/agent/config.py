@@ -38,7 +38,7 @@ class SACConfig:
     and a three-layer MLP for the wrist; it reads the observation vector itself, not the encoder
     (so neither touch nor the score window), and needs the finger targets. What one finger learns
     to do for a key serves the others: imitating the scripted pianist, it plays melodies it never
-    saw far better than the 'mlp' actor (docs/benchmarks.md, "The general policy on unseen pieces")."""
+    saw far better than the 'mlp' actor (docs/training.md, "The finger-shared actor")."""
     score_input: bool = False
     """Feed the score window (L keys x 5 channels x lookahead steps, the paper's input) to the
     networks. Off by default: the finger targets in the observation say, for each finger, where

@@ -46,6 +46,7 @@ OPTIONS = {
     "env.world.hand.spec": "--thumb",
     "env.reward.kind": "--reward",
     "env.reward.fingering_gate": "--fingering-gate/--no-fingering-gate",
+    "sac.actor": "--actor",
     "sac.": "the agent's network settings (SACConfig)",
 }
 """The command-line option that sets a configuration field (by dotted prefix)."""

@@ -23,7 +23,7 @@ FINE_TUNING_STD = 0.02
 
 
 class Imitation:
-    """Adam over the actor and encoder of ``agent``; :meth:`update` is one gradient step."""
+    """Adam over the actor of ``agent``, and its encoder when the actor reads it; :meth:`update` is one gradient step."""
 
     def __init__(self, agent: SAC, learning_rate: float):
         self.agent = agent

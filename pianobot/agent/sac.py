@@ -4,7 +4,8 @@
 Networks (paper, "Architecture"): a tactile encoder of three convolution layers shared across
 fingers, a three-layer MLP for the vector inputs (finger targets, wrist, joints; the score
 window only with ``score_input``), their features concatenated and fed to two-layer heads; ReLU
-throughout. The critic's two Q heads are one batched network (weights stacked on a leading
+throughout. ``SACConfig.actor`` 'fingers' gives the actor networks of its own instead, over the
+observation vector: one MLP shared by the fingers and one for the wrist (:class:`FingerActor`). The critic's two Q heads are one batched network (weights stacked on a leading
 axis, one ``baddbmm`` per layer), so both critics cost one forward and one optimiser step. The encoder belongs to the critic and the actor reads
 its features detached (as in DrQ): one encoder pass per update serves both.
 

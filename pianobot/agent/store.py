@@ -44,7 +44,8 @@ reading (:func:`upgrade_manifest`), so every model a user has keeps playing.
   since, absent from the manifests written before them, where their absence means what those
   runs did: ``config.from_general`` (false: trained from scratch) and ``start`` (null: the
   policy training began from, fine-tuning; docs/training.md), ``config.finetune_until_f1``
-  (unused without ``from_general``), ``config.envs`` and ``config.device`` (1, auto); the file
+  (unused without ``from_general``), ``config.envs`` and ``config.device`` (1, auto),
+  ``config.sac.actor`` ('mlp'); the file
   ``critic.safetensors`` (missing: the policy cannot pass its critic on to a fine-tuning run,
   which then begins with fresh Q heads).
 - 1: the agent's ``config.sac.tactile_resolution`` overrode ``config.env.tactile_pool``; the

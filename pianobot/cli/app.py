@@ -830,16 +830,15 @@ def train(
         )
     if general_policy is not None:
         find_general(models, path=general_policy)  # a folder that holds no policy: said before any work
-    start = None
+    # where the run begins, before its folders are named: a run from a policy takes its networks
+    config, start = general_start(config, models, general_policy, networks_given=actor is not None)
     if task is not None:
         job = task_job(task, config, models)
         refuse_training_into(general_policy, [job])
         todo, done = plan_jobs([job], force)
         label = f"task {task}"
-        if general_policy is not None and todo:
-            config, start = general_start(config, models, general_policy, networks_given=actor is not None)
-            if store.checkpoint_state(job.folder) is None:  # (else the run resumes, and says so)
-                console.print(f"continuing the policy {said(start)} on {said(label)}: evaluated first", soft_wrap=True)
+        if start is not None and todo and store.checkpoint_state(job.folder) is None:  # (else it resumes, and says so)
+            console.print(f"continuing the policy {said(start)} on {said(label)}: evaluated first", soft_wrap=True)
     else:
         piece = read_song(
             song, make_options(track, tempo, transpose, fingering, hand_part, split, quantize, refinger), keyboard, hand
@@ -849,7 +848,6 @@ def train(
         refuse_training_into(general_policy, jobs)
         label = f"{song.name}: {len(phrases)} phrases"
         if force or not all(store.is_trained(job.folder) for job in jobs):  # (before --force removes a policy)
-            config, start = general_start(config, models, general_policy, networks_given=actor is not None)
             if start is not None:
                 console.print(
                     f"starting every phrase from the general policy {said(start)}: evaluated first, a phrase stops at "
