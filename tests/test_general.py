@@ -265,3 +265,26 @@ def test_a_phrase_trained_from_the_general_policy_takes_its_actor(tmp_path):
     one_line_error(
         run("train", "--task", "melody", *QUICK, "--actor", "cnn"), "--actor cnn", "choose one of mlp, fingers"
     )
+
+
+def test_the_newest_general_policy_is_the_last_trained_not_the_last_checked_out(tmp_path, general):
+    """A clone gives every file the checkout's time: which general policy is newest comes from the
+    manifests' `saved`, and a manifest without it falls back to its file's time."""
+    import os
+
+    from pianobot.agent.general import find_general
+
+    models = tmp_path / "models"
+    older, newer = models / f"{GENERAL_KEY}-aaaaaaaaaaaa", models / f"{GENERAL_KEY}-bbbbbbbbbbbb"
+    for folder, saved in ((older, "2026-01-01T00:00:00+00:00"), (newer, "2026-06-01T00:00:00+00:00")):
+        shutil.copytree(general, folder)
+        manifest = manifest_of(folder)
+        assert isinstance(manifest["saved"], str)  # every stored policy records it
+        (folder / store.MANIFEST_FILE).write_text(json.dumps({**manifest, "saved": saved}))
+    os.utime(older / store.MANIFEST_FILE, (2e9, 2e9))  # the older one checked out last
+    assert store.find_policies(models, GENERAL_KEY) == [newer, older]
+    assert find_general(models) == newer
+    legacy = {k: v for k, v in manifest_of(older).items() if k != "saved"}  # written before `saved`: its file's time
+    (older / store.MANIFEST_FILE).write_text(json.dumps(legacy))
+    os.utime(older / store.MANIFEST_FILE, (2e9, 2e9))  # 2033
+    assert store.find_policies(models, GENERAL_KEY) == [older, newer]

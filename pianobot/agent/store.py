@@ -23,6 +23,7 @@ import hashlib
 import json
 import os
 import shutil
+from datetime import datetime, timezone
 from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -45,7 +46,8 @@ reading (:func:`upgrade_manifest`), so every model a user has keeps playing.
   runs did: ``config.from_general`` (false: trained from scratch) and ``start`` (null: the
   policy training began from, fine-tuning; docs/training.md), ``config.finetune_until_f1``
   (unused without ``from_general``), ``config.envs`` and ``config.device`` (1, auto),
-  ``config.sac.actor`` ('mlp'); the file
+  ``config.sac.actor`` ('mlp'), ``saved`` (when the policy was stored: the manifest file's
+  modification time stands in); the file
   ``critic.safetensors`` (missing: the policy cannot pass its critic on to a fine-tuning run,
   which then begins with fresh Q heads).
 - 1: the agent's ``config.sac.tactile_resolution`` overrode ``config.env.tactile_pool``; the
@@ -147,7 +149,8 @@ def save_policy(
         save_tensors(critic, folder / CRITIC_FILE, metadata={"format": str(FORMAT)})
     else:  # (a forced retrain must not leave an older run's critic beside the new policy)
         (folder / CRITIC_FILE).unlink(missing_ok=True)
-    manifest = {"format": FORMAT, **manifest, "versions": package_versions()}
+    saved = datetime.now(timezone.utc).isoformat(timespec="seconds")
+    manifest = {"format": FORMAT, **manifest, "saved": saved, "versions": package_versions()}
     atomic_write(folder / MANIFEST_FILE, json.dumps(manifest, indent=2, default=str) + "\n")
 
 
@@ -203,13 +206,27 @@ def trained_keys(root: Path) -> set[str]:
     return {d.name.rsplit("-", 1)[0] for d in root.iterdir() if d.is_dir() and "-" in d.name and is_trained(d)}
 
 
+def saved_at(folder: Path) -> str:
+    """When the policy in ``folder`` was stored (UTC, ISO 8601): its manifest's ``saved``, else (a
+    manifest written before it was recorded) the manifest file's modification time."""
+    try:
+        saved = json.loads((folder / MANIFEST_FILE).read_text()).get("saved")
+    except (OSError, ValueError, AttributeError):
+        saved = None
+    if isinstance(saved, str):
+        return saved
+    mtime = (folder / MANIFEST_FILE).stat().st_mtime
+    return datetime.fromtimestamp(mtime, timezone.utc).isoformat(timespec="seconds")
+
+
 def find_policies(root: Path, key: str) -> list[Path]:
-    """Trained policy folders for a phrase hash (or task key), newest first."""
+    """Trained policy folders for a phrase hash (or task key), newest first (:func:`saved_at`:
+    a clone's files all have the time of the checkout, the manifests keep when they were trained)."""
     root = Path(root)
     if not root.is_dir():
         return []
     found = [d for d in root.iterdir() if d.is_dir() and d.name.startswith(f"{key}-") and is_trained(d)]
-    return sorted(found, key=lambda d: (d / MANIFEST_FILE).stat().st_mtime, reverse=True)
+    return sorted(found, key=saved_at, reverse=True)
 
 
 # -- checkpoints ------------------------------------------------------------------------------
