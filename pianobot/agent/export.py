@@ -1,8 +1,8 @@
 """A stored policy as an ONNX graph, for running it on a robot or in any ONNX runtime.
 
 The graph is the deterministic policy: inputs ``vector`` (batch, V) float32, the observation
-vector in the order docs/models.md gives, and, for a policy whose actor reads touch, ``tactile`` (batch, 2,
-fingers, rows, cols) uint8; output ``action`` (batch, A) in [-1, 1]. The policy's manifest goes
+vector in the order docs/models.md gives, and, for a policy whose actor reads touch, ``tactile``
+(batch, 2, fingers, rows, cols) uint8; output ``action`` (batch, A) in [-1, 1]. The policy's manifest goes
 into the graph's metadata (``pianobot_manifest``), so the file says how it was trained and which
 environment it expects.
 """

@@ -2,8 +2,9 @@
 :mod:`pianobot.learn.dagger`). Not in the paper.
 
 One gradient step moves the actor and the encoder together (in SAC the encoder learns from the
-critic alone; an actor that does not read the encoder, ``SACConfig.actor`` 'fingers', moves alone): the loss is the squared error of the deterministic action (tanh of the mean) to
-the teacher's, averaged over action dimensions. A strike fails once the finger joints' speeds
+critic alone; an actor that does not read the encoder, ``SACConfig.actor`` 'fingers', moves
+alone): the loss is the squared error of the deterministic action (tanh of the mean) to the
+teacher's, averaged over action dimensions. A strike fails once the finger joints' speeds
 stray about 0.02 from the teacher's (docs/benchmarks.md, "How precise must a policy be?"), so the
 loss worth reaching is around 4e-4. The policy's spread (its log standard deviation) is pulled
 towards :data:`FINE_TUNING_STD`, so that SAC fine-tuning from a cloned policy begins by exploring
@@ -23,7 +24,8 @@ FINE_TUNING_STD = 0.02
 
 
 class Imitation:
-    """Adam over the actor of ``agent``, and its encoder when the actor reads it; :meth:`update` is one gradient step."""
+    """Adam over the actor of ``agent`` (and its encoder, when the actor reads it); :meth:`update`
+    is one gradient step."""
 
     def __init__(self, agent: SAC, learning_rate: float):
         self.agent = agent

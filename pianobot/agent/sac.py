@@ -5,9 +5,11 @@ Networks (paper, "Architecture"): a tactile encoder of three convolution layers 
 fingers, a three-layer MLP for the vector inputs (finger targets, wrist, joints; the score
 window only with ``score_input``), their features concatenated and fed to two-layer heads; ReLU
 throughout. ``SACConfig.actor`` 'fingers' gives the actor networks of its own instead, over the
-observation vector: one MLP shared by the fingers and one for the wrist (:class:`FingerActor`). The critic's two Q heads are one batched network (weights stacked on a leading
-axis, one ``baddbmm`` per layer), so both critics cost one forward and one optimiser step. The encoder belongs to the critic and the actor reads
-its features detached (as in DrQ): one encoder pass per update serves both.
+observation vector: one MLP shared by the fingers and one for the wrist (:class:`FingerActor`).
+The critic's two Q heads are one batched network (weights stacked on a leading axis, one
+``baddbmm`` per layer), so both critics cost one forward and one optimiser step. The encoder
+belongs to the critic and the 'mlp' actor reads its features detached (as in DrQ): one encoder
+pass per update serves both.
 
 Everything tunable is in :class:`~pianobot.agent.config.SACConfig`; docs/training.md says where our defaults differ
 from the paper's and why.
@@ -242,16 +244,16 @@ class FingerActor(GaussianActor):
 
     def heads(self, features: torch.Tensor | None, vector: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
         v = vector[:, self.score_dim :]
-        batch, (fingers, joints, width) = (
-            v.shape[0],
-            (self.layout.fingers, self.layout.joints, self.layout.target_width),
-        )
-        at = 2 + fingers * joints
+        batch = v.shape[0]
+        fingers, joints, width = self.layout.fingers, self.layout.joints, self.layout.target_width
+        angles = 2  # after the wrist's position and speed: angles, speeds, targets, finger by finger
+        speeds = angles + fingers * joints
+        targets = speeds + fingers * joints
         own = [
             v[:, None, :2].expand(batch, fingers, 2),
-            v[:, 2:at].reshape(batch, fingers, joints),
-            v[:, at : at + fingers * joints].reshape(batch, fingers, joints),
-            v[:, at + fingers * joints : at + fingers * (joints + width)].reshape(batch, fingers, width),
+            v[:, angles:speeds].reshape(batch, fingers, joints),
+            v[:, speeds:targets].reshape(batch, fingers, joints),
+            v[:, targets : targets + fingers * width].reshape(batch, fingers, width),
             self.which.expand(batch, fingers, fingers),
             v[:, None, :].expand(batch, fingers, v.shape[1]),
         ]

@@ -27,7 +27,7 @@ class DaggerConfig:
     """Gradient steps of behaviour cloning at a round's end, per environment step of the round."""
     batch_size: int = 256
     learning_rate: float = 1e-3
-    """Adam's step size, over the actor and the encoder, at the run's start; it falls along a
+    """Adam's step size, over the actor (and the encoder it reads), at the run's start; it falls along a
     cosine to ``final_learning_rate`` at its last step (a cloned policy must be precise: docs/training.md)."""
     final_learning_rate: float = 3e-5
     teacher_share: float = 0.5
