@@ -101,3 +101,16 @@ def test_a_corrupted_policy_file_loads_or_is_one_line(data):
         load_and_act(folder)
     finally:
         shutil.rmtree(folder.parent)
+
+
+def test_a_manifest_asking_for_a_window_loads_without_one(tmp_path):
+    """`world.gui` true in a manifest (fuzzing found it) once opened a PyBullet GUI connection,
+    which waits for ever where there is no display: a stored file never opens a window."""
+    folder = tmp_path / SOURCE.name
+    shutil.copytree(SOURCE, folder)
+    manifest = json.loads((folder / store.MANIFEST_FILE).read_text())
+    manifest["config"]["env"]["world"]["gui"] = True
+    (folder / store.MANIFEST_FILE).write_text(json.dumps(manifest))
+    env_config, _ = policy_configs(folder)
+    assert env_config.world.gui is False
+    load_and_act(folder)

@@ -10,6 +10,7 @@ device trained them. A loaded :class:`SAC` has the controller interface (``reset
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -49,13 +50,14 @@ def make_agent(env, config: SACConfig, device: str | torch.device = "cpu") -> SA
 
 
 def policy_configs(folder: Path) -> tuple[EnvConfig, SACConfig]:
-    """The environment and agent configurations the policy in ``folder`` was trained with."""
+    """The environment and agent configurations the policy in ``folder`` was trained with, with no
+    simulation window (``world.gui``): whether one is shown is the caller's choice, never a file's."""
     manifest = store.read_manifest(folder)
     try:
         env = from_dict(EnvConfig, manifest["config"]["env"], "config.env")
         sac = from_dict(SACConfig, manifest["config"]["sac"], "config.sac")
         idle_pose(env.world)  # a hand that can reach the keys at all
-        return env, sac
+        return replace(env, world=replace(env.world, gui=False)), sac
     except ConfigError as e:
         raise PianobotError(f"{folder / store.MANIFEST_FILE}: {e}: retrain the phrase with --force") from None
     except ValueError as e:
