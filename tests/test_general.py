@@ -218,6 +218,44 @@ def test_play_with_only_the_general_policy_plays_every_phrase_in_its_environment
     assert report["phrases"] == {"0": f"general policy {general.name}"}
 
 
+def test_the_general_policy_plays_its_consecutive_phrases_as_one_section(tmp_path, models):
+    """Phrases without their own policy that follow each other are one stretch for the general policy:
+    it sees all their notes, a held one included, and the wrist guard it plays through is its own."""
+    from pianobot.agent.policy import policy_configs
+    from pianobot.env.piano import PianoEnv
+    from pianobot.music.phrases import split_phrases
+    from pianobot.perform.compose import CompositionalController
+    from pianobot.perform.guard import WristGuard
+
+    general = next(models.glob(f"{GENERAL_KEY}-*"))
+    trained = run("train", EXAMPLES / "one-note.mid", *QUICK, "--no-from-general", "--models", models)
+    assert trained.exit_code == 0, trained.output
+    notes = (Note(0.0, 60, 1.0, 80, 2), Note(3.0, 64, 4.0, 80, 3), Note(6.0, 67, 7.5, 70, 2), Note(7.0, 69, 8.0, 70, 3))
+    piece = Piece(notes, bpm=60)  # phrase 1 is one-note.mid's note (its own policy); G4 is still held at A4's onset
+    phrases = split_phrases(piece, 1)
+    env = PianoEnv(piece=piece, config=policy_configs(general)[0])
+    composed = CompositionalController(env, phrases, models, False, general)
+    assert [[p.index for p in s.phrases] for s in composed.sections] == [[0], [1], [2, 3]]
+    assert [s.source.split()[0] for s in composed.sections] == ["general", "policy", "general"]
+    assert composed.sections[0].controller is composed.sections[2].controller  # one guarded policy, loaded once
+    assert isinstance(composed.sections[2].controller, WristGuard)
+    last = composed.sections[2]
+    window = last.rows(last.start, last.start + len(last.tensor))
+    sounding = window[:, :, 0].sum(axis=1)
+    assert sounding.max() == 2  # at A4's onset G4 still sounds: the general policy sees both
+    unguarded = CompositionalController(env, phrases, models, False, general, guard=False)
+    assert not isinstance(unguarded.sections[2].controller, WristGuard)
+
+    song = write_midi(piece, tmp_path / "song.mid")
+    args = ("play", song, "-o", tmp_path / "out.mid", "--models", models, "--phrase-notes", "1")
+    for flag, on in (("--wrist-guard", True), ("--no-wrist-guard", False)):
+        result = run(*args, flag)
+        assert result.exit_code == 0, result.output
+        report = json.loads((tmp_path / "out.report.json").read_text())
+        assert [report["phrases"][k].split()[0] for k in "0123"] == ["general", "policy", "general", "general"]
+        assert report["wrist_guard"]["on"] is on and report["wrist_guard"]["slowed_steps"] >= 0
+
+
 def test_the_options_default_to_the_training_configuration_and_say_what_they_do():
     import typer.main
 
@@ -229,7 +267,7 @@ def test_the_options_default_to_the_training_configuration_and_say_what_they_do(
     assert train["until_f1"].default is TrainConfig.until_f1 is None and TrainConfig.finetune_until_f1 == 1.0
     assert "evaluate it before any training step" in train["from_general"].help
     play = {p.name: p.default for p in commands["play"].params}
-    assert play["use_general"] is True and play["general_policy"] is None
+    assert play["use_general"] is True and play["general_policy"] is None and play["wrist_guard"] is True
 
 
 def test_a_phrase_trained_from_the_general_policy_takes_its_actor(tmp_path):

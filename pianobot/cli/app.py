@@ -451,6 +451,12 @@ def play(
         "melody` policy in --models, or --general-policy), when there is one.",
     ),
     general_policy: Optional[Path] = GeneralPolicy,
+    wrist_guard: bool = typer.Option(
+        True,
+        "--wrist-guard/--no-wrist-guard",
+        help="While a fingertip is low over the keys, the general policy's wrist slides no faster than the scripted "
+        "pianist's does while holding a key (8 mm a step), so a late release does not drag a finger across keys.",
+    ),
     phrase_notes: Optional[int] = PlayPhraseNotes,
     seed: int = typer.Option(
         0, "--seed", help="Seed of the simulation (the hand's start position) and of the random controller."
@@ -493,6 +499,7 @@ def play(
         shared_env_config,
         trained_split,
     )
+    from pianobot.perform.guard import WristGuard
     from pianobot.perform.perform import PLAY_CONFIG, perform, write_video
     from pianobot.sim.hand import HandConfig
     from pianobot.sim.keyboard import KeyboardConfig
@@ -525,6 +532,7 @@ def play(
     world = WorldConfig(keyboard=KeyboardConfig(spec=keyboard), hand=HandConfig(spec=hand), gui=gui)
     config = replace(PLAY_CONFIG, world=world)
     sources: dict = {}
+    guards: list = []  # the wrist guard the general policy played through (one, shared by its sections)
     general = None  # the general policy's folder, when it plays a phrase
     who = controller
     if controller == "sac":
@@ -560,8 +568,9 @@ def play(
             raise PianobotError("--fallback scripted needs policies trained with --control velocity or position")
 
         def who(env):
-            composed = CompositionalController(env, phrases, models, fallback is not None, general)
-            sources.update({s.phrase.index: s.source for s in composed.sections})
+            composed = CompositionalController(env, phrases, models, fallback is not None, general, wrist_guard)
+            sources.update({p.index: s.source for s in composed.sections for p in s.phrases})
+            guards.extend(s.controller for s in composed.sections if isinstance(s.controller, WristGuard))
             return composed
 
     with Progress(
@@ -587,6 +596,7 @@ def play(
     by_general = [k for k, v in sources.items() if v.startswith(GENERAL_SOURCE)]
     if by_general:
         extra["general_policy"] = describe(general)
+        extra["wrist_guard"] = {"on": bool(guards), "slowed_steps": guards[0].capped if guards else 0}
     atomic_write(
         report_path, json.dumps({"controller": controller, "seed": seed, **extra, **report.to_dict()}, indent=2) + "\n"
     )

@@ -10,11 +10,13 @@ later, but at the latest one step before phrase k's first onset; the hand is whe
 previous policy left it.
 
 Who plays a phrase: its own policy (stored under its phrase hash); else the general policy
-(:mod:`pianobot.agent.general`), which sees the phrase exactly as an own policy would (its
-own masked window and finger targets, as the ``melody`` family's phrases were seen in
-training); else, when asked (``fallback``), the scripted pianist. All of them play in one
+(:mod:`pianobot.agent.general`); else, when asked (``fallback``), the scripted pianist. The
+general policy was trained on random melodies, not on one phrase: consecutive phrases it plays
+form one section, and it sees that stretch's whole window (a held note and the next phrase's
+notes included), with no hand-over to itself at the phrase breaks. All of them play in one
 simulation, so the policies must share one environment (:func:`shared_env_config`,
-:func:`general_for`).
+:func:`general_for`). Learnt policies other than a phrase's own play through a
+:class:`~pianobot.perform.guard.WristGuard` when ``guard`` is set.
 """
 
 from __future__ import annotations
@@ -35,6 +37,7 @@ from pianobot.music.metrics import DEFAULT_ONSET_TOLERANCE
 from pianobot.music.phrases import DEFAULT_MAX_NOTES, Phrase, split_phrases
 from pianobot.music.piece import Piece
 from pianobot.music.tensor import score_tensor
+from pianobot.perform.guard import WristGuard
 from pianobot.perform.rollout import Controller
 from pianobot.pianist.scripted import ScriptedPianist
 
@@ -44,22 +47,22 @@ GENERAL_SOURCE = "general policy"
 
 @dataclass
 class Section:
-    """One phrase's stretch of the performance."""
+    """One controller's stretch of the performance: one phrase, or consecutive phrases the general policy plays."""
 
-    phrase: Phrase
+    phrases: tuple[Phrase, ...]
     first_step: int
     """Env step at which this phrase's controller takes over."""
     start: int
     """Env step of the phrase's first score row."""
     tensor: np.ndarray
-    """The phrase's own score tensor (steps x keys x channels), from its first onset."""
+    """The section's own score tensor (steps x keys x channels), from its first onset."""
     controller: Controller
     source: str
     """'policy <folder name>' (its own), 'general policy <folder name>' or 'scripted (fallback)'."""
 
     def rows(self, begin: int, end: int) -> np.ndarray:
-        """Env steps ``begin`` to ``end`` of the performance's score as this phrase's policy sees
-        it: only its own notes. Memory stays that of the phrase, however long the piece."""
+        """Env steps ``begin`` to ``end`` of the performance's score as this section's controller
+        sees it: only its own notes. Memory stays that of the section, however long the piece."""
         out = np.zeros((end - begin, *self.tensor.shape[1:]), self.tensor.dtype)
         low, high = max(begin, self.start), min(end, self.start + len(self.tensor))
         if low < high:
@@ -124,35 +127,53 @@ def general_for(models: Path, phrases_env: EnvConfig | None, path: Path | None =
 
 class CompositionalController:
     """Acts with the controller of the section the current step falls in: the phrase's own
-    policy, else the ``general`` policy (a folder), else (``fallback``) the scripted pianist."""
+    policy, else the ``general`` policy (a folder), else (``fallback``) the scripted pianist.
+    ``guard``: the general policy plays through a :class:`~pianobot.perform.guard.WristGuard`."""
 
-    def __init__(self, env: PianoEnv, phrases: list[Phrase], models: Path, fallback: bool, general: Path | None = None):
+    def __init__(
+        self,
+        env: PianoEnv,
+        phrases: list[Phrase],
+        models: Path,
+        fallback: bool,
+        general: Path | None = None,
+        guard: bool = True,
+    ):
         spec = env.spec_score
         lead = env.lead_steps
         grace = math.ceil(DEFAULT_ONSET_TOLERANCE * spec.control_hz - 1e-9)  # steps a strike may come late
+        general_agent = None  # loaded once, shared by every stretch it plays (a policy keeps no state)
+        runs: list[tuple[list[Phrase], Controller, str]] = []  # (phrases, controller, source) of each section
+        for phrase in phrases:
+            folder = find_policy(models, phrase)
+            if folder is not None:
+                runs.append(([phrase], load_policy(folder, env), f"policy {folder.name}"))
+            elif general is not None:
+                if runs and runs[-1][1] is general_agent:  # the general policy goes on playing: one section
+                    runs[-1][0].append(phrase)
+                    continue
+                if general_agent is None:
+                    agent = load_policy(general, env)
+                    guarded = guard and not env.config.world.discrete_wrist  # (a wrist that goes to keys has no speed)
+                    general_agent = WristGuard(agent, env.config) if guarded else agent
+                runs.append(([phrase], general_agent, f"{GENERAL_SOURCE} {Path(general).name}"))
+            elif fallback:
+                runs.append(([phrase], ScriptedPianist(env.config), "scripted (fallback)"))
+            else:  # checked before simulating; kept as a guard
+                raise PianobotError(f"phrase {phrase.index} has no trained policy in {models}")
         self.sections: list[Section] = []
         previous_last_onset = None
-        general_agent = None  # loaded once, shared by every phrase it plays (a policy keeps no state)
-        for phrase in phrases:
-            start = lead + spec.step_of(phrase.start)
+        for members, controller, source in runs:
+            start = lead + spec.step_of(members[0].start)
             if previous_last_onset is None:
                 first = 0
             else:
                 latest = max(start - 1, previous_last_onset + 1)
                 first = max(min(previous_last_onset + 1 + grace, latest), start - lead)
-            tensor = score_tensor(phrase.piece(), spec)
-            folder = find_policy(models, phrase)
-            if folder is not None:
-                controller, source = load_policy(folder, env), f"policy {folder.name}"
-            elif general is not None:
-                general_agent = general_agent or load_policy(general, env)
-                controller, source = general_agent, f"{GENERAL_SOURCE} {Path(general).name}"
-            elif fallback:
-                controller, source = ScriptedPianist(env.config), "scripted (fallback)"
-            else:  # checked before simulating; kept as a guard
-                raise PianobotError(f"phrase {phrase.index} has no trained policy in {models}")
-            self.sections.append(Section(phrase, first, start, tensor, controller, source))
-            previous_last_onset = lead + spec.step_of(phrase.notes[-1].onset)
+            notes = tuple(note for phrase in members for note in phrase.notes)
+            tensor = score_tensor(Piece(notes).shift(-members[0].start), spec)
+            self.sections.append(Section(tuple(members), first, start, tensor, controller, source))
+            previous_last_onset = lead + spec.step_of(members[-1].notes[-1].onset)
         self.env = env
         self.lookahead = env.config.lookahead
         self.step = 0

@@ -88,9 +88,7 @@ class Motion:
                 high = min(min(holds) + tuning.hold_reach, wrist + tuning.hold_slide)
                 target = float(np.clip(target, low, high)) if low <= high else wrist
         if any(
-            self._low(joints[slot])
-            for slot, f in enumerate(self.fingers)
-            if f not in plans or plans[f].phase == "ready"
+            self.low(joints[slot]) for slot, f in enumerate(self.fingers) if f not in plans or plans[f].phase == "ready"
         ):
             target = wrist  # a finger that lets go of a key rises before the hand moves
         return target
@@ -218,7 +216,7 @@ class Motion:
                 return q
         return current
 
-    def _low(self, q: np.ndarray) -> bool:
+    def low(self, q: np.ndarray) -> bool:
         """True when the fingertip is over the keys and lower than their top plus the clearance (it may touch one).
         Over the black keys' band their tops count.
 

@@ -1,0 +1,52 @@
+"""The wrist guard: a learnt policy's wrist slides no faster than its teacher's while a fingertip is low.
+
+A policy cloned from the scripted pianist learns its switch from "hold the key and ease the wrist
+along" to "let go, rise, then rush to the next position" blurred by a control step: it starts the
+rush while its finger is still on the key and drags the finger across the neighbouring keys,
+which sound. The scripted pianist never slides the wrist faster than
+:attr:`~pianobot.pianist.tuning.PianistTuning.hold_slide` a step while a fingertip is low over
+the keys (:meth:`~pianobot.pianist.motion.Motion.low`): it holds a key then, or has just let go
+of one. The guard holds a policy to the same limit, from the joint angles in the observation
+alone, and leaves every other action as the policy chose it.
+
+``pianobot play`` plays the general policy through it (``--wrist-guard``, the default); a
+phrase's own policy, trained on its phrase until perfect, plays unguarded.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from pianobot.env.piano import EnvConfig
+from pianobot.perform.rollout import Controller
+from pianobot.pianist.layout import KeyLayout
+from pianobot.pianist.motion import Motion
+from pianobot.pianist.tuning import PianistTuning
+
+
+class WristGuard:
+    """Wraps ``policy`` (a :class:`~pianobot.perform.rollout.Controller`): while any fingertip is
+    low over the keys, the wrist's action is clipped to ``tuning.hold_slide`` a control step."""
+
+    def __init__(self, policy: Controller, config: EnvConfig, tuning: PianistTuning = PianistTuning()):
+        world = config.world
+        if world.discrete_wrist:
+            raise ValueError("the wrist guard limits the wrist's speed: it needs discrete_wrist=False")
+        self.policy = policy
+        self.motion = Motion(world, KeyLayout(world), tuning)
+        self.fingers = len(world.hand.spec.fingers)
+        self.limit = tuning.hold_slide * world.control_hz / world.hand.max_wrist_speed
+        """The wrist's largest action while a fingertip is low (its action is a share of the top speed)."""
+        self.capped = 0
+        """Control steps in which the guard slowed the wrist, since the guard was made."""
+
+    def reset(self) -> None:
+        self.policy.reset()
+
+    def act(self, observation: dict) -> np.ndarray:
+        action = np.array(self.policy.act(observation), dtype=np.float32)  # a copy: the policy's own is left alone
+        joints = np.asarray(observation["joints"], dtype=float).reshape(self.fingers, 4)
+        if abs(action[-1]) > self.limit and any(self.motion.low(q) for q in joints):
+            action[-1] = np.sign(action[-1]) * self.limit
+            self.capped += 1
+        return action
