@@ -8,6 +8,7 @@ import shutil
 from dataclasses import replace
 from pathlib import Path
 
+import numpy as np
 import pytest
 import torch
 from typer.testing import CliRunner
@@ -220,7 +221,7 @@ def test_play_with_only_the_general_policy_plays_every_phrase_in_its_environment
 
 def test_the_general_policy_plays_its_consecutive_phrases_as_one_section(tmp_path, models):
     """Phrases without their own policy that follow each other are one stretch for the general policy:
-    it sees all their notes, a held one included, and the wrist guard it plays through is its own."""
+    it sees all their notes, a held one included, on the steps the environment scores them at."""
     from pianobot.agent.policy import policy_configs
     from pianobot.env.piano import PianoEnv
     from pianobot.music.phrases import split_phrases
@@ -230,30 +231,40 @@ def test_the_general_policy_plays_its_consecutive_phrases_as_one_section(tmp_pat
     general = next(models.glob(f"{GENERAL_KEY}-*"))
     trained = run("train", EXAMPLES / "one-note.mid", *QUICK, "--no-from-general", "--models", models)
     assert trained.exit_code == 0, trained.output
-    notes = (Note(0.0, 60, 1.0, 80, 2), Note(3.0, 64, 4.0, 80, 3), Note(6.0, 67, 7.5, 70, 2), Note(7.0, 69, 8.0, 70, 3))
-    piece = Piece(notes, bpm=60)  # phrase 1 is one-note.mid's note (its own policy); G4 is still held at A4's onset
+    notes = (
+        Note(0.0, 60, 1.0, 80, 2),
+        Note(2.5, 62, 2.8, 80, 3),
+        Note(3.0, 64, 4.0, 80, 3),  # one-note.mid's note: its own policy
+        Note(6.03, 67, 7.53, 70, 2),  # off the 50 ms grid; still held at A4's onset
+        Note(7.06, 69, 8.06, 70, 3),
+    )
+    piece = Piece(notes, bpm=60)
     phrases = split_phrases(piece, 1)
     env = PianoEnv(piece=piece, config=policy_configs(general)[0])
     composed = CompositionalController(env, phrases, models, False, general)
-    assert [[p.index for p in s.phrases] for s in composed.sections] == [[0], [1], [2, 3]]
+    assert [[p.index for p in s.phrases] for s in composed.sections] == [[0, 1], [2], [3, 4]]
     assert [s.source.split()[0] for s in composed.sections] == ["general", "policy", "general"]
     assert composed.sections[0].controller is composed.sections[2].controller  # one guarded policy, loaded once
     assert isinstance(composed.sections[2].controller, WristGuard)
+    # the own policy takes over after the tolerance of the section's last onset (D4, step 20 + 50), not C4's
+    lead = env.lead_steps
+    assert composed.sections[1].first_step == lead + 50 + 2
     last = composed.sections[2]
-    window = last.rows(last.start, last.start + len(last.tensor))
-    sounding = window[:, :, 0].sum(axis=1)
-    assert sounding.max() == 2  # at A4's onset G4 still sounds: the general policy sees both
+    steps = slice(last.start, last.start + len(last.tensor))
+    assert np.array_equal(last.rows(steps.start, steps.stop), env.score[steps])  # on the scored steps
+    assert last.rows(steps.start, steps.stop)[:, :, 0].sum(axis=1).max() == 2  # G4 still sounds at A4's onset
     unguarded = CompositionalController(env, phrases, models, False, general, guard=False)
     assert not isinstance(unguarded.sections[2].controller, WristGuard)
 
     song = write_midi(piece, tmp_path / "song.mid")
     args = ("play", song, "-o", tmp_path / "out.mid", "--models", models, "--phrase-notes", "1")
-    for flag, on in (("--wrist-guard", True), ("--no-wrist-guard", False)):
+    for flag in ("--wrist-guard", "--no-wrist-guard"):
         result = run(*args, flag)
         assert result.exit_code == 0, result.output
         report = json.loads((tmp_path / "out.report.json").read_text())
-        assert [report["phrases"][k].split()[0] for k in "0123"] == ["general", "policy", "general", "general"]
-        assert report["wrist_guard"]["on"] is on and report["wrist_guard"]["slowed_steps"] >= 0
+        assert [report["phrases"][k].split()[0] for k in "01234"] == ["general"] * 2 + ["policy"] + ["general"] * 2
+        guard = report["wrist_guard"]
+        assert guard == {"on": False, "slowed_steps": 0} if flag == "--no-wrist-guard" else guard["on"] is True
 
 
 def test_the_options_default_to_the_training_configuration_and_say_what_they_do():

@@ -33,15 +33,18 @@ class Constant:
         return self.action
 
 
-def observation_with(height: float | None) -> dict:
-    """The hand at rest, its second finger's tip ``height`` (m) over the white keys' top (None: left at rest)."""
-    world = CONFIG.world
+def observation_with(height: float | None, config: EnvConfig = CONFIG) -> dict:
+    """The hand at rest, its second finger's tip ``height`` (m) over the white keys' top, 40 mm in
+    from their front (None: left at rest)."""
+    world = config.world
     fingers = len(world.hand.spec.fingers)
     joints = np.tile(idle_pose(world), (fingers, 1))
     if height is not None:
         hand = world.hand
         reach = hand.palm_y - (world.keyboard.geometry.white_length - 0.040)
-        joints[1, 1:] = finger_ik(hand.geometry, reach, hand.palm_height - height)
+        flexion = finger_ik(hand.geometry, reach, hand.palm_height - height)
+        assert flexion is not None
+        joints[1, 1:] = flexion
     return {"joints": joints.reshape(-1).astype(np.float32)}
 
 
@@ -67,7 +70,24 @@ def test_the_wrist_is_slowed_only_while_a_fingertip_is_low():
     assert guard.policy.resets == 1
 
 
-def test_the_scripted_pianist_is_never_slowed_by_the_guard():
+@pytest.mark.parametrize(
+    "config",
+    [
+        EnvConfig(tactile=False, actuated=("mcp", "pip")),  # 2 joints a finger: the wrist is still the last action
+        EnvConfig(tactile=False, world=WorldConfig(control="position")),  # the wrist is driven by speed in every mode
+        EnvConfig(tactile=False, world=WorldConfig(control="torque")),
+    ],
+)
+def test_the_guard_clips_the_wrist_whatever_the_joints_and_control(config):
+    actions = len(actuated_indices(config))
+    asked = np.full(actions, 0.5, dtype=np.float32)
+    asked[-1] = 1.0
+    guard = WristGuard(Constant(asked), config)
+    low = guard.act(observation_with(0.001, config))
+    assert low[-1] == pytest.approx(0.16) and np.array_equal(low[:-1], asked[:-1])
+
+
+def test_the_scripted_pianist_plays_the_scale_unslowed_by_the_guard():
     """The guard holds a policy to its teacher's own limit: the teacher plays on unchanged."""
     piece = load_piece(EXAMPLES / "c-major-scale.mid", LoadOptions())
     guards = []

@@ -5,8 +5,8 @@ training of a new phrase begins (fine-tuning).
 Where it lives: in the model store, where ``pianobot train --task melody`` puts it (folder
 ``task-melody-<config hash>``); ``pianobot play`` and ``pianobot train`` take the newest such
 folder whose environment is the one they need, and ``--general-policy DIR`` names another (any
-trained policy folder). It sees a phrase as a phrase's own policy does: the sliding score window
-of that phrase alone, and its finger targets (:mod:`pianobot.perform.compose`).
+trained policy folder). It plays consecutive phrases without a policy of their own as one stretch:
+the sliding score window of that stretch, and its finger targets (:mod:`pianobot.perform.compose`).
 
 A general policy and the phrases it plays or starts must share one environment (the
 observations and actions it was trained with): :func:`difference` names the first field in which

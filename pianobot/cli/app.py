@@ -455,7 +455,8 @@ def play(
         True,
         "--wrist-guard/--no-wrist-guard",
         help="While a fingertip is low over the keys, the general policy's wrist slides no faster than the scripted "
-        "pianist's does while holding a key (8 mm a step), so a late release does not drag a finger across keys.",
+        "pianist's does while holding a key (PianistTuning.hold_slide, 8 mm a step), so that a late release drags a "
+        "finger across the keys less often (no effect on a policy trained with a discrete wrist).",
     ),
     phrase_notes: Optional[int] = PlayPhraseNotes,
     seed: int = typer.Option(

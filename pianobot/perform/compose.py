@@ -1,22 +1,23 @@
 """Compositional execution (paper, "Compositional Execution for long-horizon task"): a whole piece
 played by the policies of its phrases, one after another, in one continuous simulation.
 
-Each phrase's policy was trained on its phrase alone, seeing a sliding score window of only that
-phrase's notes. During the performance the active policy sees the same thing: the window at the
-current time, masked to its own phrase. Control passes from phrase k-1 to phrase k once the
-onset tolerance of phrase k-1's last note has run out (a strike up to 50 ms late still counts, so
-its policy keeps the hand until then), or one lead-in before phrase k's first note, whichever is
-later, but at the latest one step before phrase k's first onset; the hand is wherever the
-previous policy left it.
+The performance is a series of sections, each played by one controller. Each phrase's own
+policy was trained on its phrase alone, seeing a sliding score window of only that phrase's
+notes, and it plays a section of that one phrase: the window at the current time, masked to its
+phrase. Control passes from section k-1 to section k once the onset tolerance of section k-1's
+last note has run out (a strike up to 50 ms late still counts, so its controller keeps the hand
+until then), or one lead-in before section k's first note, whichever is later, but at the latest
+one step before section k's first onset; the hand is wherever the previous controller left it.
 
 Who plays a phrase: its own policy (stored under its phrase hash); else the general policy
-(:mod:`pianobot.agent.general`); else, when asked (``fallback``), the scripted pianist. The
-general policy was trained on random melodies, not on one phrase: consecutive phrases it plays
-form one section, and it sees that stretch's whole window (a held note and the next phrase's
-notes included), with no hand-over to itself at the phrase breaks. All of them play in one
-simulation, so the policies must share one environment (:func:`shared_env_config`,
-:func:`general_for`). Learnt policies other than a phrase's own play through a
-:class:`~pianobot.perform.guard.WristGuard` when ``guard`` is set.
+(:mod:`pianobot.agent.general`); else, when asked (``fallback``), the scripted pianist, each
+phrase a section of its own. Consecutive phrases the general policy plays form one section: it
+sees that stretch's whole window, a note held over a phrase break and the next phrase's notes
+included, with no hand-over to itself at the breaks. It was trained on single phrases, each
+alone in its window, so this is new to it; it plays better for it (docs/benchmarks.md, "What
+the wrist guard and one section change"). With ``guard``, the general policy plays through a
+:class:`~pianobot.perform.guard.WristGuard`. All of them play in one simulation, so the
+policies must share one environment (:func:`shared_env_config`, :func:`general_for`).
 """
 
 from __future__ import annotations
@@ -51,11 +52,14 @@ class Section:
 
     phrases: tuple[Phrase, ...]
     first_step: int
-    """Env step at which this phrase's controller takes over."""
+    """Env step at which this section's controller takes over."""
     start: int
-    """Env step of the phrase's first score row."""
+    """Env step of the section's first score row (the step of its first onset, or the one before)."""
     tensor: np.ndarray
-    """The section's own score tensor (steps x keys x channels), from its first onset."""
+    """The section's own score tensor (steps x keys x channels), from env step ``start`` on. A phrase's
+    own policy gets its phrase's tensor as in training (its first onset on row 0, the others placed
+    from there); the general policy and the scripted pianist get each note on the step the
+    environment scores it at. The two differ by a step for notes off the control-step grid."""
     controller: Controller
     source: str
     """'policy <folder name>' (its own), 'general policy <folder name>' or 'scripted (fallback)'."""
@@ -143,11 +147,11 @@ class CompositionalController:
         lead = env.lead_steps
         grace = math.ceil(DEFAULT_ONSET_TOLERANCE * spec.control_hz - 1e-9)  # steps a strike may come late
         general_agent = None  # loaded once, shared by every stretch it plays (a policy keeps no state)
-        runs: list[tuple[list[Phrase], Controller, str]] = []  # (phrases, controller, source) of each section
+        runs: list[tuple[list[Phrase], Controller, str, bool]] = []  # each section's phrases, controller, source, own?
         for phrase in phrases:
             folder = find_policy(models, phrase)
             if folder is not None:
-                runs.append(([phrase], load_policy(folder, env), f"policy {folder.name}"))
+                runs.append(([phrase], load_policy(folder, env), f"policy {folder.name}", True))
             elif general is not None:
                 if runs and runs[-1][1] is general_agent:  # the general policy goes on playing: one section
                     runs[-1][0].append(phrase)
@@ -156,23 +160,28 @@ class CompositionalController:
                     agent = load_policy(general, env)
                     guarded = guard and not env.config.world.discrete_wrist  # (a wrist that goes to keys has no speed)
                     general_agent = WristGuard(agent, env.config) if guarded else agent
-                runs.append(([phrase], general_agent, f"{GENERAL_SOURCE} {Path(general).name}"))
+                runs.append(([phrase], general_agent, f"{GENERAL_SOURCE} {Path(general).name}", False))
             elif fallback:
-                runs.append(([phrase], ScriptedPianist(env.config), "scripted (fallback)"))
+                runs.append(([phrase], ScriptedPianist(env.config), "scripted (fallback)", False))
             else:  # checked before simulating; kept as a guard
                 raise PianobotError(f"phrase {phrase.index} has no trained policy in {models}")
         self.sections: list[Section] = []
         previous_last_onset = None
-        for members, controller, source in runs:
-            start = lead + spec.step_of(members[0].start)
+        for members, controller, source, own in runs:
+            onset = lead + spec.step_of(members[0].start)  # the section's first onset's step
             if previous_last_onset is None:
                 first = 0
             else:
-                latest = max(start - 1, previous_last_onset + 1)
-                first = max(min(previous_last_onset + 1 + grace, latest), start - lead)
-            notes = tuple(note for phrase in members for note in phrase.notes)
-            tensor = score_tensor(Piece(notes).shift(-members[0].start), spec)
-            self.sections.append(Section(tuple(members), first, start, tensor, controller, source))
+                latest = max(onset - 1, previous_last_onset + 1)
+                first = max(min(previous_last_onset + 1 + grace, latest), onset - lead)
+            notes = Piece(tuple(note for phrase in members for note in phrase.notes))
+            if own:  # a phrase's own policy sees its phrase exactly as in training: from its first onset
+                row, shift = spec.step_of(members[0].start), members[0].start
+            else:  # the others see every note on the step the environment scores it at (the piece's grid)
+                row = math.floor(members[0].start * spec.control_hz + 1e-9)
+                shift = min(row / spec.control_hz, members[0].start)
+            tensor = score_tensor(notes.shift(-shift), spec)
+            self.sections.append(Section(tuple(members), first, lead + row, tensor, controller, source))
             previous_last_onset = lead + spec.step_of(members[-1].notes[-1].onset)
         self.env = env
         self.lookahead = env.config.lookahead
@@ -192,7 +201,7 @@ class CompositionalController:
         section = self.section_at(self.step)
         window = section.rows(self.step, self.step + self.lookahead + 1)
         observation = {**observation, "score": window}
-        if "targets" in observation:  # what the phrase's own window asks of each finger
+        if "targets" in observation:  # what the section's own window asks of each finger
             previous = section.rows(self.step - 1, self.step)[0] if self.step > 0 else np.zeros_like(window[0])
             observation["targets"] = self.env.targets(window, previous)
         self.step += 1
