@@ -1,12 +1,12 @@
 """The general policy on pieces it was never trained on, beside the scripted pianist (its teacher).
 
     python benchmarks/zeroshot.py [--general DIR] [--melodies 50] [--seed 2026] [--per-task 10]
-                                  [--sets examples melodies tasks] [--no-wrist-guard]
+                                  [--sets examples melodies tasks] [--wrist-guard]
                                   [--json out.json] [--plot docs/zeroshot.png]
 
 Three sets, each played in one continuous simulation per piece, from hand start 0, as
-``pianobot play`` plays a piece no phrase policy was trained for (the general policy through the
-wrist guard, :mod:`pianobot.perform.guard`, unless ``--no-wrist-guard``):
+``pianobot play`` plays a piece no phrase policy was trained for (the general policy, through the
+wrist guard, :mod:`pianobot.perform.guard`, with ``--wrist-guard``):
 
 - ``examples``: the one-hand example songs (their own fingering), split into phrases as
   ``pianobot play`` splits them, every phrase played by the general policy (no phrase policy is
@@ -78,7 +78,7 @@ def placed_hits(phrases, rollout) -> list[tuple[int, int, bool]]:
     return out
 
 
-def play_both(piece: Piece, general: Path, empty: Path, guard: bool = True) -> dict:
+def play_both(piece: Piece, general: Path, empty: Path, guard: bool = False) -> dict:
     """The general policy's and the scripted pianist's figures on ``piece``."""
     env_config, _ = policy_configs(general)
     phrases = split_phrases(piece, DEFAULT_MAX_NOTES)
@@ -214,7 +214,7 @@ def main() -> None:
     parser.add_argument("--seed", type=int, default=2026, help="first entry of the melodies' generator seeds")
     parser.add_argument("--per-task", type=int, default=10, help="instances of each paper task family (default 10)")
     parser.add_argument("--sets", nargs="+", choices=SETS, default=list(SETS), help="which sets to play (default all)")
-    parser.add_argument("--no-wrist-guard", action="store_true", help="play the general policy without the wrist guard")
+    parser.add_argument("--wrist-guard", action="store_true", help="play the general policy through the wrist guard")
     parser.add_argument("--json", help="write every piece's figures here")
     parser.add_argument("--plot", help="draw every piece's note F1 to this PNG")
     args = parser.parse_args()
@@ -230,10 +230,9 @@ def main() -> None:
     with tempfile.TemporaryDirectory() as empty:
         for name, pieces in sets.items():
             results[name] = [
-                {"piece": label, **play_both(piece, general, Path(empty), not args.no_wrist_guard)}
-                for label, piece in pieces
+                {"piece": label, **play_both(piece, general, Path(empty), args.wrist_guard)} for label, piece in pieces
             ]
-    print(f"general policy: {general}{' (no wrist guard)' * args.no_wrist_guard}\n")
+    print(f"general policy: {general}{' (wrist guard)' * args.wrist_guard}\n")
     print(table(results))
     if "melodies" in results:
         print("\nRandom melodies: the share of notes the general policy played (count), by place\n")
@@ -243,7 +242,7 @@ def main() -> None:
     if args.json:
         with open(args.json, "w") as f:
             json.dump(
-                {"general": str(general), "wrist_guard": not args.no_wrist_guard, "rejected": rejected, **results},
+                {"general": str(general), "wrist_guard": args.wrist_guard, "rejected": rejected, **results},
                 f,
                 indent=1,
             )

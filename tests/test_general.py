@@ -241,7 +241,7 @@ def test_the_general_policy_plays_its_consecutive_phrases_as_one_section(tmp_pat
     piece = Piece(notes, bpm=60)
     phrases = split_phrases(piece, 1)
     env = PianoEnv(piece=piece, config=policy_configs(general)[0])
-    composed = CompositionalController(env, phrases, models, False, general)
+    composed = CompositionalController(env, phrases, models, False, general, guard=True)
     assert [[p.index for p in s.phrases] for s in composed.sections] == [[0, 1], [2], [3, 4]]
     assert [s.source.split()[0] for s in composed.sections] == ["general", "policy", "general"]
     assert composed.sections[0].controller is composed.sections[2].controller  # one guarded policy, loaded once
@@ -253,7 +253,7 @@ def test_the_general_policy_plays_its_consecutive_phrases_as_one_section(tmp_pat
     steps = slice(last.start, last.start + len(last.tensor))
     assert np.array_equal(last.rows(steps.start, steps.stop), env.score[steps])  # on the scored steps
     assert last.rows(steps.start, steps.stop)[:, :, 0].sum(axis=1).max() == 2  # G4 still sounds at A4's onset
-    unguarded = CompositionalController(env, phrases, models, False, general, guard=False)
+    unguarded = CompositionalController(env, phrases, models, False, general)  # unguarded by default
     assert not isinstance(unguarded.sections[2].controller, WristGuard)
 
     song = write_midi(piece, tmp_path / "song.mid")
@@ -278,7 +278,7 @@ def test_the_options_default_to_the_training_configuration_and_say_what_they_do(
     assert train["until_f1"].default is TrainConfig.until_f1 is None and TrainConfig.finetune_until_f1 == 1.0
     assert "evaluate it before any training step" in train["from_general"].help
     play = {p.name: p.default for p in commands["play"].params}
-    assert play["use_general"] is True and play["general_policy"] is None and play["wrist_guard"] is True
+    assert play["use_general"] is True and play["general_policy"] is None and play["wrist_guard"] is False
 
 
 def test_a_phrase_trained_from_the_general_policy_takes_its_actor(tmp_path):

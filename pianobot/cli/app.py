@@ -452,7 +452,7 @@ def play(
     ),
     general_policy: Optional[Path] = GeneralPolicy,
     wrist_guard: bool = typer.Option(
-        True,
+        False,
         "--wrist-guard/--no-wrist-guard",
         help="While a fingertip is low over the keys, the general policy's wrist slides no faster than the scripted "
         "pianist's does while holding a key (PianistTuning.hold_slide, 8 mm a step), so that a late release drags a "

@@ -141,7 +141,7 @@ class CompositionalController:
         models: Path,
         fallback: bool,
         general: Path | None = None,
-        guard: bool = True,
+        guard: bool = False,
     ):
         spec = env.spec_score
         lead = env.lead_steps

@@ -12,8 +12,10 @@ holds a policy to ``hold_slide`` whenever a fingertip is low, from the joint ang
 observation alone, and leaves every other action as the policy chose it. It makes a drag less
 likely, not impossible: a fingertip low over the keys may still slide 8 mm a step.
 
-``pianobot play`` plays the general policy through it (``--wrist-guard``, the default); a
-phrase's own policy, trained on its phrase until perfect, plays unguarded.
+``pianobot play --wrist-guard`` plays the general policy through it (a phrase's own policy,
+trained on its phrase until perfect, plays unguarded). It is off by default: the committed
+general policy plays as well without it (docs/benchmarks.md), and unguarded it plays as
+training evaluated it; a general policy that drags keys while the hand shifts plays better with it.
 """
 
 from __future__ import annotations
