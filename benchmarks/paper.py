@@ -8,7 +8,7 @@
 EXPERIMENT is a number or a name:
 
 1 ``tasks``         one-note, three-note and six-note tasks; SAC with and without tactile images,
-                    the scripted and random controllers beside them (paper, figure "Comparison on
+                    the scripted, idle and random controllers beside them (paper, figure "Comparison on
                     different levels of music tasks")
 2 ``rhythm-chord``  the rhythmic and chord tasks (figure "Evaluation on tasks with different rhythms and chords")
 3 ``rewards``       linear, squared and Wasserstein rewards (Table I)
@@ -98,7 +98,9 @@ episode, whatever reward the policy trained with (paper, Table I: "evaluated wit
 reward"): no fingering gate (fingering accuracy is reported on its own) and no closeness bonus."""
 EVAL_FILE = "paper-eval.json"
 """A task run's evaluation, beside its policy."""
-BASELINES = ("scripted", "random")
+BASELINES = ("scripted", "idle", "random")
+"""The controllers that play beside the trained arms: the scripted pianist, a hand that holds
+still (:class:`IdleController`: what a policy that plays nothing earns) and uniform random actions."""
 
 # -- cost, from docs/benchmarks.md ("Trained phrase policies", last paragraph) --------------------
 EXPLORE_MINUTES_PER_15K = 4.0
@@ -138,6 +140,9 @@ class Options:
     lengths: tuple[int, ...] = (1, 2, 3, 5)
     """``compose``: the pieces are the first N phrases of ``piece``."""
     tempo: float | None = PAPER_BPM
+    stop_at: int | None = None
+    """Train each run only to this many steps this time: it checkpoints and stops there, and the
+    same command without it goes on to the full budget (a time box; None: the full budget)."""
 
 
 def setting_config(setting: str, options: Options, seed: int, steps: int, eval_episodes: int) -> TrainConfig:
@@ -148,6 +153,7 @@ def setting_config(setting: str, options: Options, seed: int, steps: int, eval_e
         eval_every=options.eval_every,
         eval_episodes=eval_episodes,
         checkpoint_every=options.eval_every,
+        from_general=False,  # every run trains from scratch, and only an exact F1 1.0 evaluation would not stop it
     )
     if setting == "ours":
         return TrainConfig(**common, sac=SACConfig(exploration_steps=options.exploration_steps))
@@ -242,6 +248,7 @@ EXPERIMENTS = {
             (Variant("tactile", _same, "SAC"),),
             PAPER_TASK_STEPS,
             "not stated; experiment 1's 2e5",
+            baselines=BASELINES,
         ),
         Experiment(
             3,
@@ -254,6 +261,7 @@ EXPERIMENTS = {
             ),
             ABLATION_STEPS,
             "not stated",
+            baselines=BASELINES,
         ),
         Experiment(
             4,
@@ -268,6 +276,7 @@ EXPERIMENTS = {
             ),
             ABLATION_STEPS,
             "not stated",
+            baselines=BASELINES,
         ),
         Experiment(
             5,
@@ -280,6 +289,7 @@ EXPERIMENTS = {
             ),
             ABLATION_STEPS,
             "not stated",
+            baselines=BASELINES,
             adjust=_no_teacher,
         ),
         Experiment(
@@ -293,6 +303,7 @@ EXPERIMENTS = {
             ),
             ABLATION_STEPS,
             "not stated",
+            baselines=BASELINES,
             fingering=True,
         ),
         Experiment(
@@ -434,6 +445,10 @@ def train_job(job: PhraseJob, config: TrainConfig, label: str = "", stop_after: 
     torch.set_num_threads(1)
     if store.is_trained(job.folder):
         return {"state": "trained", "folder": str(job.folder)}
+    state = store.checkpoint_state(job.folder)
+    if stop_after is not None and state is not None and state["step"] >= stop_after:
+        print(f"{label}: at {state['step']} steps, already past --stop-at {stop_after}", flush=True)
+        return {"state": "interrupted", "folder": str(job.folder)}
 
     def report(progress) -> None:
         if progress.resumed:
@@ -446,8 +461,10 @@ def train_job(job: PhraseJob, config: TrainConfig, label: str = "", stop_after: 
     except PianobotError as e:  # another process trains the same folder (a run two experiments share)
         print(f"{label}: {e}", flush=True)
         return {"state": "busy", "folder": str(job.folder)}
-    state = "interrupted" if "interrupted_at" in out else "trained"
-    return {"state": state, "folder": str(job.folder)}
+    if "interrupted_at" in out:
+        print(f"{label}: stopped at step {out['interrupted_at']} (--stop-at; rerun without it to go on)", flush=True)
+        return {"state": "interrupted", "folder": str(job.folder)}
+    return {"state": "trained", "folder": str(job.folder)}
 
 
 def trained(run: Run) -> bool:
@@ -466,7 +483,7 @@ def execute(runs: list[Run], options: Options, workers: int) -> None:
     print(f"{len(runs)} runs, {len(jobs)} policies: {len(todo)} to train, {len(ready)} runs to evaluate", flush=True)
     if workers <= 1:
         for job, config, label in todo:
-            train_job(job, config, label)
+            train_job(job, config, label, options.stop_at)
         for run in runs:
             if trained(run) and not _evaluated(run, options):
                 _print_evaluation(run, evaluate_run(run, options))
@@ -483,7 +500,7 @@ def execute(runs: list[Run], options: Options, workers: int) -> None:
         initializer=_exit_with_parent,
         initargs=(os.getpid(),),
     ) as pool:
-        pending = {pool.submit(train_job, job, config, label): label for job, config, label in todo}
+        pending = {pool.submit(train_job, job, config, label, options.stop_at): label for job, config, label in todo}
 
         def submit_evaluations() -> None:
             for run in runs:
@@ -599,8 +616,22 @@ def perform_piece(run: Run, hand_starts: int) -> dict:
     return _figures(played)
 
 
+class IdleController:
+    """Zero actions: under velocity control no joint moves, and the hand holds its starting pose
+    above the keys. Its return is what a policy that has learnt only to press nothing earns."""
+
+    def __init__(self, action_size: int):
+        self.action = np.zeros(action_size, np.float32)
+
+    def reset(self) -> None:
+        pass
+
+    def act(self, observation: dict) -> np.ndarray:
+        return self.action
+
+
 def baseline_figures(controller: str, task: str, seed: int, options: Options) -> dict:
-    """The scripted or random controller on the task's check instances (experiment 1), cached."""
+    """A baseline controller (:data:`BASELINES`) on the task's check instances, cached."""
     path = options.store / "baselines" / f"{task}-{controller}-seed{seed}.json"
     episodes = options.check_episodes or 30
     found = _read_json(path)
@@ -608,8 +639,15 @@ def baseline_figures(controller: str, task: str, seed: int, options: Options) ->
         return found
     from pianobot.perform.controllers import make_controller
 
-    env_config = EnvConfig(tactile=False)  # neither reads touch; the reward is EVAL_REWARD either way
-    figures = play_instances(lambda env: make_controller(controller, env, seed), task, env_config, episodes, CHECK_SEED)
+    def factory(env):
+        return (
+            IdleController(env.action_space.shape[0])
+            if controller == "idle"
+            else make_controller(controller, env, seed)
+        )
+
+    env_config = EnvConfig(tactile=False)  # none reads touch; the reward is EVAL_REWARD either way
+    figures = play_instances(factory, task, env_config, episodes, CHECK_SEED)
     path.parent.mkdir(parents=True, exist_ok=True)
     atomic_write(path, json.dumps(figures) + "\n")
     return figures
@@ -811,7 +849,8 @@ def plot(experiment: Experiment, found: list[Progress], baselines: dict, folder:
         else:
             _plot_curves(row, mine, style)
         for (task, controller), figures in baselines.items():
-            level = dict(color=style(task, variants[0])["color"], linestyle=":" if controller == "scripted" else "-.")
+            look = {"scripted": ":", "idle": (0, (1, 4)), "random": "-."}[controller]
+            level = dict(color=style(task, variants[0])["color"], linestyle=look)
             row[1].axhline(np.mean([f["f1"] for f in figures]), linewidth=1, **level, label=f"{task}, {controller}")
             if setting == "paper":  # its training reward is the linear one (gated: the baselines' fingers pass)
                 row[0].axhline(np.mean([f["return"] for f in figures]), linewidth=1, **level)
@@ -947,6 +986,13 @@ def parse(argv: list[str] | None = None) -> tuple[argparse.Namespace, Options]:
         "--lengths", nargs="+", type=int, default=list(Options.lengths), help="compose: first N phrases"
     )
     parser.add_argument("--tempo", type=float, default=Options.tempo, help="compose: re-time the piece (bpm)")
+    parser.add_argument(
+        "--stop-at",
+        type=int,
+        default=None,
+        help="train each run only to this many steps this time (it checkpoints there; rerun without it to go on); "
+        "--report --check then judges each run's best policy so far",
+    )
     parser.add_argument("--workers", type=int, default=1, help="runs in parallel, one torch thread each")
     parser.add_argument("--store", type=Path, default=Options.store)
     parser.add_argument("--plots", type=Path, default=ROOT / "docs" / "paper")
@@ -956,9 +1002,11 @@ def parse(argv: list[str] | None = None) -> tuple[argparse.Namespace, Options]:
     )
     parser.add_argument("--list", action="store_true", help="train nothing: the runs and the CPU-hours they need")
     args = parser.parse_args(argv)
-    for name in ("seeds", "workers", "check_episodes", "eval_episodes", "steps"):
+    for name in ("seeds", "workers", "check_episodes", "eval_episodes", "steps", "stop_at"):
         if getattr(args, name) is not None and getattr(args, name) < 1:
             parser.error(f"--{name.replace('_', '-')} must be at least 1")
+    if args.stop_at is not None and args.stop_at % args.eval_every:
+        parser.error(f"--stop-at must be a multiple of --eval-every ({args.eval_every}): runs checkpoint only there")
     options = Options(
         settings=SETTINGS if args.setting == "both" else (args.setting,),
         seeds=args.seeds,
@@ -973,6 +1021,7 @@ def parse(argv: list[str] | None = None) -> tuple[argparse.Namespace, Options]:
         piece=args.piece,
         lengths=tuple(args.lengths),
         tempo=args.tempo,
+        stop_at=args.stop_at,
     )
     return args, options
 

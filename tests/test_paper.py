@@ -70,7 +70,8 @@ def test_the_tables_arms_are_the_papers():
     ]
     assert paper.experiment_named("1").tasks == ("one-note", "three-note", "six-note")
     assert paper.experiment_named("2").tasks == ("rhythmic", "chord")
-    assert paper.experiment_named("1").baselines == ("scripted", "random")
+    assert paper.experiment_named("1").baselines == ("scripted", "idle", "random")
+    assert all(e.baselines == paper.BASELINES for e in paper.EXPERIMENTS.values() if e.name != "compose")
 
 
 def test_the_paper_setting_is_plain_sac_without_our_additions(tmp_path):
@@ -87,7 +88,8 @@ def test_the_paper_setting_is_plain_sac_without_our_additions(tmp_path):
 def test_the_ours_setting_is_pianobots_defaults_but_for_the_arm(tmp_path):
     for run in paper.expand("rewards", options(tmp_path, seeds=1, settings=("ours",))):
         base = TrainConfig(steps=run.config.steps, eval_episodes=run.config.eval_episodes)
-        assert set(paper.differences(run.config, base)) <= {"env.reward.kind"}
+        assert set(paper.differences(run.config, base)) <= {"env.reward.kind", "from_general"}
+        assert not run.config.from_general  # from scratch: the general policy is not the paper's subject
     for run in paper.expand("control", options(tmp_path, seeds=1, settings=("ours",))):
         assert run.config.explore == "prior"  # the scripted teacher has no torques: both arms explore alike
 
@@ -214,3 +216,36 @@ def test_cpu_hours_are_estimated_from_the_measured_training_speed(tmp_path):
     assert paper.run_minutes(40_000, 15_000) == pytest.approx(4.0 + 2.5 * 10.0)
     hours, policies = paper.estimate(paper.expand("rewards", options(tmp_path, seeds=3)))
     assert policies == 18 and hours == pytest.approx(18 * paper.run_minutes(100_000, 15_000) / 60)
+
+
+def test_stop_at_time_boxes_every_run_at_a_checkpoint_and_the_full_command_goes_on(tmp_path, capsys):
+    args = [*TINY, "--store", str(tmp_path), "--plots", str(tmp_path / "plots"), "--variants", "linear"]
+    with pytest.raises(SystemExit):  # between checkpoints the steps after the last one would be lost
+        paper.parse(["rewards", *args, "--stop-at", "250"])
+    _, opts = paper.parse(["rewards", *args, "--stop-at", "200"])
+    (run,) = paper.expand("rewards", opts)
+    assert opts.stop_at == 200 and run.config.steps == 300  # the protocol's budget, not the time box
+    assert not run.config.from_general and run.config.stop_f1 is None  # trains from scratch, never stops early
+
+    paper.main(["rewards", *args, "--stop-at", "200"])
+    folder = run.jobs[0].folder
+    stopped = store.checkpoint_state(folder)["step"]
+    assert 200 <= stopped < 300 and not store.is_trained(folder)
+    assert "stopped at step" in capsys.readouterr().out
+
+    paper.main(["rewards", *args, "--stop-at", "200"])  # already there: nothing is trained again
+    assert "already past --stop-at 200" in capsys.readouterr().out
+    assert store.checkpoint_state(folder)["step"] == stopped
+
+    paper.main(["rewards", *args])  # without it: on to the full budget
+    assert f"resuming from its checkpoint at step {stopped}" in capsys.readouterr().out
+    assert store.read_manifest(folder)["steps"] == 300
+
+
+def test_the_idle_hand_presses_no_key_and_earns_between_random_and_scripted(tmp_path):
+    opts = options(tmp_path, check_episodes=2)
+    played = {c: paper.baseline_figures(c, "three-note", 0, opts) for c in paper.BASELINES}
+    assert played["idle"]["f1"] == 0 and played["idle"]["velocity_mae"] is None  # no note sounded
+    assert played["random"]["return"] < played["idle"]["return"] < played["scripted"]["return"]
+    assert played["scripted"]["f1"] == 1.0
+    assert paper.baseline_figures("idle", "three-note", 0, opts) == played["idle"]  # cached
