@@ -797,6 +797,11 @@ def report(experiment: Experiment, runs: list[Run], options: Options, plots: Pat
         f"{'hand starts of the piece' if experiment.name == 'compose' else 'fresh task instances'}; "
         "mean ± standard deviation over seeds\n\n" + table(experiment, found, baselines)
     )
+    hours, policies = training_hours(runs)
+    text += (
+        f"\n\ntraining so far: {hours:.1f} CPU-hours, {policies} polic{'y' if policies == 1 else 'ies'} (each on one core; "
+        "a policy that several experiments share counts in each)"
+    )
     unfinished = [p for p in found if p.state.startswith("at ")]
     if unfinished:
         text += "\n\nunfinished: " + ", ".join(f"{p.run.label} ({p.state})" for p in unfinished)
@@ -805,6 +810,19 @@ def report(experiment: Experiment, runs: list[Run], options: Options, plots: Pat
     if plots is not None and any(p.curves for p in found):
         text += f"\n\nplot: {plot(experiment, found, baselines, plots)}"
     return text
+
+
+def training_hours(runs: list[Run]) -> tuple[float, int]:
+    """The training time so far of the runs' distinct policies, in hours (the manifests' seconds,
+    or the newest checkpoint's for an unfinished policy), and how many have begun."""
+    seconds: dict[Path, float] = {}
+    for run in runs:
+        for job in run.jobs:
+            if store.is_trained(job.folder):
+                seconds[job.folder] = store.read_manifest(job.folder)["seconds"]
+            elif (state := store.checkpoint_state(job.folder)) is not None:
+                seconds[job.folder] = state.get("seconds", 0.0)
+    return sum(seconds.values()) / 3600, len(seconds)
 
 
 def _binned(curves: list[list[dict]], key: str, every: int) -> tuple[list[int], list[float], list[float]]:
