@@ -845,7 +845,7 @@ def plot(experiment: Experiment, found: list[Progress], baselines: dict, folder:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    settings = [s for s in SETTINGS if any(p.run.setting == s for p in found)]
+    settings = [s for s in SETTINGS if any(p.run.setting == s and p.curves for p in found)]  # a row per setting run
     fig, axes = plt.subplots(len(settings), 2, figsize=(11, 3.6 * len(settings)), squeeze=False)
     cycle = plt.rcParams["axes.prop_cycle"].by_key()["color"]
     tasks = list(dict.fromkeys(p.run.task for p in found))
