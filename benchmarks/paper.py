@@ -100,7 +100,8 @@ EVAL_FILE = "paper-eval.json"
 """A task run's evaluation, beside its policy."""
 BASELINES = ("scripted", "idle", "random")
 """The controllers that play beside the trained arms: the scripted pianist, a hand that holds
-still (:class:`IdleController`: what a policy that plays nothing earns) and uniform random actions."""
+still (``idle``, :class:`~pianobot.perform.controllers.IdleController`: what a policy that
+presses nothing earns) and uniform random actions."""
 
 # -- cost, from docs/benchmarks.md ("Trained phrase policies", last paragraph) --------------------
 EXPLORE_MINUTES_PER_15K = 4.0
@@ -153,7 +154,7 @@ def setting_config(setting: str, options: Options, seed: int, steps: int, eval_e
         eval_every=options.eval_every,
         eval_episodes=eval_episodes,
         checkpoint_every=options.eval_every,
-        from_general=False,  # every run trains from scratch, and only an exact F1 1.0 evaluation would not stop it
+        from_general=False,  # from scratch, to the budget (with it on, an F1 1.0 evaluation would end a run early)
     )
     if setting == "ours":
         return TrainConfig(**common, sac=SACConfig(exploration_steps=options.exploration_steps))
@@ -616,20 +617,6 @@ def perform_piece(run: Run, hand_starts: int) -> dict:
     return _figures(played)
 
 
-class IdleController:
-    """Zero actions: under velocity control no joint moves, and the hand holds its starting pose
-    above the keys. Its return is what a policy that has learnt only to press nothing earns."""
-
-    def __init__(self, action_size: int):
-        self.action = np.zeros(action_size, np.float32)
-
-    def reset(self) -> None:
-        pass
-
-    def act(self, observation: dict) -> np.ndarray:
-        return self.action
-
-
 def baseline_figures(controller: str, task: str, seed: int, options: Options) -> dict:
     """A baseline controller (:data:`BASELINES`) on the task's check instances, cached."""
     path = options.store / "baselines" / f"{task}-{controller}-seed{seed}.json"
@@ -639,15 +626,8 @@ def baseline_figures(controller: str, task: str, seed: int, options: Options) ->
         return found
     from pianobot.perform.controllers import make_controller
 
-    def factory(env):
-        return (
-            IdleController(env.action_space.shape[0])
-            if controller == "idle"
-            else make_controller(controller, env, seed)
-        )
-
     env_config = EnvConfig(tactile=False)  # none reads touch; the reward is EVAL_REWARD either way
-    figures = play_instances(factory, task, env_config, episodes, CHECK_SEED)
+    figures = play_instances(lambda env: make_controller(controller, env, seed), task, env_config, episodes, CHECK_SEED)
     path.parent.mkdir(parents=True, exist_ok=True)
     atomic_write(path, json.dumps(figures) + "\n")
     return figures
