@@ -98,6 +98,8 @@ episode, whatever reward the policy trained with (paper, Table I: "evaluated wit
 reward"): no fingering gate (fingering accuracy is reported on its own) and no closeness bonus."""
 EVAL_FILE = "paper-eval.json"
 """A task run's evaluation, beside its policy."""
+SO_FAR_FILE = "paper-eval-so-far.json"
+"""An unfinished task run's best policy so far, judged (``--report --check``), beside its checkpoint."""
 BASELINES = ("scripted", "idle", "random")
 """The controllers that play beside the trained arms: the scripted pianist, a hand that holds
 still (``idle``, :class:`~pianobot.perform.controllers.IdleController`: what a policy that
@@ -635,16 +637,26 @@ def baseline_figures(controller: str, task: str, seed: int, options: Options) ->
 
 def best_so_far(run: Run, options: Options) -> dict | None:
     """An unfinished task run's best policy so far (from its checkpoint), judged as a finished
-    one is; None when it has none yet. Changes nothing."""
+    one is; None when it has none yet. The figures are kept beside the checkpoint
+    (:data:`SO_FAR_FILE`) and judged again only when the kept policy or the episodes change."""
     if run.piece is not None:
         return None
+    folder = run.jobs[0].folder
+    state = store.checkpoint_state(folder)
+    if state is None or state.get("best") is None:
+        return None
+    episodes = check_episodes(run, options)
+    kept = [state["best"]["step"]]
+    cached = _read_json(folder / SO_FAR_FILE)
+    if cached is not None and cached.get("episodes") == episodes and cached.get("kept_steps") == kept:
+        return cached
     import torch
 
     from pianobot.agent.policy import make_agent
     from pianobot.learn.train import best_policy_tensors
 
     torch.set_num_threads(1)
-    found = store.load_checkpoint(run.jobs[0].folder)
+    found = store.load_checkpoint(folder)
     if found is None or found[1].get("best") is None:
         return None
     tensors = best_policy_tensors(found[0])
@@ -654,8 +666,10 @@ def best_so_far(run: Run, options: Options) -> dict | None:
         agent.load_tensors(tensors, with_training_state=False)
         return agent
 
-    figures = play_instances(factory, run.task, run.config.env, check_episodes(run, options), CHECK_SEED)
-    return {**figures, "kept_steps": [found[1]["best"]["step"]], "so_far": True}
+    figures = play_instances(factory, run.task, run.config.env, episodes, CHECK_SEED)
+    figures = {**figures, "kept_steps": [found[1]["best"]["step"]], "so_far": True}
+    atomic_write(folder / SO_FAR_FILE, json.dumps(figures) + "\n")
+    return figures
 
 
 def _read_json(path: Path) -> dict | None:

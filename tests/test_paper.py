@@ -220,7 +220,7 @@ def test_cpu_hours_are_estimated_from_the_measured_training_speed(tmp_path):
     assert policies == 18 and hours == pytest.approx(18 * paper.run_minutes(100_000, 15_000) / 60)
 
 
-def test_stop_at_time_boxes_every_run_at_a_checkpoint_and_the_full_command_goes_on(tmp_path, capsys):
+def test_stop_at_time_boxes_every_run_at_a_checkpoint_and_the_full_command_goes_on(tmp_path, capsys, monkeypatch):
     args = [*TINY, "--store", str(tmp_path), "--plots", str(tmp_path / "plots"), "--variants", "linear"]
     with pytest.raises(SystemExit):  # between checkpoints the steps after the last one would be lost
         paper.parse(["rewards", *args, "--stop-at", "250"])
@@ -234,6 +234,12 @@ def test_stop_at_time_boxes_every_run_at_a_checkpoint_and_the_full_command_goes_
     stopped = store.checkpoint_state(folder)["step"]
     assert 200 <= stopped < 300 and not store.is_trained(folder)
     assert "stopped at step" in capsys.readouterr().out
+
+    played, real = [], paper.play_instances  # --report --check judges the best so far once, then reads it back
+    monkeypatch.setattr(paper, "play_instances", lambda *a: played.append(a[3]) or real(*a))
+    judged = paper.best_so_far(run, opts)
+    assert judged["so_far"] and paper.best_so_far(run, opts) == judged and played == [1]
+    assert paper.best_so_far(run, replace(opts, check_episodes=2))["episodes"] == 2 and played == [1, 2]
 
     paper.main(["rewards", *args, "--stop-at", "200"])  # already there: nothing is trained again
     assert "already past --stop-at 200" in capsys.readouterr().out
