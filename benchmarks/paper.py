@@ -776,6 +776,18 @@ def table(experiment: Experiment, found: list[Progress], baselines: dict | None 
     return "\n".join(lines)
 
 
+def by_seed(found: list[Progress]) -> str:
+    """Each row's judged note F1 seed by seed (the figures behind the table's mean ± std)."""
+    groups: dict[tuple, list[Progress]] = {}
+    for p in found:
+        if p.figures is not None:
+            groups.setdefault(p.run.group, []).append(p)
+    return "\n".join(
+        f"- {' '.join(group)}: " + ", ".join(f"seed {p.run.seed} {p.figures['f1']:.3f}" for p in members)
+        for group, members in groups.items()
+    )
+
+
 def report(experiment: Experiment, runs: list[Run], options: Options, plots: Path | None, check: bool) -> str:
     """The tables (and plot) of an experiment from its runs so far; trains nothing."""
     found = [progress(run, options, check) for run in runs]
@@ -791,6 +803,9 @@ def report(experiment: Experiment, runs: list[Run], options: Options, plots: Pat
         f"{'hand starts of the piece' if experiment.name == 'compose' else 'fresh task instances'}; "
         "mean ± standard deviation over seeds\n\n" + table(experiment, found, baselines)
     )
+    seeds = by_seed(found)
+    if seeds:
+        text += "\n\nnote F1 by seed:\n" + seeds
     hours, policies = training_hours(runs)
     text += (
         f"\n\ntraining so far: {hours:.1f} CPU-hours, {policies} polic{'y' if policies == 1 else 'ies'} (each on one core; "

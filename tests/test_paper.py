@@ -186,6 +186,8 @@ def test_report_tables_a_finished_run_with_mean_and_std(tiny, capsys):
     cells = [c.strip() for c in row.strip("|").split("|")]
     assert cells[3] == "1 / 1 / 1 / 1" and cells[4] == "300"
     assert " ± 0.00" in cells[5] and " ± 0.000" in cells[6]  # linear return and note F1, one seed
+    f1 = cells[6].split(" ± ")[0]
+    assert f"- paper three-note squared: seed 0 {f1}" in printed  # the seed behind the mean
     assert "| paper | three-note | linear | 0 / 0 / 0 / 1 |" in printed  # not started
     hours = store.read_manifest(run.jobs[0].folder)["seconds"] / 3600
     assert f"training so far: {hours:.1f} CPU-hours, 1 policy" in printed  # the squared run only
