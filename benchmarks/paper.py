@@ -98,8 +98,9 @@ episode, whatever reward the policy trained with (paper, Table I: "evaluated wit
 reward"): no fingering gate (fingering accuracy is reported on its own) and no closeness bonus."""
 EVAL_FILE = "paper-eval.json"
 """A task run's evaluation, beside its policy."""
-SO_FAR_FILE = "paper-eval-so-far.json"
-"""An unfinished task run's best policy so far, judged (``--report --check``), beside its checkpoint."""
+SO_FAR_DIR = "so-far"
+"""Where ``--report --check`` keeps its judgements of unfinished runs' best policies so far
+(one file per model folder, under ``--store``)."""
 BASELINES = ("scripted", "idle", "random")
 """The controllers that play beside the trained arms: the scripted pianist, a hand that holds
 still (``idle``, :class:`~pianobot.perform.controllers.IdleController`: what a policy that
@@ -637,18 +638,19 @@ def baseline_figures(controller: str, task: str, seed: int, options: Options) ->
 
 def best_so_far(run: Run, options: Options) -> dict | None:
     """An unfinished task run's best policy so far (from its checkpoint), judged as a finished
-    one is; None when it has none yet. The figures are kept beside the checkpoint
-    (:data:`SO_FAR_FILE`) and judged again only when the kept policy or the episodes change."""
+    one is; None when it has none yet. The figures are kept under ``store/so-far/`` (outside
+    the model folder, which its training process owns) and judged again only when the kept
+    policy (its whole evaluation record) or how it is judged changes."""
     if run.piece is not None:
         return None
     folder = run.jobs[0].folder
     state = store.checkpoint_state(folder)
     if state is None or state.get("best") is None:
         return None
-    episodes = check_episodes(run, options)
-    kept = [state["best"]["step"]]
-    cached = _read_json(folder / SO_FAR_FILE)
-    if cached is not None and cached.get("episodes") == episodes and cached.get("kept_steps") == kept:
+    judging = {"episodes": check_episodes(run, options), "first_seed": CHECK_SEED, "reward": to_dict(EVAL_REWARD)}
+    path = options.store / SO_FAR_DIR / f"{folder.name}.json"
+    cached = _read_json(path)
+    if cached is not None and cached.get("best") == state["best"] and cached.get("judging") == judging:
         return cached
     import torch
 
@@ -659,16 +661,17 @@ def best_so_far(run: Run, options: Options) -> dict | None:
     found = store.load_checkpoint(folder)
     if found is None or found[1].get("best") is None:
         return None
-    tensors = best_policy_tensors(found[0])
+    tensors, best = best_policy_tensors(found[0]), found[1]["best"]
 
     def factory(env):
         agent = make_agent(env, run.config.sac)
         agent.load_tensors(tensors, with_training_state=False)
         return agent
 
-    figures = play_instances(factory, run.task, run.config.env, episodes, CHECK_SEED)
-    figures = {**figures, "kept_steps": [found[1]["best"]["step"]], "so_far": True}
-    atomic_write(folder / SO_FAR_FILE, json.dumps(figures) + "\n")
+    figures = play_instances(factory, run.task, run.config.env, judging["episodes"], CHECK_SEED)
+    figures = {**figures, "kept_steps": [best["step"]], "so_far": True, "best": best, "judging": judging}
+    path.parent.mkdir(parents=True, exist_ok=True)
+    atomic_write(path, json.dumps(figures) + "\n")
     return figures
 
 
@@ -783,9 +786,13 @@ def by_seed(found: list[Progress]) -> str:
         if p.figures is not None:
             groups.setdefault(p.run.group, []).append(p)
     return "\n".join(
-        f"- {' '.join(group)}: " + ", ".join(f"seed {p.run.seed} {p.figures['f1']:.3f}" for p in members)
+        f"- {' '.join(group)}: " + ", ".join(f"seed {p.run.seed} {p.figures['f1']:.3f}{_so_far(p)}" for p in members)
         for group, members in groups.items()
     )
+
+
+def _so_far(p: Progress) -> str:
+    return f" (so far: best at {p.figures['kept_steps'][0]} steps)" if p.figures.get("so_far") else ""
 
 
 def report(experiment: Experiment, runs: list[Run], options: Options, plots: Path | None, check: bool) -> str:

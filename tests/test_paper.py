@@ -4,6 +4,7 @@ tables mean ± std, and every policy is judged with the linear reward. One tiny 
 
 from __future__ import annotations
 
+import json
 import sys
 from dataclasses import replace
 from pathlib import Path
@@ -164,6 +165,7 @@ def test_a_run_resumes_rather_than_restarts_when_rerun(tiny, capsys):
     paper.main(["rewards", *args, "--report", "--check"])  # an unfinished run is reported, its best policy judged
     printed = capsys.readouterr().out
     assert f"(at {cut_at} steps)" in printed and "| paper | three-note | squared | 1 / 0 / 1 / 1 |" in printed
+    assert "- paper three-note squared: seed 0 " in printed and "(so far: best at " in printed  # provisional
 
     paper.main(["rewards", *args])
     printed = capsys.readouterr().out
@@ -242,6 +244,12 @@ def test_stop_at_time_boxes_every_run_at_a_checkpoint_and_the_full_command_goes_
     judged = paper.best_so_far(run, opts)
     assert judged["so_far"] and paper.best_so_far(run, opts) == judged and played == [1]
     assert paper.best_so_far(run, replace(opts, check_episodes=2))["episodes"] == 2 and played == [1, 2]
+    cached = tmp_path / paper.SO_FAR_DIR / f"{folder.name}.json"
+    assert not list(folder.glob("*.json*"))  # nothing written into the folder its training owns
+    stale = json.loads(cached.read_text())  # a folder trained afresh: its best falls on the same step
+    stale["best"] = {**stale["best"], "f1": stale["best"]["f1"] + 0.5}
+    cached.write_text(json.dumps(stale))
+    assert paper.best_so_far(run, replace(opts, check_episodes=2))["best"] != stale["best"] and played == [1, 2, 2]
 
     paper.main(["rewards", *args, "--stop-at", "200"])  # already there: nothing is trained again
     assert "already past --stop-at 200" in capsys.readouterr().out
