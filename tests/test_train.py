@@ -494,6 +494,32 @@ def test_a_kill_at_any_point_of_a_checkpoint_write_loses_at_most_one_interval(tm
     assert _log_without_time(tmp_path / "killed") == _log_without_time(tmp_path / "straight")  # as one run
 
 
+class _Buffer:
+    def save(self, path):
+        path.mkdir()
+
+
+def test_a_checkpoint_read_beside_a_running_training_is_one_whole_checkpoint(tmp_path, monkeypatch):
+    """A report reads the checkpoint of a run that is still training: when the training replaces
+    the newest checkpoint between the listing and the read, the reader takes the new one whole
+    (its state with its own tensors), and only a checkpoint still in place that is broken is
+    reported unreadable."""
+    folder = tmp_path / "m"
+    store.save_checkpoint(folder, {"w": torch.zeros(1)}, {"step": 10}, _Buffer())
+    stale = store._checkpoints(folder)
+    store.save_checkpoint(folder, {"w": torch.ones(1)}, {"step": 20}, _Buffer())  # (removes step 10)
+    listings = [stale]
+    real = store._checkpoints
+    monkeypatch.setattr(store, "_checkpoints", lambda f: listings.pop() if listings else real(f))
+    tensors, state, buffer = store.load_checkpoint(folder)
+    assert state["step"] == 20 and torch.equal(tensors["w"], torch.ones(1)) and buffer.parent.name == f"{20:010d}"
+    listings.append(stale)
+    assert store.checkpoint_state(folder)["step"] == 20
+    (real(folder)[-1] / "state.safetensors").write_bytes(b"broken")
+    with pytest.raises(PianobotError, match=r"checkpoint .*0000000020 is unreadable .*: delete it"):
+        store.load_checkpoint(folder)
+
+
 def test_a_due_evaluation_survives_an_interruption(tmp_path):
     """At step 70 an evaluation is due but waits for exploration to end (step 70 is not past
     it); a run interrupted there must still evaluate at the next episode end, as a straight run does."""

@@ -262,24 +262,43 @@ def save_checkpoint(folder: Path, tensors: dict[str, torch.Tensor], state: dict,
             shutil.rmtree(other, ignore_errors=True) if other.is_dir() else other.unlink(missing_ok=True)
 
 
+def _read_newest(folder: Path, read):
+    """``(newest checkpoint, read(it))``, or None when there is none. Each checkpoint is read
+    from the one listing that found it, so its parts always belong together; a checkpoint that a
+    running training replaced while it was being read (its folder is gone) is read again from a
+    fresh listing, and only one still in place but missing or broken is reported unreadable."""
+    for _ in range(5):
+        found = _checkpoints(folder)
+        if not found:
+            return None
+        newest = found[-1]
+        try:
+            return newest, read(newest)
+        except (OSError, ValueError, SafetensorError) as e:
+            if newest.is_dir():
+                raise PianobotError(f"checkpoint {newest} is unreadable ({e}): delete it to start afresh") from None
+    raise PianobotError(f"the checkpoints in {folder} kept changing while being read: try again")
+
+
 def checkpoint_state(folder: Path) -> dict | None:
     """The counters of the newest checkpoint (step, evaluations, ...), or None: cheap, reads no tensors."""
-    found = _checkpoints(folder)
-    if not found:
-        return None
-    try:
-        return json.loads((found[-1] / "state.json").read_text())
-    except (OSError, json.JSONDecodeError) as e:
-        raise PianobotError(f"checkpoint {found[-1]} is unreadable ({e}): delete it to start afresh") from None
+    found = _read_newest(folder, lambda newest: json.loads((newest / "state.json").read_text()))
+    return None if found is None else found[1]
 
 
 def load_checkpoint(folder: Path) -> tuple[dict[str, torch.Tensor], dict, Path] | None:
     """(tensors, state, buffer folder) of the newest complete checkpoint, or None."""
-    state = checkpoint_state(folder)
-    if state is None:
+
+    from safetensors.torch import load_file
+
+    def read(newest: Path):
+        return json.loads((newest / "state.json").read_text()), load_file(newest / "state.safetensors")
+
+    found = _read_newest(folder, read)
+    if found is None:
         return None
-    newest = _checkpoints(folder)[-1]
-    return load_tensors(newest / "state.safetensors"), state, newest / "buffer"
+    newest, (state, tensors) = found
+    return tensors, state, newest / "buffer"
 
 
 def drop_checkpoint(folder: Path) -> None:
