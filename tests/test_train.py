@@ -501,13 +501,14 @@ class _Buffer:
 
 def test_a_checkpoint_read_beside_a_running_training_is_one_whole_checkpoint(tmp_path, monkeypatch):
     """A report reads the checkpoint of a run that is still training: when the training replaces
-    the newest checkpoint between the listing and the read, the reader takes the new one whole
-    (its state with its own tensors), and only a checkpoint still in place that is broken is
-    reported unreadable."""
+    the newest checkpoint between the listing and the read (its files going one by one), the
+    reader takes the new one whole (its state with its own tensors), and only a newest
+    checkpoint that stays broken is reported unreadable."""
     folder = tmp_path / "m"
     store.save_checkpoint(folder, {"w": torch.zeros(1)}, {"step": 10}, _Buffer())
     stale = store._checkpoints(folder)
     store.save_checkpoint(folder, {"w": torch.ones(1)}, {"step": 20}, _Buffer())  # (removes step 10)
+    (stale[0] / "buffer").mkdir(parents=True)  # step 10 half removed: its folder is still there
     listings = [stale]
     real = store._checkpoints
     monkeypatch.setattr(store, "_checkpoints", lambda f: listings.pop() if listings else real(f))

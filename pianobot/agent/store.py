@@ -23,6 +23,7 @@ import hashlib
 import json
 import os
 import shutil
+import time
 from datetime import datetime, timezone
 from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
@@ -264,9 +265,11 @@ def save_checkpoint(folder: Path, tensors: dict[str, torch.Tensor], state: dict,
 
 def _read_newest(folder: Path, read):
     """``(newest checkpoint, read(it))``, or None when there is none. Each checkpoint is read
-    from the one listing that found it, so its parts always belong together; a checkpoint that a
-    running training replaced while it was being read (its folder is gone) is read again from a
-    fresh listing, and only one still in place but missing or broken is reported unreadable."""
+    from the one listing that found it, so its parts always belong together. A running training
+    replaces its checkpoint (and removes it when it finishes) while a report may be reading it, a
+    few milliseconds of files going one by one: a read that fails is tried again from a fresh
+    listing a moment later, and only a newest checkpoint that fails twice is reported unreadable."""
+    failed = None
     for _ in range(5):
         found = _checkpoints(folder)
         if not found:
@@ -275,8 +278,10 @@ def _read_newest(folder: Path, read):
         try:
             return newest, read(newest)
         except (OSError, ValueError, SafetensorError) as e:
-            if newest.is_dir():
+            if newest == failed:
                 raise PianobotError(f"checkpoint {newest} is unreadable ({e}): delete it to start afresh") from None
+            failed = newest
+            time.sleep(0.2)
     raise PianobotError(f"the checkpoints in {folder} kept changing while being read: try again")
 
 
