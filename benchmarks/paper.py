@@ -1,4 +1,5 @@
-"""The paper's seven experiments (issue 21), each in two settings: the paper's recipe and ours.
+"""The paper's seven experiments (issue 21), each in two settings: the paper's recipe and ours;
+and an eighth, which takes pianobot's additions away from its own setting one at a time.
 
     python benchmarks/paper.py EXPERIMENT [--setting paper|ours|both] [--seeds 3] [--steps N] [--workers 2]
     python benchmarks/paper.py EXPERIMENT --list       # the runs, how they differ, the CPU-hours they need
@@ -17,6 +18,8 @@ EXPERIMENT is a number or a name:
 6 ``fingering``     with and without the fingering gate (figure "Qualitative results ... fingering indicators")
 7 ``compose``       compositional execution against one end-to-end policy, pieces of growing length,
                     the same total steps (figure "Comparison between compositional execution ...")
+8 ``additions``     not the paper's: pianobot's setting with one of its additions taken away at a
+                    time (the teacher, the closeness bonus, the finger targets, its hyperparameters)
 
 Settings: ``paper`` is the paper's recipe: plain SAC (no teacher), prior exploration, the linear
 reward without our closeness bonus, the score window as observation (no finger targets), the
@@ -318,6 +321,40 @@ EXPERIMENTS = {
             (Variant("compositional", _same, "compositional"), Variant("end-to-end", _same, "end-to-end RL")),
             PHRASE_STEPS,
             "not stated; per phrase",
+        ),
+        Experiment(
+            8,
+            "additions",
+            "What pianobot's additions change",
+            (ABLATION_TASK,),
+            (
+                Variant("ours", _same, "", ("ours",)),
+                Variant("no-teacher", lambda c: replace(c, explore="prior"), "", ("ours",)),
+                Variant("no-closeness", lambda c: with_reward(c, closeness_weight=0.0), "", ("ours",)),
+                Variant(
+                    "score-window",
+                    lambda c: replace(with_env(c, target_observations=False), sac=replace(c.sac, score_input=True)),
+                    "",
+                    ("ours",),
+                ),
+                Variant(
+                    "paper-hyperparameters",
+                    lambda c: replace(
+                        c,
+                        sac=replace(
+                            c.sac,
+                            learning_rate=PAPER_LEARNING_RATE,
+                            discount=SAC_DISCOUNT,
+                            target_entropy_scale=SAC_TARGET_ENTROPY_SCALE,
+                        ),
+                    ),
+                    "",
+                    ("ours",),
+                ),
+            ),
+            ABLATION_STEPS,
+            "experiments 3-6's",
+            baselines=BASELINES,
         ),
     )
 }
@@ -1002,7 +1039,7 @@ def estimate(runs: list[Run]) -> tuple[float, int]:
 def parse(argv: list[str] | None = None) -> tuple[argparse.Namespace, Options]:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument(
-        "experiment", help="1-7 or tasks, rhythm-chord, rewards, exploration, control, fingering, compose"
+        "experiment", help="1-8 or tasks, rhythm-chord, rewards, exploration, control, fingering, compose, additions"
     )
     parser.add_argument("--setting", choices=(*SETTINGS, "both"), default="both")
     parser.add_argument("--seeds", type=int, default=Options.seeds, help="seeds 0 .. N-1 (the paper used 5)")

@@ -122,6 +122,34 @@ def test_equal_configurations_share_one_folder_across_experiments(tmp_path):
     assert len(set(folders)) == 1
 
 
+def test_the_additions_experiment_takes_away_one_of_ours_at_a_time(tmp_path):
+    """Experiment 8 is pianobot's setting only; each arm differs from it in one addition, and its
+    full arm and its arm without the teacher are the runs experiments 3 and 4 already train."""
+    runs = paper.expand("additions", options(tmp_path, seeds=1))
+    assert {r.setting for r in runs} == {"ours"} and {r.task for r in runs} == {"three-note"}
+    arms = {r.variant: r for r in runs}
+    removed = {
+        "ours": set(),
+        "no-teacher": {"explore"},
+        "no-closeness": {"env.reward.closeness_weight"},
+        "score-window": {"env.target_observations", "sac.score_input"},
+        "paper-hyperparameters": {"sac.learning_rate", "sac.discount", "sac.target_entropy_scale"},
+    }
+    assert arms.keys() == removed.keys()
+    for name, changed in removed.items():
+        assert set(paper.differences(arms[name].config, arms["ours"].config)) == changed, name
+    paper_setting = paper.setting_config("paper", options(tmp_path), 0, paper.ABLATION_STEPS, 20)
+    for name in ("no-closeness", "score-window", "paper-hyperparameters"):  # each takes the paper's value
+        assert not removed[name] & paper.differences(arms[name].config, paper_setting).keys(), name
+    same_as = {"ours": ("rewards", "linear"), "no-teacher": ("exploration", "prior")}
+    for name, (experiment, arm) in same_as.items():
+        other = next(
+            r for r in paper.expand(experiment, options(tmp_path, seeds=1, settings=("ours",))) if r.variant == arm
+        )
+        assert other.jobs[0].folder == arms[name].jobs[0].folder
+    assert paper.expand("additions", options(tmp_path, seeds=1, settings=("paper",))) == []
+
+
 def test_compose_trains_growing_pieces_end_to_end_with_the_same_total_steps(tmp_path):
     runs = paper.expand("compose", options(tmp_path, steps=20_000))
     assert len(runs) == 2 * 2 * len(paper.Options.lengths) * 2
