@@ -37,7 +37,9 @@ note F1, velocity error and fingering accuracy, on ``--check-episodes`` task ins
 never evaluated on (a piece from as many hand starts, for ``compose``). ``--report`` prints
 Markdown tables (mean ± standard deviation over seeds) and draws return and note F1 against
 environment steps (the training evaluations, in the reward each run trained with) into
-``--plots`` (docs/paper/), from finished and unfinished runs alike.
+``--plots`` (docs/paper/), from finished and unfinished runs alike. Beside each plot it keeps the
+records of every run it has seen (``N-name.json``), and tables those of them the store lacks (a
+fresh clone, another machine) from there.
 """
 
 from __future__ import annotations
@@ -740,15 +742,21 @@ class Progress:
     """Each policy's training evaluations (step, f1, return in the training reward)."""
     figures: dict | None = None
     """The linear-reward evaluation (finished runs; unfinished ones with --check)."""
+    seconds: dict[str, float] = field(default_factory=dict)
+    """Each policy's training time so far, by its model folder (relative to the store)."""
+    recorded: bool = False
+    """Read from the experiment's records (:func:`records_path`), not from the store."""
 
 
 def progress(run: Run, options: Options, check: bool = False) -> Progress:
-    curves, steps, started, finished = [], 0, False, True
+    curves, steps, seconds, started, finished = [], 0, {}, False, True
     for job in run.jobs:
+        name = job.folder.relative_to(options.store).as_posix()
         if store.is_trained(job.folder):
             manifest = store.read_manifest(job.folder)
             curves.append(manifest["evaluations"])
             steps += manifest["steps"]
+            seconds[name] = manifest["seconds"]
             started = True
             continue
         finished = False
@@ -756,13 +764,75 @@ def progress(run: Run, options: Options, check: bool = False) -> Progress:
         if state is not None:
             curves.append(state["evaluations"])
             steps += state["step"]
+            seconds[name] = state.get("seconds", 0.0)
             started = True
     if finished:  # judged now if the training command was cut off before it judged the run
         figures = _read_json(run.result) if _evaluated(run, options) else evaluate_run(run, options)
-        return Progress(run, "finished", steps, curves, figures)
+        return Progress(run, "finished", steps, curves, figures, seconds)
     if not started:
         return Progress(run, "not started")
-    return Progress(run, f"at {_steps(steps)} steps", steps, curves, best_so_far(run, options) if check else None)
+    figures = best_so_far(run, options) if check else None
+    return Progress(run, f"at {_steps(steps)} steps", steps, curves, figures, seconds)
+
+
+# -- records: what the report saw, kept beside its plot -------------------------------------------
+def records_path(experiment: Experiment, plots: Path) -> Path:
+    """``N-name.json`` beside the plot: every run the experiment's reports have seen (its state,
+    steps, training time, training evaluations and judged figures), so that a report on another
+    machine, or after the store is gone, still tables and plots them. Checkpoints and policies
+    stay in the store: a recorded run can be reported, not resumed or judged again."""
+    return plots / f"{experiment.number}-{experiment.name}.json"
+
+
+def record_key(run: Run, options: Options) -> str:
+    """A run's name in the records: where its evaluation goes, relative to the store (the model
+    folder's name holds the configuration's hash, so a changed configuration is another run)."""
+    return run.result.relative_to(options.store).as_posix()
+
+
+def read_records(path: Path) -> dict[str, dict]:
+    found = _read_json(path)
+    return found.get("runs", {}) if found else {}
+
+
+def with_records(found: list[Progress], records: dict[str, dict], options: Options) -> list[Progress]:
+    """Each run as far as the store or the records have it, whichever is further along
+    (finished, then more steps, then judged); a recorded judgement counts only if it was judged
+    as this report judges (the same number of episodes)."""
+
+    def rank(p: Progress) -> tuple:
+        return p.state == "finished", p.steps, p.figures is not None
+
+    out = []
+    for p in found:
+        kept = records.get(record_key(p.run, options))
+        if kept is not None:
+            figures = kept["figures"]
+            if figures is not None and figures.get("episodes") != check_episodes(p.run, options):
+                figures = None
+            mine = Progress(p.run, kept["state"], kept["steps"], kept["curves"], figures, kept["seconds"], True)
+            if rank(mine) > rank(p):
+                p = mine
+        out.append(p)
+    return out
+
+
+def write_records(path: Path, records: dict[str, dict], found: list[Progress], options: Options) -> None:
+    """The records updated with every run this report read from the store (the others kept)."""
+    for p in found:
+        if not p.recorded and p.state != "not started":
+            records[record_key(p.run, options)] = {
+                "label": p.run.label,
+                "state": p.state,
+                "steps": p.steps,
+                "seconds": p.seconds,
+                "curves": p.curves,
+                "figures": p.figures,
+            }
+    if not records:
+        return
+    path.parent.mkdir(parents=True, exist_ok=True)
+    atomic_write(path, json.dumps({"runs": records}, indent=1, sort_keys=True) + "\n")
 
 
 def mean_std(values: list[float], digits: int = 2) -> str:
@@ -833,8 +903,13 @@ def _so_far(p: Progress) -> str:
 
 
 def report(experiment: Experiment, runs: list[Run], options: Options, plots: Path | None, check: bool) -> str:
-    """The tables (and plot) of an experiment from its runs so far; trains nothing."""
+    """The tables (and plot) of an experiment from its runs so far, in the store or in the
+    records beside the plot (which it then updates); trains nothing."""
     found = [progress(run, options, check) for run in runs]
+    if plots is not None:
+        records = read_records(records_path(experiment, plots))
+        found = with_records(found, records, options)
+        write_records(records_path(experiment, plots), records, found, options)
     baselines = {}
     for task in options.tasks or experiment.tasks:
         for controller in experiment.baselines:
@@ -850,11 +925,17 @@ def report(experiment: Experiment, runs: list[Run], options: Options, plots: Pat
     seeds = by_seed(found)
     if seeds:
         text += "\n\nnote F1 by seed:\n" + seeds
-    hours, policies = training_hours(runs)
+    hours, policies = training_hours(found)
     text += (
         f"\n\ntraining so far: {hours:.1f} CPU-hours, {policies} polic{'y' if policies == 1 else 'ies'} (each on one core; "
         "a policy that several experiments share counts in each)"
     )
+    recorded = [p for p in found if p.recorded]
+    if recorded:
+        text += (
+            f"\n\nfrom the records ({records_path(experiment, plots)}), not in the store "
+            f"{options.store}: {len(recorded)} run{'s' if len(recorded) > 1 else ''}"
+        )
     unfinished = [p for p in found if p.state.startswith("at ")]
     if unfinished:
         text += "\n\nunfinished: " + ", ".join(f"{p.run.label} ({p.state})" for p in unfinished)
@@ -865,16 +946,12 @@ def report(experiment: Experiment, runs: list[Run], options: Options, plots: Pat
     return text
 
 
-def training_hours(runs: list[Run]) -> tuple[float, int]:
+def training_hours(found: list[Progress]) -> tuple[float, int]:
     """The training time so far of the runs' distinct policies, in hours (the manifests' seconds,
     or the newest checkpoint's for an unfinished policy), and how many have begun."""
-    seconds: dict[Path, float] = {}
-    for run in runs:
-        for job in run.jobs:
-            if store.is_trained(job.folder):
-                seconds[job.folder] = store.read_manifest(job.folder)["seconds"]
-            elif (state := store.checkpoint_state(job.folder)) is not None:
-                seconds[job.folder] = state.get("seconds", 0.0)
+    seconds: dict[str, float] = {}
+    for p in found:
+        seconds.update(p.seconds)
     return sum(seconds.values()) / 3600, len(seconds)
 
 
@@ -1066,7 +1143,12 @@ def parse(argv: list[str] | None = None) -> tuple[argparse.Namespace, Options]:
     )
     parser.add_argument("--workers", type=int, default=1, help="runs in parallel, one torch thread each")
     parser.add_argument("--store", type=Path, default=Options.store)
-    parser.add_argument("--plots", type=Path, default=ROOT / "docs" / "paper")
+    parser.add_argument(
+        "--plots",
+        type=Path,
+        default=ROOT / "docs" / "paper",
+        help="where --report draws N-name.png and keeps N-name.json, the records of every run it has seen",
+    )
     parser.add_argument("--report", action="store_true", help="train nothing: tables and plots of the runs so far")
     parser.add_argument(
         "--check", action="store_true", help="with --report: judge unfinished runs' best policies so far"

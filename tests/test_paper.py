@@ -224,6 +224,38 @@ def test_report_tables_a_finished_run_with_mean_and_std(tiny, capsys):
     assert (root / "plots" / "3-rewards.png").stat().st_size > 0
 
 
+def test_a_report_keeps_records_beside_its_plot_and_tables_them_without_the_store(tiny, capsys, tmp_path):
+    root, args, opts, run = tiny
+    if not store.is_trained(run.jobs[0].folder):
+        paper.main(["rewards", *args])
+    key, path = paper.record_key(run, opts), root / "plots" / "3-rewards.json"
+    paper.main(["rewards", *args, "--report"])
+    with_store = capsys.readouterr().out
+    records = json.loads(path.read_text())["runs"]
+    assert list(records) == [key] and records[key]["state"] == "finished" and records[key]["figures"]["episodes"] == 1
+
+    def hours(printed: str) -> str:
+        return next(line for line in printed.splitlines() if line.startswith("training so far: "))
+
+    elsewhere = [*args, "--store", str(tmp_path / "empty")]  # a fresh clone: no store, the records only
+    paper.main(["rewards", *elsewhere, "--report"])
+    without = capsys.readouterr().out
+    row = next(line for line in without.splitlines() if line.startswith("| paper | three-note | squared |"))
+    assert row in with_store and "1 / 1 / 1 / 1" in row  # the same figures
+    assert hours(without) == hours(with_store) and "1 policy" in hours(without)
+    assert "not in the store" in without and "not in the store" not in with_store
+    assert json.loads(path.read_text())["runs"] == records  # kept, not emptied
+
+    stale = {**records[key], "state": "at 100 steps", "steps": 100, "figures": None}
+    path.write_text(json.dumps({"runs": {key: stale}}))
+    paper.main(["rewards", *args, "--report"])  # the store is further along than the record: it wins
+    assert "| paper | three-note | squared | 1 / 1 / 1 / 1 |" in capsys.readouterr().out
+    assert json.loads(path.read_text())["runs"] == records
+
+    paper.main(["rewards", *elsewhere, "--report", "--check-episodes", "2"])  # judged otherwise: no judgement
+    assert "| paper | three-note | squared | 0 / 1 / 1 / 1 |" in capsys.readouterr().out
+
+
 def test_a_policy_trained_with_the_squared_reward_is_judged_with_the_linear_one(tiny, monkeypatch):
     root, args, opts, run = tiny
     folder = run.jobs[0].folder
