@@ -72,7 +72,7 @@ from pianobot.learn.config import TrainConfig  # noqa: E402
 from pianobot.learn.jobs import PhraseJob, phrase_jobs, task_job  # noqa: E402
 from pianobot.learn.train import TASK_EVAL_EPISODES  # noqa: E402
 from pianobot.music.load import LoadOptions, load_piece  # noqa: E402
-from pianobot.music.phrases import DEFAULT_MAX_NOTES, split_phrases  # noqa: E402
+from pianobot.music.phrases import DEFAULT_MAX_NOTES, phrase_hash, split_phrases  # noqa: E402
 from pianobot.music.piece import Piece  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -463,11 +463,12 @@ def _compose_runs(experiment: Experiment, options: Options) -> list[Run]:
                 parts = tuple(phrase_jobs(split_phrases(piece), config, root, piece=about))
                 whole = replace(config, steps=steps * len(parts))  # the same total steps
                 single = tuple(phrase_jobs(split_phrases(piece, len(piece)), whole, root, piece=about))
+                notes = phrase_hash(piece.notes)  # another piece or tempo: another result
                 arms = (
                     Run(experiment.name, setting, task, "compositional", seed, config, parts,
-                        root / f"compositional-{length}.json", piece),
+                        root / f"compositional-{length}-{notes}.json", piece),
                     Run(experiment.name, setting, task, "end-to-end", seed, whole, single,
-                        root / f"end-to-end-{length}.json", piece, len(piece)),
+                        root / f"end-to-end-{length}-{notes}.json", piece, len(piece)),
                 )  # fmt: skip
                 runs += [run for run in arms if options.variants is None or run.variant in options.variants]
     return runs
@@ -785,8 +786,9 @@ def records_path(experiment: Experiment, plots: Path) -> Path:
 
 
 def record_key(run: Run, options: Options) -> str:
-    """A run's name in the records: where its evaluation goes, relative to the store (the model
-    folder's name holds the configuration's hash, so a changed configuration is another run)."""
+    """A run's name in the records: where its evaluation goes, relative to the store (the name
+    holds the configuration's hash, and for ``compose`` the piece's, so another configuration or
+    piece is another run)."""
     return run.result.relative_to(options.store).as_posix()
 
 
@@ -795,40 +797,50 @@ def read_records(path: Path) -> dict[str, dict]:
     return found.get("runs", {}) if found else {}
 
 
-def with_records(found: list[Progress], records: dict[str, dict], options: Options) -> list[Progress]:
-    """Each run as far as the store or the records have it, whichever is further along
-    (finished, then more steps, then judged); a recorded judgement counts only if it was judged
-    as this report judges (the same number of episodes)."""
+def _rank(state: str, steps: int, figures: dict | None) -> tuple:
+    """How far along a run is: finished first, then more steps, then judged on more episodes."""
+    return state == "finished", steps, (figures or {}).get("episodes", 0)
 
-    def rank(p: Progress) -> tuple:
-        return p.state == "finished", p.steps, p.figures is not None
 
+def with_records(found: list[Progress], records: dict[str, dict], options: Options, check: bool) -> list[Progress]:
+    """The runs the store lacks, as the records have them (the store's own are its). A recorded
+    judgement counts only if it was judged as this report judges (the same number of episodes)
+    and, for an unfinished run's best policy so far, only with ``--check``."""
     out = []
     for p in found:
         kept = records.get(record_key(p.run, options))
-        if kept is not None:
+        if p.state == "not started" and kept is not None:
             figures = kept["figures"]
-            if figures is not None and figures.get("episodes") != check_episodes(p.run, options):
+            if figures is not None and (
+                figures.get("episodes") != check_episodes(p.run, options) or (figures.get("so_far") and not check)
+            ):
                 figures = None
-            mine = Progress(p.run, kept["state"], kept["steps"], kept["curves"], figures, kept["seconds"], True)
-            if rank(mine) > rank(p):
-                p = mine
+            p = Progress(p.run, kept["state"], kept["steps"], kept["curves"], figures, kept["seconds"], recorded=True)
         out.append(p)
     return out
 
 
 def write_records(path: Path, records: dict[str, dict], found: list[Progress], options: Options) -> None:
-    """The records updated with every run this report read from the store (the others kept)."""
+    """The records updated with the runs this report read from the store, where the store has
+    the run at least as far along as the record (a run started afresh, or judged on fewer
+    episodes, does not replace what was recorded); the other records kept."""
     for p in found:
-        if not p.recorded and p.state != "not started":
-            records[record_key(p.run, options)] = {
-                "label": p.run.label,
-                "state": p.state,
-                "steps": p.steps,
-                "seconds": p.seconds,
-                "curves": p.curves,
-                "figures": p.figures,
-            }
+        if p.recorded or p.state == "not started":
+            continue
+        key = record_key(p.run, options)
+        kept = records.get(key)
+        if kept is not None and _rank(p.state, p.steps, p.figures) < _rank(
+            kept["state"], kept["steps"], kept["figures"]
+        ):
+            continue
+        records[key] = {
+            "label": p.run.label,
+            "state": p.state,
+            "steps": p.steps,
+            "seconds": p.seconds,
+            "curves": p.curves,
+            "figures": p.figures,
+        }
     if not records:
         return
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -908,7 +920,7 @@ def report(experiment: Experiment, runs: list[Run], options: Options, plots: Pat
     found = [progress(run, options, check) for run in runs]
     if plots is not None:
         records = read_records(records_path(experiment, plots))
-        found = with_records(found, records, options)
+        found = with_records(found, records, options, check)
         write_records(records_path(experiment, plots), records, found, options)
     baselines = {}
     for task in options.tasks or experiment.tasks:
@@ -951,7 +963,8 @@ def training_hours(found: list[Progress]) -> tuple[float, int]:
     or the newest checkpoint's for an unfinished policy), and how many have begun."""
     seconds: dict[str, float] = {}
     for p in found:
-        seconds.update(p.seconds)
+        for folder, spent in p.seconds.items():  # a policy two runs share counts once
+            seconds[folder] = max(spent, seconds.get(folder, 0.0))
     return sum(seconds.values()) / 3600, len(seconds)
 
 

@@ -168,6 +168,8 @@ def test_compose_trains_growing_pieces_end_to_end_with_the_same_total_steps(tmp_
                 notes.append(len(composed.piece))
             assert notes == sorted(notes) and len(set(notes)) == len(notes)  # growing pieces
             assert len({job.folder.parent for r in mine for job in r.jobs}) == 1  # shared phrases train once
+    faster = paper.expand("compose", options(tmp_path, steps=20_000, tempo=90.0))
+    assert not {r.result for r in faster} & {r.result for r in runs}  # another tempo: judged afresh
 
 
 @pytest.fixture(scope="module")
@@ -228,32 +230,46 @@ def test_a_report_keeps_records_beside_its_plot_and_tables_them_without_the_stor
     root, args, opts, run = tiny
     if not store.is_trained(run.jobs[0].folder):
         paper.main(["rewards", *args])
-    key, path = paper.record_key(run, opts), root / "plots" / "3-rewards.json"
+    key, path, png = paper.record_key(run, opts), root / "plots" / "3-rewards.json", root / "plots" / "3-rewards.png"
     paper.main(["rewards", *args, "--report"])
     with_store = capsys.readouterr().out
     records = json.loads(path.read_text())["runs"]
     assert list(records) == [key] and records[key]["state"] == "finished" and records[key]["figures"]["episodes"] == 1
 
-    def hours(printed: str) -> str:
-        return next(line for line in printed.splitlines() if line.startswith("training so far: "))
+    def line(printed: str, start: str) -> str:
+        return next(line for line in printed.splitlines() if line.startswith(start))
 
     elsewhere = [*args, "--store", str(tmp_path / "empty")]  # a fresh clone: no store, the records only
+    png.unlink()
     paper.main(["rewards", *elsewhere, "--report"])
     without = capsys.readouterr().out
-    row = next(line for line in without.splitlines() if line.startswith("| paper | three-note | squared |"))
-    assert row in with_store and "1 / 1 / 1 / 1" in row  # the same figures
-    assert hours(without) == hours(with_store) and "1 policy" in hours(without)
+    row = line(without, "| paper | three-note | squared |")
+    assert row == line(with_store, "| paper | three-note | squared |") and "1 / 1 / 1 / 1" in row  # the same figures
+    assert line(without, "training so far") == line(with_store, "training so far") and "1 policy" in line(
+        without, "training so far"
+    )
     assert "not in the store" in without and "not in the store" not in with_store
-    assert json.loads(path.read_text())["runs"] == records  # kept, not emptied
+    assert png.stat().st_size > 0  # drawn from the recorded curves
 
     stale = {**records[key], "state": "at 100 steps", "steps": 100, "figures": None}
     path.write_text(json.dumps({"runs": {key: stale}}))
-    paper.main(["rewards", *args, "--report"])  # the store is further along than the record: it wins
+    paper.main(["rewards", *args, "--report"])  # the store is further along than the record: it replaces it
     assert "| paper | three-note | squared | 1 / 1 / 1 / 1 |" in capsys.readouterr().out
     assert json.loads(path.read_text())["runs"] == records
 
-    paper.main(["rewards", *elsewhere, "--report", "--check-episodes", "2"])  # judged otherwise: no judgement
+    paper.main(["rewards", *args, "--report", "--check-episodes", "2"])  # judged on more episodes: recorded
+    paper.main(["rewards", *args, "--report"])  # on fewer: the store's, but the record keeps the better judgement
+    capsys.readouterr()
+    assert json.loads(path.read_text())["runs"][key]["figures"]["episodes"] == 2
+    paper.main(["rewards", *elsewhere, "--report"])  # judged otherwise than this report judges: no judgement
     assert "| paper | three-note | squared | 0 / 1 / 1 / 1 |" in capsys.readouterr().out
+
+    so_far = {**stale, "figures": {**records[key]["figures"], "so_far": True, "kept_steps": [100]}}
+    path.write_text(json.dumps({"runs": {key: so_far}}))  # an unfinished run's best policy so far
+    paper.main(["rewards", *elsewhere, "--report"])
+    assert "| paper | three-note | squared | 0 / 0 / 1 / 1 |" in capsys.readouterr().out  # only with --check
+    paper.main(["rewards", *elsewhere, "--report", "--check"])
+    assert "| paper | three-note | squared | 1 / 0 / 1 / 1 |" in capsys.readouterr().out
 
 
 def test_a_policy_trained_with_the_squared_reward_is_judged_with_the_linear_one(tiny, monkeypatch):
