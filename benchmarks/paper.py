@@ -792,9 +792,24 @@ def record_key(run: Run, options: Options) -> str:
     return run.result.relative_to(options.store).as_posix()
 
 
+RECORD_FIELDS = ("label", "state", "steps", "seconds", "curves", "figures")
+
+
 def read_records(path: Path) -> dict[str, dict]:
-    found = _read_json(path)
-    return found.get("runs", {}) if found else {}
+    """The records in ``path`` (none if it does not exist). A file that is there but cannot be
+    read stops the report, which would otherwise write the store's runs over it."""
+    if not path.exists():
+        return {}
+    try:
+        runs = json.loads(path.read_text())["runs"]
+        if not all(set(RECORD_FIELDS) <= record.keys() for record in runs.values()):
+            raise ValueError
+    except (OSError, ValueError, KeyError, TypeError, AttributeError):
+        raise PianobotError(
+            f"{path} is not a records file this report can read (a merge conflict?): "
+            "mend it from git, or move it away to start new records"
+        ) from None
+    return runs
 
 
 def _rank(state: str, steps: int, figures: dict | None) -> tuple:
@@ -1197,8 +1212,11 @@ def main(argv: list[str] | None = None) -> None:
     try:
         experiment = experiment_named(args.experiment)
         runs = expand(experiment.name, options)
+        if not args.list:  # before any training: its closing report writes them
+            read_records(records_path(experiment, args.plots))
     except (PianobotError, ValueError) as e:
-        raise SystemExit(f"error: {e}") from None
+        print(f"error: {e}", file=sys.stderr)
+        raise SystemExit(2) from None
     if args.list:
         print(listing(experiment, runs))
     elif args.report:

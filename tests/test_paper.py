@@ -271,6 +271,13 @@ def test_a_report_keeps_records_beside_its_plot_and_tables_them_without_the_stor
     paper.main(["rewards", *elsewhere, "--report", "--check"])
     assert "| paper | three-note | squared | 1 / 0 / 1 / 1 |" in capsys.readouterr().out
 
+    conflicted = "<<<<<<< HEAD\n" + path.read_text()  # a merge left half done: not overwritten, one line
+    path.write_text(conflicted)
+    with pytest.raises(SystemExit) as stopped:
+        paper.main(["rewards", *args])
+    assert stopped.value.code == 2 and path.read_text() == conflicted
+    assert capsys.readouterr().err.strip().startswith(f"error: {path} is not a records file")
+
 
 def test_a_policy_trained_with_the_squared_reward_is_judged_with_the_linear_one(tiny, monkeypatch):
     root, args, opts, run = tiny
