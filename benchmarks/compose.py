@@ -34,6 +34,7 @@ from pianobot.music.load import load_piece
 from pianobot.music.phrases import split_phrases
 from pianobot.perform.compose import CompositionalController
 from pianobot.perform.perform import perform
+from pianobot.perform.plan import assign
 
 PLAY_SEEDS = (0, 1, 2)
 
@@ -97,9 +98,7 @@ def main() -> None:
             )
         end_to_end_minutes = (time.perf_counter() - started) / 60
 
-        composed = play(
-            piece, lambda e, models=models: CompositionalController(e, phrases, models, fallback=False), env
-        )
+        composed = play(piece, lambda e, models=models: CompositionalController(e, assign(phrases, models)), env)
         single = play(
             piece, lambda e, folder=folder: load_policy(folder, e), env
         )  # the whole piece's window, as trained

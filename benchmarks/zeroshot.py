@@ -49,6 +49,7 @@ from pianobot.music.piece import Piece
 from pianobot.music.tasks import TASKS, make_task
 from pianobot.perform.compose import CompositionalController
 from pianobot.perform.perform import PLAY_CONFIG, perform
+from pianobot.perform.plan import assign
 from pianobot.pianist.fingering import ensure_fingering
 
 EXAMPLES = ("c-major-scale", "mary", "ode-to-joy", "twinkle", "one-note", "three-note", "six-note", "rhythmic", "chord")
@@ -82,7 +83,9 @@ def play_both(piece: Piece, general: Path, empty: Path, guard: bool = False) -> 
     """The general policy's and the scripted pianist's figures on ``piece``."""
     env_config, _ = policy_configs(general)
     phrases = split_phrases(piece, DEFAULT_MAX_NOTES)
-    policy = perform(piece, lambda env: CompositionalController(env, phrases, empty, False, general, guard), env_config)
+    policy = perform(
+        piece, lambda env: CompositionalController(env, assign(phrases, empty, general), guard), env_config
+    )
     scripted = perform(piece, "scripted", PLAY_CONFIG)
     return {
         "notes": len(piece),

@@ -6,7 +6,9 @@ stays quick (it registers the gymnasium ids ``pianobot/Piano-v0``, ``pianobot/On
 - :func:`load_piece` -- a ``.mid`` (or PIG) file as a validated :class:`Piece`;
 - :class:`PianoEnv`, :class:`EnvConfig` -- the gymnasium environment;
 - :func:`load_policy`, :func:`policy_configs` -- a stored policy and the environment it was trained in;
-- :class:`ScriptedPianist` -- the hand-written pianist; :func:`play` -- a whole piece in one simulation;
+- :class:`ScriptedPianist` -- the hand-written pianist;
+- :func:`play` -- a whole piece performed as ``pianobot play`` performs it (:func:`plan_performance`
+  says who plays each stretch, :func:`perform_plan` plays a plan);
 - :func:`compare` -- note F1, velocity and timing errors of a performance against its score.
 """
 
@@ -31,18 +33,14 @@ _API = {
     "load_policy": "pianobot.agent.policy",
     "policy_configs": "pianobot.agent.policy",
     "rollout": "pianobot.perform.rollout",
+    "play": "pianobot.perform.plan",
+    "plan_performance": "pianobot.perform.plan",
+    "perform_plan": "pianobot.perform.plan",
 }
 __all__ = ["__version__", *_API]
-
-
-_RENAMED = {"play": ("pianobot.perform.perform", "perform")}  # (pianobot.perform is the package)
-__all__ += list(_RENAMED)
 
 
 def __getattr__(name: str):
     if name in _API:
         return getattr(importlib.import_module(_API[name]), name)
-    if name in _RENAMED:
-        module, attribute = _RENAMED[name]
-        return getattr(importlib.import_module(module), attribute)
     raise AttributeError(f"module 'pianobot' has no attribute {name!r}")

@@ -390,11 +390,12 @@ def test_sections_hand_over_after_the_last_strike():
     from pianobot.env.piano import EnvConfig, PianoEnv
     from pianobot.music.phrases import split_phrases
     from pianobot.perform.compose import CompositionalController
+    from pianobot.perform.plan import assign
 
     piece = Piece((Note(0.0, 60, 0.5, 80, 2), Note(0.5, 62, 1.0, 80, 3), Note(1.0, 64, 1.5, 80, 4)), bpm=60)
     phrases = split_phrases(piece, 1)
     env = PianoEnv(piece=piece, config=EnvConfig(tactile=False))
-    composed = CompositionalController(env, phrases, Path("/nonexistent"), fallback=True)
+    composed = CompositionalController(env, assign(phrases, Path("/nonexistent"), fallback=True))
     firsts = [s.first_step for s in composed.sections]
     # the previous phrase keeps the hand through its last note's onset tolerance (50 ms = 1 step):
     # control passes 2 steps after that note's onset step (lead-in 20 steps, notes 10 steps apart)
@@ -407,7 +408,7 @@ def test_sections_hand_over_after_the_last_strike():
 
     fast = Piece((Note(0.0, 60, 0.1, 80, 2), Note(0.1, 62, 0.2, 80, 3)), bpm=60)  # onsets 2 steps apart
     env = PianoEnv(piece=fast, config=EnvConfig(tactile=False))
-    composed = CompositionalController(env, split_phrases(fast, 1), Path("/nonexistent"), fallback=True)
+    composed = CompositionalController(env, assign(split_phrases(fast, 1), Path("/nonexistent"), fallback=True))
     assert [s.first_step for s in composed.sections] == [0, 21]  # at the latest one step before the next onset (22)
 
 

@@ -227,6 +227,7 @@ def test_the_general_policy_plays_its_consecutive_phrases_as_one_section(tmp_pat
     from pianobot.music.phrases import split_phrases
     from pianobot.perform.compose import CompositionalController
     from pianobot.perform.guard import WristGuard
+    from pianobot.perform.plan import assign
 
     general = next(models.glob(f"{GENERAL_KEY}-*"))
     trained = run("train", EXAMPLES / "one-note.mid", *QUICK, "--no-from-general", "--models", models)
@@ -241,9 +242,9 @@ def test_the_general_policy_plays_its_consecutive_phrases_as_one_section(tmp_pat
     piece = Piece(notes, bpm=60)
     phrases = split_phrases(piece, 1)
     env = PianoEnv(piece=piece, config=policy_configs(general)[0])
-    composed = CompositionalController(env, phrases, models, False, general, guard=True)
+    composed = CompositionalController(env, assign(phrases, models, general), guard=True)
     assert [[p.index for p in s.phrases] for s in composed.sections] == [[0, 1], [2], [3, 4]]
-    assert [s.source.split()[0] for s in composed.sections] == ["general", "policy", "general"]
+    assert [s.stretch.player.value for s in composed.sections] == ["general policy", "own policy", "general policy"]
     assert composed.sections[0].controller is composed.sections[2].controller  # one guarded policy, loaded once
     assert isinstance(composed.sections[2].controller, WristGuard)
     # the own policy takes over after the tolerance of the section's last onset (D4, step 20 + 50), not C4's
@@ -253,7 +254,7 @@ def test_the_general_policy_plays_its_consecutive_phrases_as_one_section(tmp_pat
     steps = slice(last.start, last.start + len(last.tensor))
     assert np.array_equal(last.rows(steps.start, steps.stop), env.score[steps])  # on the scored steps
     assert last.rows(steps.start, steps.stop)[:, :, 0].sum(axis=1).max() == 2  # G4 still sounds at A4's onset
-    unguarded = CompositionalController(env, phrases, models, False, general)  # unguarded by default
+    unguarded = CompositionalController(env, assign(phrases, models, general))  # unguarded by default
     assert not isinstance(unguarded.sections[2].controller, WristGuard)
 
     song = write_midi(piece, tmp_path / "song.mid")

@@ -2,10 +2,11 @@
 docs/training.md), which plays the phrases that have no policy of their own and is where the
 training of a new phrase begins (fine-tuning).
 
-Where it lives: in the model store, where ``pianobot train --task melody`` puts it (folder
-``task-melody-<config hash>``); ``pianobot play`` and ``pianobot train`` take the newest such
-folder whose environment is the one they need, and ``--general-policy DIR`` names another (any
-trained policy folder). It plays consecutive phrases without a policy of their own as one stretch:
+Where it lives: the committed general policy ships inside the package (:data:`PACKAGED`), so it
+is found from any folder and from a wheel install; a user's model store, where ``pianobot train
+--task melody`` puts one (folder ``task-melody-<config hash>``), comes first. ``pianobot play``
+and ``pianobot train`` take the newest such folder in the store whose environment is the one they
+need, then the packaged one, and ``--general-policy DIR`` names another (any trained policy folder). It plays consecutive phrases without a policy of their own as one stretch:
 the sliding score window of that stretch, and its finger targets (:mod:`pianobot.perform.compose`).
 
 A general policy and the phrases it plays or starts must share one environment (the
@@ -34,6 +35,8 @@ GENERAL_TASK = MELODY
 """The task family whose policy is the general policy."""
 GENERAL_KEY = store.task_key(GENERAL_TASK)
 """Its folders' key in the model store: ``task-melody-<config hash>``."""
+PACKAGED = Path(__file__).resolve().parent.parent / "policies"
+"""The policies that ship with pianobot (package data): the committed general policy."""
 
 NETWORK_FIELDS = ("hidden", "actor", "score_input", "score_features", "tactile_channels", "tactile_features")
 """The :class:`SACConfig` fields that shape the networks: a start policy's must be the run's."""
@@ -99,6 +102,16 @@ def explain(folder: Path, found: tuple[str, Any, Any], ours: str) -> str:
     )
 
 
+def general_candidates(models: Path | None) -> list[Path]:
+    """Every general policy there is: the newest first in ``models`` (the user's store), then the
+    packaged ones (:data:`PACKAGED`)."""
+    found = store.find_policies(models, GENERAL_KEY) if models is not None else []
+    packaged = [
+        p for p in store.find_policies(PACKAGED, GENERAL_KEY) if p.resolve() not in {f.resolve() for f in found}
+    ]
+    return found + packaged
+
+
 def find_general(
     models: Path,
     env: EnvConfig | None = None,
@@ -108,9 +121,12 @@ def find_general(
     remedy: str = "",
 ) -> Path | None:
     """The general policy's folder: ``path`` when given (any trained policy), else the newest
-    ``task-melody`` policy in ``models`` that fits ``env`` (and ``sac``'s networks, when given),
-    else None when there is none. One that does not fit is refused: a one-line
-    :class:`PianobotError` naming the first field that differs (and its option) and ``remedy``."""
+    ``task-melody`` policy in ``models``, then the packaged one (:func:`general_candidates`), that
+    fits ``env`` (and ``sac``'s networks, when given); None when there is none. A policy of the
+    user's (``path``, or in ``models``) that does not fit is refused: a one-line
+    :class:`PianobotError` naming the first field that differs (and its option) and ``remedy``.
+    The packaged one that does not fit is passed over (a run with other options than the
+    committed policy's trains from scratch, as it would with no general policy)."""
     if path is not None:
         if not store.is_trained(Path(path)):
             raise PianobotError(
@@ -119,7 +135,7 @@ def find_general(
             )
         candidates = [Path(path)]
     else:
-        candidates = store.find_policies(models, GENERAL_KEY)
+        candidates = general_candidates(models)
     if not candidates:
         return None
     if env is None:
@@ -130,7 +146,10 @@ def find_general(
         found = difference(env, their_env, sac, their_sac if sac is not None else None)
         if found is None:
             return folder
-        first = first or (folder, found)
+        if path is not None or PACKAGED not in folder.resolve().parents:
+            first = first or (folder, found)
+    if first is None:
+        return None
     folder, found = first
     raise PianobotError(explain(folder, found, ours) + (f": {remedy}" if remedy else ""))
 

@@ -10,6 +10,9 @@
           state.json            counters and generator states
           buffer/*.npy          the replay buffer (plain arrays, read without pickle)
         .lock                   held by the process training into the folder
+      general-plays.json        the phrases the general policy plays: no folder of their own (a
+                                phrase it already played when training began), or a folder whose
+                                policy made its piece play worse (:func:`general_plays`)
 
 Files are written to a temporary name and renamed into place, so a crash never leaves a half
 written model; loading never unpickles anything; a corrupt or foreign file is a one-line error.
@@ -228,6 +231,42 @@ def find_policies(root: Path, key: str) -> list[Path]:
         return []
     found = [d for d in root.iterdir() if d.is_dir() and d.name.startswith(f"{key}-") and is_trained(d)]
     return sorted(found, key=saved_at, reverse=True)
+
+
+GENERAL_INDEX = "general-plays.json"
+"""The store's index of the phrases the general policy plays (:func:`general_plays`)."""
+
+
+def general_plays(root: Path) -> dict[str, dict]:
+    """The phrases the general policy plays, by folder name (``<phrase hash>-<config hash>``):
+    each with ``why`` (a phrase it played at the run's stopping note F1 before any training step,
+    so none was stored; or a policy of its own that made its piece play worse, and is not used)
+    and the general policy's ``sha256``. A missing or unreadable index is an empty one: a phrase
+    then is what its folder says."""
+    try:
+        found = json.loads((Path(root) / GENERAL_INDEX).read_text())
+    except (OSError, ValueError):
+        return {}
+    return {k: v for k, v in found.items() if isinstance(v, dict)} if isinstance(found, dict) else {}
+
+
+def mark_general_plays(root: Path, entries: dict[str, dict | None]) -> None:
+    """Record (a dict) or forget (None) that the general policy plays these folders' phrases;
+    written atomically, merged with what the index holds."""
+    index = general_plays(root)
+    for key, entry in entries.items():
+        if entry is None:
+            index.pop(key, None)
+        else:
+            index[key] = entry
+    Path(root).mkdir(parents=True, exist_ok=True)
+    atomic_write(Path(root) / GENERAL_INDEX, json.dumps(index, indent=2, sort_keys=True) + "\n")
+
+
+def covered_keys(root: Path) -> set[str]:
+    """The phrase hashes that play without training: a policy of their own, or the general policy's
+    by the index (:func:`general_plays`)."""
+    return trained_keys(root) | {key.rsplit("-", 1)[0] for key in general_plays(root)}
 
 
 # -- checkpoints ------------------------------------------------------------------------------

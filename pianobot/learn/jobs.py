@@ -119,16 +119,20 @@ def task_job(task: str, config: TrainConfig, root: Path) -> PhraseJob:
 
 
 def plan_jobs(jobs: list[PhraseJob], force: bool) -> tuple[list[PhraseJob], list[PhraseJob]]:
-    """(jobs to train, jobs already trained); ``force`` removes stored policies, so that an
+    """(jobs to train, jobs already done: a stored policy, or the store's index says the general
+    policy plays the phrase); ``force`` removes stored policies and index entries, so that an
     interrupted forced run is not taken for a finished one (its checkpoint is kept and resumed)."""
     todo, done = [], []
     for job in jobs:
-        if store.is_trained(job.folder) and not force:
+        root = job.folder.parent
+        if (store.is_trained(job.folder) or job.folder.name in store.general_plays(root)) and not force:
             done.append(job)
         else:
             if force and job.folder.exists():
                 for name in (store.POLICY_FILE, store.CRITIC_FILE, store.MANIFEST_FILE):
                     (job.folder / name).unlink(missing_ok=True)
+            if force and job.folder.name in store.general_plays(root):
+                store.mark_general_plays(root, {job.folder.name: None})
             todo.append(job)
     return todo, done
 

@@ -9,15 +9,15 @@ last note has run out (a strike up to 50 ms late still counts, so its controller
 until then), or one lead-in before section k's first note, whichever is later, but at the latest
 one step before section k's first onset; the hand is wherever the previous controller left it.
 
-Who plays a phrase: its own policy (stored under its phrase hash); else the general policy
-(:mod:`pianobot.agent.general`); else, when asked (``fallback``), the scripted pianist, each
-phrase a section of its own. Consecutive phrases the general policy plays form one section: it
+Who plays a phrase is the performance plan's decision (:mod:`pianobot.perform.plan`): its own
+policy, the general policy (:mod:`pianobot.agent.general`) or the scripted pianist, each
+phrase a section of its own, except that consecutive phrases the general policy plays form one section: it
 sees that stretch's whole window, a note held over a phrase break and the next phrase's notes
 included, with no hand-over to itself at the breaks. It was trained on single phrases, each
 alone in its window, so this is new to it; it plays better for it (docs/benchmarks.md, "What
 the wrist guard and one section change"). With ``guard``, the general policy plays through a
 :class:`~pianobot.perform.guard.WristGuard`. All of them play in one simulation, so the
-policies must share one environment (:func:`shared_env_config`, :func:`general_for`).
+policies must share one environment (the plan's).
 """
 
 from __future__ import annotations
@@ -30,10 +30,8 @@ from pathlib import Path
 import numpy as np
 
 from pianobot.agent import store
-from pianobot.agent.general import find_general
-from pianobot.agent.policy import load_policy, policy_configs
-from pianobot.env.piano import EnvConfig, PianoEnv
-from pianobot.errors import PianobotError
+from pianobot.agent.policy import load_policy
+from pianobot.env.piano import PianoEnv
 from pianobot.music.metrics import DEFAULT_ONSET_TOLERANCE
 from pianobot.music.phrases import DEFAULT_MAX_NOTES, Phrase, split_phrases
 from pianobot.music.piece import Piece
@@ -41,9 +39,6 @@ from pianobot.music.tensor import score_tensor
 from pianobot.perform.guard import WristGuard
 from pianobot.perform.rollout import Controller
 from pianobot.pianist.scripted import ScriptedPianist
-
-GENERAL_SOURCE = "general policy"
-"""How a section played by the general policy names its source (then the folder's name)."""
 
 
 @dataclass
@@ -61,8 +56,8 @@ class Section:
     from there); the general policy and the scripted pianist get each note on the step the
     environment scores it at. The two differ by a step for notes off the control-step grid."""
     controller: Controller
-    source: str
-    """'policy <folder name>' (its own), 'general policy <folder name>' or 'scripted (fallback)'."""
+    stretch: object
+    """The plan's :class:`~pianobot.perform.plan.Stretch` this section plays: who, with which policy."""
 
     def rows(self, begin: int, end: int) -> np.ndarray:
         """Env steps ``begin`` to ``end`` of the performance's score as this section's controller
@@ -80,9 +75,10 @@ def find_policy(models: Path, phrase: Phrase) -> Path | None:
 
 
 def missing_phrases(models: Path, phrases: list[Phrase]) -> list[Phrase]:
-    """The phrases without a trained policy in ``models``."""
-    trained = store.trained_keys(models)
-    return [p for p in phrases if p.hash not in trained]
+    """The phrases the store has no player for: no policy of their own, and not in its index of
+    phrases the general policy plays (:func:`~pianobot.agent.store.general_plays`)."""
+    covered = store.covered_keys(models)
+    return [p for p in phrases if p.hash not in covered]
 
 
 def trained_split(models: Path, piece: Piece, phrase_notes: int | None) -> list[Phrase]:
@@ -103,71 +99,39 @@ def trained_split(models: Path, piece: Piece, phrase_notes: int | None) -> list[
     return split_phrases(piece, DEFAULT_MAX_NOTES)
 
 
-def shared_env_config(models: Path, phrases: list[Phrase]) -> EnvConfig | None:
-    """The environment the stored policies of these phrases were trained in (None when no
-    phrase has a policy); they must share one, since they play in one simulation."""
-    folders = [find_policy(models, phrase) for phrase in phrases]
-    configs = {policy_configs(folder)[0] for folder in folders if folder is not None}
-    if len(configs) > 1:
-        raise PianobotError(
-            f"the policies in {models} for this piece were trained with different environments: retrain them with one set of options"
-        )
-    return configs.pop() if configs else None
-
-
-def general_for(models: Path, phrases_env: EnvConfig | None, path: Path | None = None) -> Path | None:
-    """The general policy to play phrases without a policy of their own (``path``, else the newest
-    ``task-melody`` policy in ``models``), or None. With ``phrases_env`` (the environment of the
-    piece's own phrase policies, :func:`shared_env_config`) it must have been trained in the same
-    one, or it is refused in one line naming the option that differs."""
-    return find_general(
-        models,
-        phrases_env,
-        path=path,
-        ours="the phrase policies of this piece",
-        remedy="play with --no-general (and --fallback scripted), or train the general policy or the phrases with the same options",
-    )
-
-
 class CompositionalController:
-    """Acts with the controller of the section the current step falls in: the phrase's own
-    policy, else the ``general`` policy (a folder), else (``fallback``) the scripted pianist.
-    ``guard``: the general policy plays through a :class:`~pianobot.perform.guard.WristGuard`."""
+    """Acts with the controller of the section the current step falls in. ``stretches`` say who
+    plays what (:func:`pianobot.perform.plan.assign`): a phrase's own policy, the general policy
+    (loaded once, shared by every stretch it plays), or the scripted pianist. ``guard``: the
+    general policy plays through a :class:`~pianobot.perform.guard.WristGuard`."""
 
-    def __init__(
-        self,
-        env: PianoEnv,
-        phrases: list[Phrase],
-        models: Path,
-        fallback: bool,
-        general: Path | None = None,
-        guard: bool = False,
-    ):
+    def __init__(self, env: PianoEnv, stretches, guard: bool = False):
+        from pianobot.perform.plan import Player  # (the plan module builds on this one)
+
         spec = env.spec_score
         lead = env.lead_steps
         grace = math.ceil(DEFAULT_ONSET_TOLERANCE * spec.control_hz - 1e-9)  # steps a strike may come late
         general_agent = None  # loaded once, shared by every stretch it plays (a policy keeps no state)
-        runs: list[tuple[list[Phrase], Controller, str, bool]] = []  # each section's phrases, controller, source, own?
-        for phrase in phrases:
-            folder = find_policy(models, phrase)
-            if folder is not None:
-                runs.append(([phrase], load_policy(folder, env), f"policy {folder.name}", True))
-            elif general is not None:
-                if runs and runs[-1][1] is general_agent:  # the general policy goes on playing: one section
-                    runs[-1][0].append(phrase)
-                    continue
+        runs: list[
+            tuple[list[Phrase], Controller, object, bool]
+        ] = []  # each section's phrases, controller, stretch, own?
+        for stretch in stretches:
+            if stretch.player is Player.OWN:
+                controller = load_policy(stretch.policy, env)
+            elif stretch.player is Player.GENERAL:
                 if general_agent is None:
-                    agent = load_policy(general, env)
+                    agent = load_policy(stretch.policy, env)
                     guarded = guard and not env.config.world.discrete_wrist  # (a wrist that goes to keys has no speed)
                     general_agent = WristGuard(agent, env.config) if guarded else agent
-                runs.append(([phrase], general_agent, f"{GENERAL_SOURCE} {Path(general).name}", False))
-            elif fallback:
-                runs.append(([phrase], ScriptedPianist(env.config), "scripted (fallback)", False))
-            else:  # checked before simulating; kept as a guard
-                raise PianobotError(f"phrase {phrase.index} has no trained policy in {models}")
+                controller = general_agent
+            elif stretch.player is Player.SCRIPTED:
+                controller = ScriptedPianist(env.config)
+            else:
+                raise ValueError(f"compositional execution has no {stretch.player.value}")
+            runs.append((list(stretch.phrases), controller, stretch, stretch.player is Player.OWN))
         self.sections: list[Section] = []
         previous_last_onset = None
-        for members, controller, source, own in runs:
+        for members, controller, stretch, own in runs:
             onset = lead + spec.step_of(members[0].start)  # the section's first onset's step
             if previous_last_onset is None:
                 first = 0
@@ -181,7 +145,7 @@ class CompositionalController:
                 row = math.floor(members[0].start * spec.control_hz + 1e-9)
                 shift = min(row / spec.control_hz, members[0].start)
             tensor = score_tensor(notes.shift(-shift), spec)
-            self.sections.append(Section(tuple(members), first, lead + row, tensor, controller, source))
+            self.sections.append(Section(tuple(members), first, lead + row, tensor, controller, stretch))
             previous_last_onset = lead + spec.step_of(members[-1].notes[-1].onset)
         self.env = env
         self.lookahead = env.config.lookahead

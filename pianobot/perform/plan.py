@@ -1,0 +1,339 @@
+"""One performance, one call: who plays each stretch of a piece, in which environment, and playing it.
+
+:func:`plan_performance` decides, before anything is simulated, who plays each phrase: its own
+policy (from the model store), the general policy (the user's store first, then the one that
+ships with pianobot), or the scripted pianist (``fallback``, or ``controller='scripted'``). The
+answer is a :class:`PerformancePlan`: immutable, typed, and what the report and the MIDI track
+say about who played. :func:`perform_plan` performs a plan in one continuous simulation
+(compositional execution, :mod:`pianobot.perform.compose`); :func:`play` does both, as
+``pianobot play`` does::
+
+    performance = pianobot.play(pianobot.load_piece("examples/midi/mary.mid"))
+    print(performance.plan.performer, performance.report().f1)
+
+Who plays a phrase, in order: its own policy, unless the store's index says the general policy
+plays it (:func:`pianobot.agent.store.general_plays`: the general policy already played it when
+training began, or the phrase's own policy made its piece play worse); else the general policy;
+else, with ``fallback``, the scripted pianist. Consecutive phrases the general policy plays are
+one stretch: it plays them as one section, with no hand-over to itself at the phrase breaks.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+from enum import Enum
+from pathlib import Path
+from typing import Callable
+
+from pianobot.agent import store
+from pianobot.agent.general import PACKAGED, describe, find_general, general_candidates
+from pianobot.agent.policy import policy_configs
+from pianobot.env.piano import EnvConfig
+from pianobot.errors import PianobotError
+from pianobot.music.instrument import HandSpec, KeyboardSpec
+from pianobot.music.metrics import Report
+from pianobot.music.phrases import DEFAULT_MAX_NOTES, Phrase, split_phrases
+from pianobot.music.piece import Piece
+from pianobot.perform.compose import CompositionalController, find_policy, trained_split
+from pianobot.perform.controllers import CONTROLLERS
+from pianobot.perform.guard import WristGuard
+from pianobot.perform.perform import PLAY_CONFIG, perform
+from pianobot.perform.rollout import Rollout
+from pianobot.sim.hand import HandConfig
+from pianobot.sim.keyboard import KeyboardConfig
+from pianobot.sim.world import WorldConfig
+
+DEFAULT_MODELS = Path("models")
+"""The model store when none is named: ``models`` in the current folder (where ``pianobot train``
+writes). The general policy that ships with pianobot is found from anywhere besides."""
+
+
+class Player(str, Enum):
+    """Who plays a stretch of a performance."""
+
+    OWN = "own policy"
+    GENERAL = "general policy"
+    SCRIPTED = "scripted pianist"
+    RANDOM = "random actions"
+
+
+ONE_PLAYER = {"scripted": Player.SCRIPTED, "random": Player.RANDOM}
+"""The controllers (:data:`~pianobot.perform.controllers.CONTROLLERS`) that play a whole piece
+alone; 'sac' is the trained policies: each phrase's own, else the general policy."""
+
+
+@dataclass(frozen=True)
+class Stretch:
+    """Consecutive phrases played by one player: a phrase's own policy plays that phrase alone;
+    the general policy plays consecutive phrases as one section."""
+
+    phrases: tuple[Phrase, ...]
+    player: Player
+    policy: Path | None = None
+    """The policy's folder (own policy, general policy); None for the scripted pianist and random actions."""
+
+    def __post_init__(self) -> None:
+        if not self.phrases:
+            raise ValueError("a stretch has at least one phrase")
+        if (self.policy is not None) != (self.player in (Player.OWN, Player.GENERAL)):
+            raise ValueError(f"a stretch played by the {self.player.value} has {'no' if self.policy else 'a'} policy")
+        if self.player is Player.OWN and len(self.phrases) != 1:
+            raise ValueError("a phrase's own policy plays its phrase alone")
+
+    def describe(self) -> str:
+        """'own policy <folder>', 'general policy <folder>', 'scripted pianist' or 'random actions'."""
+        return f"{self.player.value} {self.policy.name}" if self.policy is not None else self.player.value
+
+    def to_dict(self) -> dict:
+        return {
+            "phrases": [p.index for p in self.phrases],
+            "player": self.player.value,
+            "policy": str(self.policy) if self.policy is not None else None,
+        }
+
+
+@dataclass(frozen=True)
+class PerformancePlan:
+    """A piece, the environment it is played in, and who plays each stretch of it, in order."""
+
+    piece: Piece
+    config: EnvConfig
+    stretches: tuple[Stretch, ...]
+    wrist_guard: bool = False
+    """The general policy plays through a :class:`~pianobot.perform.guard.WristGuard`."""
+
+    def __post_init__(self) -> None:
+        if not self.stretches:
+            raise ValueError("a plan has at least one stretch")
+
+    @property
+    def phrases(self) -> tuple[Phrase, ...]:
+        return tuple(p for s in self.stretches for p in s.phrases)
+
+    @property
+    def players(self) -> tuple[Player, ...]:
+        """Every player that plays a stretch, in the order of :class:`Player`."""
+        return tuple(p for p in Player if any(s.player is p for s in self.stretches))
+
+    @property
+    def general(self) -> Path | None:
+        """The general policy's folder, when it plays a stretch."""
+        return next((s.policy for s in self.stretches if s.player is Player.GENERAL), None)
+
+    @property
+    def performer(self) -> str:
+        """Who played, in words: 'general policy', 'own policies and general policy', 'scripted pianist', ..."""
+        names = [("own policies" if p is Player.OWN else p.value) for p in self.players]
+        return " and ".join(names)
+
+    def player_of(self, phrase: int) -> Stretch:
+        """The stretch that plays phrase number ``phrase``."""
+        return next(s for s in self.stretches if any(p.index == phrase for p in s.phrases))
+
+    def to_dict(self) -> dict:
+        """What a report says of the plan: the performer, each stretch, and the general policy's weights."""
+        out: dict = {"performer": self.performer, "stretches": [s.to_dict() for s in self.stretches]}
+        if self.general is not None:
+            out["general_policy"] = describe(self.general)
+        return out
+
+
+@dataclass(frozen=True)
+class Performance:
+    """A plan, performed: what the piano played (:attr:`rollout`) and who played it (:attr:`plan`)."""
+
+    plan: PerformancePlan
+    rollout: Rollout
+    seed: int
+    slowed_steps: int | None = None
+    """Steps at which the wrist guard slowed the general policy's wrist (None: no guard played)."""
+
+    @property
+    def played(self) -> Piece:
+        return self.rollout.played
+
+    @property
+    def frames(self) -> list:
+        return self.rollout.frames
+
+    @property
+    def start(self) -> float:
+        return self.rollout.start
+
+    def report(self) -> Report:
+        return self.rollout.report()
+
+    def to_dict(self) -> dict:
+        """The report's JSON: who played (the plan), the seed, and every figure."""
+        out = {"seed": self.seed, **self.plan.to_dict()}
+        if self.plan.general is not None:
+            out["wrist_guard"] = {"on": self.slowed_steps is not None, "slowed_steps": self.slowed_steps or 0}
+        return {**out, **self.report().to_dict()}
+
+
+def assign(
+    phrases: list[Phrase], models: Path, general: Path | None = None, fallback: bool = False
+) -> tuple[Stretch, ...]:
+    """Who plays each phrase (the module's rule), as stretches in order. A phrase nobody can play
+    is a :class:`PianobotError` naming it, where the store is and how to go on."""
+    index = store.general_plays(models)
+    own = {p.index: f for p in phrases if (f := find_policy(models, p)) is not None and f.name not in index}
+    for phrase in phrases:
+        if phrase.index not in own and general is None and not fallback:
+            notes = " ".join(n.name for n in phrase.notes)
+            raise PianobotError(
+                f"phrase {phrase.index} ({notes}) has no policy of its own in the model store {models} "
+                f"({Path(models).resolve()}) and no general policy plays it (looked there and in {PACKAGED}): "
+                "train it with `pianobot train` (same reading options), name another store with --models DIR, "
+                "add --fallback scripted, or play with --controller scripted"
+            )
+    return stretches_for(phrases, own, general)
+
+
+def stretches_for(phrases: list[Phrase], own: dict[int, Path], general: Path | None) -> tuple[Stretch, ...]:
+    """Stretches in which the phrases numbered in ``own`` play with those policies, the others with
+    ``general`` (consecutive ones as one stretch), or, without it, each with the scripted pianist."""
+    stretches: list[Stretch] = []
+    for phrase in phrases:
+        if phrase.index in own:
+            stretches.append(Stretch((phrase,), Player.OWN, own[phrase.index]))
+        elif general is None:
+            stretches.append(Stretch((phrase,), Player.SCRIPTED))
+        elif stretches and stretches[-1].player is Player.GENERAL:  # the general policy goes on playing
+            stretches[-1] = replace(stretches[-1], phrases=(*stretches[-1].phrases, phrase))
+        else:
+            stretches.append(Stretch((phrase,), Player.GENERAL, general))
+    return tuple(stretches)
+
+
+def _own_environment(models: Path, phrases: list[Phrase]) -> EnvConfig | None:
+    """The environment the piece's own phrase policies were trained in (None: none has one); one for all."""
+    index = store.general_plays(models)
+    folders = {f for f in (find_policy(models, p) for p in phrases) if f is not None and f.name not in index}
+    configs = {policy_configs(folder)[0] for folder in folders}
+    if len(configs) > 1:
+        raise PianobotError(
+            f"the policies in {models} for this piece were trained with different environments: "
+            "retrain them with one set of options"
+        )
+    return configs.pop() if configs else None
+
+
+def _general_for(
+    models: Path, env: EnvConfig | None, keyboard: KeyboardSpec, hand: HandSpec, path: Path | None
+) -> Path | None:
+    """The general policy that fits: the phrase policies' environment when there are some, else the
+    keyboard and hand the piece is played on. None when there is no general policy at all."""
+    if env is not None:
+        return find_general(
+            models,
+            env,
+            path=path,
+            ours="the phrase policies of this piece",
+            remedy="play with --no-general (and --fallback scripted), or train the general policy or the phrases "
+            "with the same options",
+        )
+    candidates = [Path(path)] if path is not None else general_candidates(models)
+    if path is not None:
+        find_general(models, path=path)  # a folder that holds no policy: one line
+    for folder in candidates:
+        world = policy_configs(folder)[0].world
+        if world.keyboard.spec == keyboard and world.hand.spec == hand:
+            return folder
+    theirs = [f for f in candidates if path is not None or PACKAGED not in f.resolve().parents]
+    if not theirs:  # (the packaged policy plays its own keyboard and hand only)
+        return None
+    world = policy_configs(theirs[0])[0].world
+    raise PianobotError(
+        f"the general policy {theirs[0]} plays {world.keyboard.spec.describe()} with fingers "
+        f"{world.hand.spec.describe()}, this piece is read for {keyboard.describe()} with fingers {hand.describe()} "
+        "(--lowest-note/--keys/--thumb): play with --controller scripted, or train a general policy for them "
+        "with `pianobot train --task melody` and the same options"
+    )
+
+
+def plan_performance(
+    piece: Piece,
+    controller: str = "sac",
+    models: Path | str | None = None,
+    *,
+    keyboard: KeyboardSpec | None = None,
+    hand: HandSpec | None = None,
+    general: bool = True,
+    general_policy: Path | str | None = None,
+    fallback: bool = False,
+    phrase_notes: int | None = None,
+    wrist_guard: bool = False,
+    gui: bool = False,
+) -> PerformancePlan:
+    """Who plays each stretch of ``piece`` and in which environment (the module's rule).
+
+    ``controller``: 'sac' (trained policies), 'scripted' or 'random' (one player for the whole
+    piece). ``models``: the user's model store (default :data:`DEFAULT_MODELS`). ``keyboard``,
+    ``hand``: what the piece was read for (defaults: the paper's keyboard and the three-finger
+    hand). ``general``: let the general policy play phrases without a policy of their own
+    (``general_policy`` names one; default: the newest in ``models``, then the packaged one).
+    ``fallback``: the scripted pianist plays what no policy plays. ``phrase_notes``: the phrase
+    split (default: the longest whose phrases all have a player in the store). ``gui``: show the
+    simulation."""
+    if controller not in CONTROLLERS:
+        raise PianobotError(f"controller {controller!r}: choose one of {', '.join(CONTROLLERS)}")
+    if general_policy is not None and not general:
+        raise PianobotError(f"--general-policy {general_policy} and --no-general ask for opposite things: give one")
+    keyboard, hand = keyboard or KeyboardSpec(), hand or HandSpec()
+    models = Path(models) if models is not None else DEFAULT_MODELS
+    world = WorldConfig(keyboard=KeyboardConfig(spec=keyboard), hand=HandConfig(spec=hand), gui=gui)
+    if controller in ONE_PLAYER:
+        phrases = split_phrases(piece, phrase_notes or DEFAULT_MAX_NOTES)
+        stretch = Stretch(tuple(phrases), ONE_PLAYER[controller])
+        return PerformancePlan(piece, replace(PLAY_CONFIG, world=world), (stretch,))
+
+    phrases = trained_split(models, piece, phrase_notes)
+    env = _own_environment(models, phrases)
+    folder = _general_for(models, env, keyboard, hand, general_policy) if general else None
+    stretches = assign(phrases, models, folder, fallback)
+    if env is None and folder is not None:
+        env = policy_configs(folder)[0]
+    if env is None:  # the scripted pianist plays every phrase
+        env = replace(PLAY_CONFIG, world=world)
+    if env.world.keyboard.spec != keyboard or env.world.hand.spec != hand:
+        raise PianobotError(
+            f"the policies in {models} were trained for another keyboard or hand: use the same --lowest-note/--keys/--thumb"
+        )
+    if any(s.player is Player.SCRIPTED for s in stretches) and env.world.control == "torque":
+        raise PianobotError("--fallback scripted needs policies trained with --control velocity or position")
+    return PerformancePlan(piece, replace(env, world=replace(env.world, gui=gui)), stretches, wrist_guard)
+
+
+def perform_plan(
+    plan: PerformancePlan, seed: int = 0, video: bool = False, on_step: Callable[[int, int], None] | None = None
+) -> Performance:
+    """Play ``plan`` in one continuous simulation from hand start ``seed``; ``video`` keeps the
+    frames; ``on_step(done, total)`` reports progress."""
+    (first, *others) = plan.stretches
+    if not others and first.player in (Player.SCRIPTED, Player.RANDOM):
+        name = "scripted" if first.player is Player.SCRIPTED else "random"
+        return Performance(plan, perform(plan.piece, name, plan.config, seed, video, on_step), seed)
+    made: list[CompositionalController] = []
+
+    def controller(env):
+        made.append(CompositionalController(env, plan.stretches, plan.wrist_guard))
+        return made[0]
+
+    played = perform(plan.piece, controller, plan.config, seed, video, on_step)
+    guards = [s.controller for s in made[0].sections if isinstance(s.controller, WristGuard)]
+    return Performance(plan, played, seed, guards[0].capped if guards else None)
+
+
+def play(
+    piece: Piece,
+    controller: str = "sac",
+    models: Path | str | None = None,
+    seed: int = 0,
+    video: bool = False,
+    on_step: Callable[[int, int], None] | None = None,
+    **options,
+) -> Performance:
+    """Perform ``piece`` as ``pianobot play`` does: :func:`plan_performance` (``controller``,
+    ``models`` and ``options`` are its arguments), then :func:`perform_plan` from hand start ``seed``."""
+    return perform_plan(plan_performance(piece, controller, models, **options), seed, video, on_step)

@@ -1,0 +1,109 @@
+"""The performance plan (who plays each stretch) and fine-tuning that never makes a piece worse."""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+import pytest
+
+import pianobot
+from pianobot.agent import store
+from pianobot.agent.general import GENERAL_KEY, PACKAGED
+from pianobot.errors import PianobotError
+from pianobot.music.instrument import HandSpec
+from pianobot.music.phrases import DEFAULT_MAX_NOTES, split_phrases
+from pianobot.music.piece import Note, Piece
+from pianobot.perform.plan import Player, Stretch, plan_performance
+
+ROOT = Path(__file__).parent.parent
+MODELS = ROOT / "models"
+EXAMPLES = ROOT / "examples" / "midi"
+
+
+def test_the_packaged_general_policy_is_found_from_any_folder(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)  # no models/ here: only the policy that ships with pianobot
+    piece = pianobot.load_piece(EXAMPLES / "mary.mid")
+    plan = plan_performance(piece)
+    (stretch,) = plan.stretches  # one section: every phrase, no hand-over to itself
+    assert stretch.player is Player.GENERAL and PACKAGED in stretch.policy.resolve().parents
+    assert stretch.policy.name.startswith(GENERAL_KEY) and len(stretch.phrases) == len(plan.phrases) > 1
+    assert plan.performer == "general policy" and plan.to_dict()["general_policy"]["sha256"]
+
+
+def test_a_plan_names_each_phrases_own_policy_and_says_who_played(tmp_path):
+    piece = pianobot.load_piece(EXAMPLES / "twinkle.mid")  # its three phrases have committed policies
+    plan = plan_performance(piece, models=MODELS)
+    assert [s.player for s in plan.stretches] == [Player.OWN] * 3 and plan.performer == "own policies"
+    assert plan.general is None and "general_policy" not in plan.to_dict()
+
+    mary = pianobot.load_piece(EXAMPLES / "mary.mid")
+    phrases = split_phrases(mary, DEFAULT_MAX_NOTES)
+    general = next(PACKAGED.glob(f"{GENERAL_KEY}-*"))
+    models = tmp_path / "models"  # phrase 1 has a policy of its own (in the general policy's environment)
+    own = models / f"{phrases[1].hash}-000000000000"
+    shutil.copytree(general, own)
+    plan = plan_performance(mary, models=models)
+    assert [s.player for s in plan.stretches] == [Player.GENERAL, Player.OWN, Player.GENERAL]
+    assert plan.player_of(1).policy == own and plan.player_of(0).policy == plan.player_of(2).policy == general
+    assert plan.performer == "own policies and general policy"
+    assert plan.to_dict()["stretches"][1] == {"phrases": [1], "player": "own policy", "policy": str(own)}
+    store.mark_general_plays(models, {own.name: {"why": "a test"}})  # the index says the general policy plays it
+    (stretch,) = plan_performance(mary, models=models).stretches
+    assert stretch.player is Player.GENERAL and len(stretch.phrases) == len(phrases)
+
+
+def test_one_player_plans_and_refusals(tmp_path):
+    piece = pianobot.load_piece(EXAMPLES / "mary.mid")
+    (stretch,) = plan_performance(piece, "scripted").stretches
+    assert stretch.player is Player.SCRIPTED and stretch.policy is None
+    with pytest.raises(PianobotError, match="controller 'sac2'"):
+        plan_performance(piece, "sac2")
+    # with the thumb the packaged policy (three fingers) does not fit: nobody plays, said with where it looked
+    with pytest.raises(PianobotError, match=r"no general policy plays it \(looked there and in .*policies\).*--models"):
+        plan_performance(piece, models=tmp_path, hand=HandSpec(fingers=(1, 2, 3, 4)))
+    assert plan_performance(piece, models=tmp_path, general=False, fallback=True).performer == "scripted pianist"
+    with pytest.raises(ValueError):
+        Stretch(tuple(split_phrases(piece, 4)[:2]), Player.OWN, MODELS)  # an own policy plays one phrase
+
+
+def test_one_call_performs_a_piece_as_play_does(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    piece = Piece((Note(0.0, 60, 0.5, 80, 2), Note(0.5, 62, 1.0, 80, 3), Note(1.0, 64, 2.0, 80, 4)), bpm=60)
+    performance = pianobot.play(piece)
+    assert performance.plan.performer == "general policy" and performance.report().f1 == 1.0
+    report = performance.to_dict()
+    assert report["performer"] == "general policy" and report["stretches"][0]["player"] == "general policy"
+    assert report["seed"] == 0 and report["f1"] == 1.0
+
+
+@pytest.mark.slow
+def test_a_phrase_policy_that_makes_the_piece_worse_is_not_used(tmp_path):
+    """A phrase's own policy that holds the hand still loses its notes in the piece: training
+    ends by judging it in the whole piece, and play then lets the general policy play it."""
+    import torch
+
+    from pianobot.learn.accept import JUDGE_SEEDS, settle_piece
+    from pianobot.perform.plan import play
+
+    mary = pianobot.load_piece(EXAMPLES / "mary.mid")
+    piece = Piece(mary.notes[:12], bpm=mary.bpm)  # two phrases
+    phrases = split_phrases(piece, DEFAULT_MAX_NOTES)
+    general = next(PACKAGED.glob(f"{GENERAL_KEY}-*"))
+    models = tmp_path / "models"
+    still = models / f"{phrases[1].hash}-000000000000"  # a policy of its own that outputs nothing
+    still.mkdir(parents=True)
+    tensors = {k: torch.zeros_like(v) for k, v in store.load_tensors(general / store.POLICY_FILE).items()}
+    store.save_tensors(tensors, still / store.POLICY_FILE)
+    shutil.copy(general / store.MANIFEST_FILE, still / store.MANIFEST_FILE)
+
+    before = [play(piece, models=tmp_path / "none", seed=s).report().f1 for s in JUDGE_SEEDS]
+    worse = [play(piece, models=models, seed=s).report().f1 for s in JUDGE_SEEDS]
+    assert max(w - b for w, b in zip(worse, before)) < 0  # (the old code played it so)
+
+    verdict = settle_piece(piece, phrases, models, general, started={})
+    assert verdict.before == tuple(before) and verdict.after == tuple(before)
+    assert 1 in verdict.dropped and not verdict.used
+    assert "made the piece play worse" in store.general_plays(models)[still.name]["why"]
+    after = [play(piece, models=models, seed=s).report().f1 for s in JUDGE_SEEDS]
+    assert after == before and play(piece, models=models).plan.performer == "general policy"
