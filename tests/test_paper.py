@@ -1,28 +1,24 @@
-"""benchmarks/paper.py: the paper's experiments expand to the right runs, a run resumes, the report
+"""benchmarks/paper/ (``python -m benchmarks.paper``): the paper's experiments expand to the right runs, a run resumes, the report
 tables mean ± std, and every policy is judged with the linear reward. One tiny training run
 (300 steps, cut off at its first checkpoint and resumed) serves the slow tests."""
 
 from __future__ import annotations
 
 import json
-import sys
 from dataclasses import replace
-from pathlib import Path
 
 import pytest
 import torch
 
-ROOT = Path(__file__).resolve().parent.parent
-sys.path.append(str(ROOT / "benchmarks"))
-
-import paper  # noqa: E402
-
-from pianobot.agent import store  # noqa: E402
-from pianobot.agent.policy import load_policy  # noqa: E402
-from pianobot.agent.tasks import make_env  # noqa: E402
-from pianobot.env.rewards import RewardConfig  # noqa: E402
-from pianobot.learn.config import TrainConfig  # noqa: E402
-from pianobot.perform.rollout import rollout  # noqa: E402
+from benchmarks.paper import cli, evaluation, experiments, report, training
+from benchmarks.paper.records import record_key
+from benchmarks.paper.runs import expand
+from pianobot.agent import store
+from pianobot.agent.policy import load_policy
+from pianobot.agent.tasks import make_env
+from pianobot.env.rewards import RewardConfig
+from pianobot.learn.config import TrainConfig
+from pianobot.perform.rollout import rollout
 
 torch.set_num_threads(1)
 
@@ -38,8 +34,8 @@ TINY = ["--setting", "paper", "--seeds", "1", "--steps", "300", "--exploration-s
 TINY += ["--eval-every", "100", "--eval-episodes", "1", "--check-episodes", "1"]
 
 
-def options(tmp_path, **changes) -> paper.Options:
-    return replace(paper.Options(store=tmp_path, seeds=2), **changes)
+def options(tmp_path, **changes) -> experiments.Options:
+    return replace(experiments.Options(store=tmp_path, seeds=2), **changes)
 
 
 @pytest.mark.parametrize(
@@ -47,10 +43,10 @@ def options(tmp_path, **changes) -> paper.Options:
     [("tasks", 24), ("rhythm-chord", 8), ("rewards", 12), ("exploration", 14), ("control", 8), ("fingering", 8)],
 )
 def test_every_experiment_expands_to_its_arms_settings_tasks_and_seeds(tmp_path, name, runs):
-    expanded = paper.expand(name, options(tmp_path))
+    expanded = expand(name, options(tmp_path))
     assert len(expanded) == runs
     assert {r.setting for r in expanded} == {"paper", "ours"} and {r.seed for r in expanded} == {0, 1}
-    assert paper.expand(str(paper.EXPERIMENTS[name].number), options(tmp_path)) == expanded  # 1-7 name them too
+    assert expand(str(experiments.EXPERIMENTS[name].number), options(tmp_path)) == expanded  # 1-7 name them too
     groups: dict[tuple, list] = {}
     for run in expanded:
         assert len(run.jobs) == 1 and run.jobs[0].target == run.task  # one policy per run, on the task family
@@ -58,26 +54,26 @@ def test_every_experiment_expands_to_its_arms_settings_tasks_and_seeds(tmp_path,
     for arms in groups.values():
         assert sorted(r.variant for r in arms) == sorted({r.variant for r in arms})  # each arm once
         for run in arms[1:]:
-            assert set(paper.differences(run.config, arms[0].config)) <= ALLOWED[name], (run.variant, name)
+            assert set(report.differences(run.config, arms[0].config)) <= ALLOWED[name], (run.variant, name)
 
 
 def test_the_tables_arms_are_the_papers():
-    names = {e.name: [(v.name, v.paper_name) for v in e.variants] for e in paper.EXPERIMENTS.values()}
+    names = {e.name: [(v.name, v.paper_name) for v in e.variants] for e in experiments.EXPERIMENTS.values()}
     assert [n for n, _ in names["rewards"]] == ["linear", "squared", "wasserstein"]
     assert names["exploration"][:3] == [
         ("prior", "Prior Explore"),
         ("repeat", "Uniform Move Hand"),
         ("uniform", "No Action Repeat"),
     ]
-    assert paper.experiment_named("1").tasks == ("one-note", "three-note", "six-note")
-    assert paper.experiment_named("2").tasks == ("rhythmic", "chord")
-    assert paper.experiment_named("1").baselines == ("scripted", "idle", "random")
-    assert all(e.baselines == paper.BASELINES for e in paper.EXPERIMENTS.values() if e.name != "compose")
+    assert experiments.experiment_named("1").tasks == ("one-note", "three-note", "six-note")
+    assert experiments.experiment_named("2").tasks == ("rhythmic", "chord")
+    assert experiments.experiment_named("1").baselines == ("scripted", "idle", "random")
+    assert all(e.baselines == experiments.BASELINES for e in experiments.EXPERIMENTS.values() if e.name != "compose")
 
 
 def test_the_paper_setting_is_plain_sac_without_our_additions(tmp_path):
-    for name in paper.EXPERIMENTS:
-        for run in paper.expand(name, options(tmp_path, seeds=1, settings=("paper",))):
+    for name in experiments.EXPERIMENTS:
+        for run in expand(name, options(tmp_path, seeds=1, settings=("paper",))):
             config = run.config
             assert config.explore != "scripted" and config.sac.demo_weight == 0  # no teacher
             assert config.env.reward.closeness_weight == 0  # no closeness bonus
@@ -87,29 +83,27 @@ def test_the_paper_setting_is_plain_sac_without_our_additions(tmp_path):
 
 
 def test_the_ours_setting_is_pianobots_defaults_but_for_the_arm(tmp_path):
-    for run in paper.expand("rewards", options(tmp_path, seeds=1, settings=("ours",))):
+    for run in expand("rewards", options(tmp_path, seeds=1, settings=("ours",))):
         base = TrainConfig(steps=run.config.steps, eval_episodes=run.config.eval_episodes)
-        assert set(paper.differences(run.config, base)) <= {"env.reward.kind", "from_general"}
+        assert set(report.differences(run.config, base)) <= {"env.reward.kind", "from_general"}
         assert not run.config.from_general  # from scratch: the general policy is not the paper's subject
-    for run in paper.expand("control", options(tmp_path, seeds=1, settings=("ours",))):
+    for run in expand("control", options(tmp_path, seeds=1, settings=("ours",))):
         assert run.config.explore == "prior"  # the scripted teacher has no torques: both arms explore alike
 
 
 def test_steps_default_to_the_papers_budget_and_can_be_set(tmp_path):
-    assert {r.config.steps for r in paper.expand("tasks", options(tmp_path))} == {200_000}  # paper: 2e5
-    assert {r.config.steps for r in paper.expand("rewards", options(tmp_path))} == {paper.ABLATION_STEPS}
-    assert {r.config.steps for r in paper.expand("rewards", options(tmp_path, steps=40_000))} == {40_000}
-    _, parsed = paper.parse(
-        ["rewards", "--seeds", "5", "--setting", "paper", "--steps", "50000", "--tasks", "one-note"]
-    )
-    runs = paper.expand("rewards", parsed)
+    assert {r.config.steps for r in expand("tasks", options(tmp_path))} == {200_000}  # paper: 2e5
+    assert {r.config.steps for r in expand("rewards", options(tmp_path))} == {experiments.ABLATION_STEPS}
+    assert {r.config.steps for r in expand("rewards", options(tmp_path, steps=40_000))} == {40_000}
+    _, parsed = cli.parse(["rewards", "--seeds", "5", "--setting", "paper", "--steps", "50000", "--tasks", "one-note"])
+    runs = expand("rewards", parsed)
     assert len(runs) == 15 and {r.task for r in runs} == {"one-note"} and {r.seed for r in runs} == set(range(5))
 
 
 def test_equal_configurations_share_one_folder_across_experiments(tmp_path):
     """The paper setting's linear / prior / velocity / gated run is one run in experiments 3-6."""
     folders = [
-        next(r for r in paper.expand(name, options(tmp_path, seeds=1, settings=("paper",))) if r.variant == arm)
+        next(r for r in expand(name, options(tmp_path, seeds=1, settings=("paper",))) if r.variant == arm)
         .jobs[0]
         .folder
         for name, arm in (
@@ -125,7 +119,7 @@ def test_equal_configurations_share_one_folder_across_experiments(tmp_path):
 def test_the_additions_experiment_takes_away_one_of_ours_at_a_time(tmp_path):
     """Experiment 8 is pianobot's setting only; each arm differs from it in one addition, and its
     full arm and its arm without the teacher are the runs experiments 3 and 4 already train."""
-    runs = paper.expand("additions", options(tmp_path, seeds=1))
+    runs = expand("additions", options(tmp_path, seeds=1))
     assert {r.setting for r in runs} == {"ours"} and {r.task for r in runs} == {"three-note"}
     arms = {r.variant: r for r in runs}
     removed = {
@@ -137,23 +131,21 @@ def test_the_additions_experiment_takes_away_one_of_ours_at_a_time(tmp_path):
     }
     assert arms.keys() == removed.keys()
     for name, changed in removed.items():
-        assert set(paper.differences(arms[name].config, arms["ours"].config)) == changed, name
-    paper_setting = paper.setting_config("paper", options(tmp_path), 0, paper.ABLATION_STEPS, 20)
+        assert set(report.differences(arms[name].config, arms["ours"].config)) == changed, name
+    paper_setting = experiments.setting_config("paper", options(tmp_path), 0, experiments.ABLATION_STEPS, 20)
     for name in ("no-closeness", "score-window", "paper-hyperparameters"):  # each takes the paper's value
-        assert not removed[name] & paper.differences(arms[name].config, paper_setting).keys(), name
+        assert not removed[name] & report.differences(arms[name].config, paper_setting).keys(), name
     same_as = {"ours": ("rewards", "linear"), "no-teacher": ("exploration", "prior")}
     for name, (experiment, arm) in same_as.items():
-        other = next(
-            r for r in paper.expand(experiment, options(tmp_path, seeds=1, settings=("ours",))) if r.variant == arm
-        )
+        other = next(r for r in expand(experiment, options(tmp_path, seeds=1, settings=("ours",))) if r.variant == arm)
         assert other.jobs[0].folder == arms[name].jobs[0].folder
-    assert paper.expand("additions", options(tmp_path, seeds=1, settings=("paper",))) == []
+    assert expand("additions", options(tmp_path, seeds=1, settings=("paper",))) == []
 
 
 def test_compose_trains_growing_pieces_end_to_end_with_the_same_total_steps(tmp_path):
-    runs = paper.expand("compose", options(tmp_path, steps=20_000))
-    assert len(runs) == 2 * 2 * len(paper.Options.lengths) * 2
-    for setting in paper.SETTINGS:
+    runs = expand("compose", options(tmp_path, steps=20_000))
+    assert len(runs) == 2 * 2 * len(experiments.Options.lengths) * 2
+    for setting in experiments.SETTINGS:
         for seed in (0, 1):
             mine = [r for r in runs if r.setting == setting and r.seed == seed]
             notes = []
@@ -164,11 +156,11 @@ def test_compose_trains_growing_pieces_end_to_end_with_the_same_total_steps(tmp_
                 assert all(len(job.target) <= 6 for job in composed.jobs)  # phrases
                 assert composed.config.steps == 20_000
                 assert single.config.steps == 20_000 * len(composed.jobs)  # the same total steps
-                assert set(paper.differences(single.config, composed.config)) <= {"steps"}  # nothing else
+                assert set(report.differences(single.config, composed.config)) <= {"steps"}  # nothing else
                 notes.append(len(composed.piece))
             assert notes == sorted(notes) and len(set(notes)) == len(notes)  # growing pieces
             assert len({job.folder.parent for r in mine for job in r.jobs}) == 1  # shared phrases train once
-    faster = paper.expand("compose", options(tmp_path, steps=20_000, tempo=90.0))
+    faster = expand("compose", options(tmp_path, steps=20_000, tempo=90.0))
     assert not {r.result for r in faster} & {r.result for r in runs}  # another tempo: judged afresh
 
 
@@ -178,10 +170,10 @@ def tiny(tmp_path_factory):
     its first checkpoint, then rerun with the same command."""
     root = tmp_path_factory.mktemp("paper")
     args = [*TINY, "--store", str(root), "--plots", str(root / "plots"), "--variants", "squared"]
-    _, opts = paper.parse(["rewards", *args])
-    (run,) = paper.expand("rewards", opts)
+    _, opts = cli.parse(["rewards", *args])
+    (run,) = expand("rewards", opts)
     assert run.variant == "squared" and run.config.env.reward.kind == "squared"
-    cut = paper.train_job(run.jobs[0], run.config, "tiny", stop_after=150)
+    cut = training.train_job(run.jobs[0], run.config, "tiny", stop_after=150)
     assert cut["state"] == "interrupted"
     return root, args, opts, run
 
@@ -192,27 +184,27 @@ def test_a_run_resumes_rather_than_restarts_when_rerun(tiny, capsys):
     cut_at = store.checkpoint_state(folder)["step"]
     assert 150 <= cut_at < 300 and not store.is_trained(folder)
 
-    paper.main(["rewards", *args, "--report", "--check"])  # an unfinished run is reported, its best policy judged
+    cli.main(["rewards", *args, "--report", "--check"])  # an unfinished run is reported, its best policy judged
     printed = capsys.readouterr().out
     assert f"(at {cut_at} steps)" in printed and "| paper | three-note | squared | 1 / 0 / 1 / 1 |" in printed
     assert "- paper three-note squared: seed 0 " in printed and "(so far: best at " in printed  # provisional
 
-    paper.main(["rewards", *args])
+    cli.main(["rewards", *args])
     printed = capsys.readouterr().out
     assert f"resuming from its checkpoint at step {cut_at}" in printed
     manifest = store.read_manifest(folder)
     assert manifest["steps"] == 300 and manifest["evaluations"][0]["step"] <= cut_at  # the evaluations before the cut
 
-    paper.main(["rewards", *args])  # finished: nothing to train again
+    cli.main(["rewards", *args])  # finished: nothing to train again
     assert "0 to train, 0 runs to evaluate" in capsys.readouterr().out
 
 
 def test_report_tables_a_finished_run_with_mean_and_std(tiny, capsys):
     root, args, _, run = tiny
     if not store.is_trained(run.jobs[0].folder):
-        paper.main(["rewards", *args])
+        cli.main(["rewards", *args])
         capsys.readouterr()
-    paper.main(["rewards", *args, "linear", "--report"])  # --variants squared linear
+    cli.main(["rewards", *args, "linear", "--report"])  # --variants squared linear
     printed = capsys.readouterr().out
     row = next(line for line in printed.splitlines() if line.startswith("| paper | three-note | squared |"))
     cells = [c.strip() for c in row.strip("|").split("|")]
@@ -229,9 +221,9 @@ def test_report_tables_a_finished_run_with_mean_and_std(tiny, capsys):
 def test_a_report_keeps_records_beside_its_plot_and_tables_them_without_the_store(tiny, capsys, tmp_path):
     root, args, opts, run = tiny
     if not store.is_trained(run.jobs[0].folder):
-        paper.main(["rewards", *args])
-    key, path, png = paper.record_key(run, opts), root / "plots" / "3-rewards.json", root / "plots" / "3-rewards.png"
-    paper.main(["rewards", *args, "--report"])
+        cli.main(["rewards", *args])
+    key, path, png = record_key(run, opts), root / "plots" / "3-rewards.json", root / "plots" / "3-rewards.png"
+    cli.main(["rewards", *args, "--report"])
     with_store = capsys.readouterr().out
     records = json.loads(path.read_text())["runs"]
     assert list(records) == [key] and records[key]["state"] == "finished" and records[key]["figures"]["episodes"] == 1
@@ -241,7 +233,7 @@ def test_a_report_keeps_records_beside_its_plot_and_tables_them_without_the_stor
 
     elsewhere = [*args, "--store", str(tmp_path / "empty")]  # a fresh clone: no store, the records only
     png.unlink()
-    paper.main(["rewards", *elsewhere, "--report"])
+    cli.main(["rewards", *elsewhere, "--report"])
     without = capsys.readouterr().out
     row = line(without, "| paper | three-note | squared |")
     assert row == line(with_store, "| paper | three-note | squared |") and "1 / 1 / 1 / 1" in row  # the same figures
@@ -253,28 +245,28 @@ def test_a_report_keeps_records_beside_its_plot_and_tables_them_without_the_stor
 
     stale = {**records[key], "state": "at 100 steps", "steps": 100, "figures": None}
     path.write_text(json.dumps({"runs": {key: stale}}))
-    paper.main(["rewards", *args, "--report"])  # the store is further along than the record: it replaces it
+    cli.main(["rewards", *args, "--report"])  # the store is further along than the record: it replaces it
     assert "| paper | three-note | squared | 1 / 1 / 1 / 1 |" in capsys.readouterr().out
     assert json.loads(path.read_text())["runs"] == records
 
-    paper.main(["rewards", *args, "--report", "--check-episodes", "2"])  # judged on more episodes: recorded
-    paper.main(["rewards", *args, "--report"])  # on fewer: the store's, but the record keeps the better judgement
+    cli.main(["rewards", *args, "--report", "--check-episodes", "2"])  # judged on more episodes: recorded
+    cli.main(["rewards", *args, "--report"])  # on fewer: the store's, but the record keeps the better judgement
     capsys.readouterr()
     assert json.loads(path.read_text())["runs"][key]["figures"]["episodes"] == 2
-    paper.main(["rewards", *elsewhere, "--report"])  # judged otherwise than this report judges: no judgement
+    cli.main(["rewards", *elsewhere, "--report"])  # judged otherwise than this report judges: no judgement
     assert "| paper | three-note | squared | 0 / 1 / 1 / 1 |" in capsys.readouterr().out
 
     so_far = {**stale, "figures": {**records[key]["figures"], "so_far": True, "kept_steps": [100]}}
     path.write_text(json.dumps({"runs": {key: so_far}}))  # an unfinished run's best policy so far
-    paper.main(["rewards", *elsewhere, "--report"])
+    cli.main(["rewards", *elsewhere, "--report"])
     assert "| paper | three-note | squared | 0 / 0 / 1 / 1 |" in capsys.readouterr().out  # only with --check
-    paper.main(["rewards", *elsewhere, "--report", "--check"])
+    cli.main(["rewards", *elsewhere, "--report", "--check"])
     assert "| paper | three-note | squared | 1 / 0 / 1 / 1 |" in capsys.readouterr().out
 
     conflicted = "<<<<<<< HEAD\n" + path.read_text()  # a merge left half done: not overwritten, one line
     path.write_text(conflicted)
     with pytest.raises(SystemExit) as stopped:
-        paper.main(["rewards", *args])
+        cli.main(["rewards", *args])
     assert stopped.value.code == 2 and path.read_text() == conflicted
     assert capsys.readouterr().err.strip().startswith(f"error: {path} is not a records file")
 
@@ -283,70 +275,70 @@ def test_a_policy_trained_with_the_squared_reward_is_judged_with_the_linear_one(
     root, args, opts, run = tiny
     folder = run.jobs[0].folder
     if not store.is_trained(folder):
-        paper.main(["rewards", *args])
+        cli.main(["rewards", *args])
     built = []
-    real = paper.make_env
-    monkeypatch.setattr(paper, "make_env", lambda target, config: built.append(config) or real(target, config))
-    figures = paper.evaluate_run(run, opts)
-    assert built and all(c.reward == paper.EVAL_REWARD for c in built)
-    assert paper.EVAL_REWARD.kind == "linear" and paper.EVAL_REWARD.closeness_weight == 0
+    real = evaluation.make_env
+    monkeypatch.setattr(evaluation, "make_env", lambda target, config: built.append(config) or real(target, config))
+    figures = evaluation.evaluate_run(run, opts)
+    assert built and all(c.reward == experiments.EVAL_REWARD for c in built)
+    assert experiments.EVAL_REWARD.kind == "linear" and experiments.EVAL_REWARD.closeness_weight == 0
     assert figures["reward"]["kind"] == "linear" and figures["episodes"] == 1
 
     def played(reward: RewardConfig) -> float:
         env = make_env(run.task, replace(run.config.env, reward=reward))
-        return rollout(env, load_policy(folder, env), seed=paper.CHECK_SEED).total_reward
+        return rollout(env, load_policy(folder, env), seed=evaluation.CHECK_SEED).total_reward
 
-    assert figures["return"] == pytest.approx(played(paper.EVAL_REWARD))
+    assert figures["return"] == pytest.approx(played(experiments.EVAL_REWARD))
     assert figures["return"] != pytest.approx(played(run.config.env.reward))  # the squared reward would differ
 
 
 def test_cpu_hours_are_estimated_from_the_measured_training_speed(tmp_path):
-    assert paper.run_minutes(15_000, 15_000) == pytest.approx(4.0)
-    assert paper.run_minutes(40_000, 15_000) == pytest.approx(4.0 + 2.5 * 10.0)
-    hours, policies = paper.estimate(paper.expand("rewards", options(tmp_path, seeds=3)))
-    assert policies == 18 and hours == pytest.approx(18 * paper.run_minutes(100_000, 15_000) / 60)
+    assert experiments.run_minutes(15_000, 15_000) == pytest.approx(4.0)
+    assert experiments.run_minutes(40_000, 15_000) == pytest.approx(4.0 + 2.5 * 10.0)
+    hours, policies = report.estimate(expand("rewards", options(tmp_path, seeds=3)))
+    assert policies == 18 and hours == pytest.approx(18 * experiments.run_minutes(100_000, 15_000) / 60)
 
 
 def test_stop_at_time_boxes_every_run_at_a_checkpoint_and_the_full_command_goes_on(tmp_path, capsys, monkeypatch):
     args = [*TINY, "--store", str(tmp_path), "--plots", str(tmp_path / "plots"), "--variants", "linear"]
     with pytest.raises(SystemExit):  # between checkpoints the steps after the last one would be lost
-        paper.parse(["rewards", *args, "--stop-at", "250"])
-    _, opts = paper.parse(["rewards", *args, "--stop-at", "200"])
-    (run,) = paper.expand("rewards", opts)
+        cli.parse(["rewards", *args, "--stop-at", "250"])
+    _, opts = cli.parse(["rewards", *args, "--stop-at", "200"])
+    (run,) = expand("rewards", opts)
     assert opts.stop_at == 200 and run.config.steps == 300  # the protocol's budget, not the time box
     assert not run.config.from_general and run.config.stop_f1 is None  # trains from scratch, never stops early
 
-    paper.main(["rewards", *args, "--stop-at", "200"])
+    cli.main(["rewards", *args, "--stop-at", "200"])
     folder = run.jobs[0].folder
     stopped = store.checkpoint_state(folder)["step"]
     assert 200 <= stopped < 300 and not store.is_trained(folder)
     assert "stopped at step" in capsys.readouterr().out
 
-    played, real = [], paper.play_instances  # --report --check judges the best so far once, then reads it back
-    monkeypatch.setattr(paper, "play_instances", lambda *a: played.append(a[3]) or real(*a))
-    judged = paper.best_so_far(run, opts)
-    assert judged["so_far"] and paper.best_so_far(run, opts) == judged and played == [1]
-    assert paper.best_so_far(run, replace(opts, check_episodes=2))["episodes"] == 2 and played == [1, 2]
-    cached = tmp_path / paper.SO_FAR_DIR / f"{folder.name}.json"
+    played, real = [], evaluation.play_instances  # --report --check judges the best so far once, then reads it back
+    monkeypatch.setattr(evaluation, "play_instances", lambda *a: played.append(a[3]) or real(*a))
+    judged = evaluation.best_so_far(run, opts)
+    assert judged["so_far"] and evaluation.best_so_far(run, opts) == judged and played == [1]
+    assert evaluation.best_so_far(run, replace(opts, check_episodes=2))["episodes"] == 2 and played == [1, 2]
+    cached = tmp_path / experiments.SO_FAR_DIR / f"{folder.name}.json"
     assert not list(folder.glob("*.json*"))  # nothing written into the folder its training owns
     stale = json.loads(cached.read_text())  # a folder trained afresh: its best falls on the same step
     stale["best"] = {**stale["best"], "f1": stale["best"]["f1"] + 0.5}
     cached.write_text(json.dumps(stale))
-    assert paper.best_so_far(run, replace(opts, check_episodes=2))["best"] != stale["best"] and played == [1, 2, 2]
+    assert evaluation.best_so_far(run, replace(opts, check_episodes=2))["best"] != stale["best"] and played == [1, 2, 2]
 
-    paper.main(["rewards", *args, "--stop-at", "200"])  # already there: nothing is trained again
+    cli.main(["rewards", *args, "--stop-at", "200"])  # already there: nothing is trained again
     assert "already past --stop-at 200" in capsys.readouterr().out
     assert store.checkpoint_state(folder)["step"] == stopped
 
-    paper.main(["rewards", *args])  # without it: on to the full budget
+    cli.main(["rewards", *args])  # without it: on to the full budget
     assert f"resuming from its checkpoint at step {stopped}" in capsys.readouterr().out
     assert store.read_manifest(folder)["steps"] == 300
 
 
 def test_the_idle_hand_presses_no_key_and_earns_between_random_and_scripted(tmp_path):
     opts = options(tmp_path, check_episodes=2)
-    played = {c: paper.baseline_figures(c, "three-note", 0, opts) for c in paper.BASELINES}
+    played = {c: evaluation.baseline_figures(c, "three-note", 0, opts) for c in experiments.BASELINES}
     assert played["idle"]["f1"] == 0 and played["idle"]["velocity_mae"] is None  # no note sounded
     assert played["random"]["return"] < played["idle"]["return"] < played["scripted"]["return"]
     assert played["scripted"]["f1"] == 1.0
-    assert paper.baseline_figures("idle", "three-note", 0, opts) == played["idle"]  # cached
+    assert evaluation.baseline_figures("idle", "three-note", 0, opts) == played["idle"]  # cached

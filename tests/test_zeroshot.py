@@ -1,17 +1,14 @@
 """benchmarks/zeroshot.py's breakdown of where the general policy loses notes (by phrase and by
 onset within a phrase): the figure the docs use to tell weak phrases from weak hand-overs."""
 
-import sys
 from pathlib import Path
 
+from benchmarks import zeroshot
+from pianobot.music.phrases import split_phrases
+from pianobot.music.piece import Note, Piece
+from pianobot.perform.rollout import Rollout
+
 ROOT = Path(__file__).resolve().parent.parent
-sys.path.append(str(ROOT / "benchmarks"))
-
-import zeroshot  # noqa: E402
-
-from pianobot.music.phrases import split_phrases  # noqa: E402
-from pianobot.music.piece import Note, Piece  # noqa: E402
-from pianobot.perform.rollout import Rollout  # noqa: E402
 
 
 def test_placed_hits_name_each_missed_note_by_its_phrase_and_onset():
