@@ -97,6 +97,7 @@ def perform_piece(run: Run, hand_starts: int) -> dict:
     in one continuous simulation, as `pianobot play` does, with the linear reward."""
     from pianobot.perform.compose import CompositionalController
     from pianobot.perform.perform import perform
+    from pianobot.perform.plan import assign
 
     phrases = split_phrases(run.piece, run.phrase_notes)
     models = run.jobs[0].folder.parent
@@ -104,7 +105,7 @@ def perform_piece(run: Run, hand_starts: int) -> dict:
     played = []
     for seed in range(hand_starts):
         episode = perform(
-            run.piece, lambda env: CompositionalController(env, phrases, models, fallback=False), config, seed=seed
+            run.piece, lambda env: CompositionalController(env, assign(phrases, models)), config, seed=seed
         )
         played.append((episode.total_reward, episode.report()))
     return _figures(played)
