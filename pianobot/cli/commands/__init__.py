@@ -1,0 +1,1 @@
+"""One module per command; :mod:`pianobot.cli.app` registers them."""

@@ -1,0 +1,141 @@
+"""The `pianobot inspect` command."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from pathlib import Path
+from typing import Optional
+
+import typer
+
+from pianobot.cli.options import (
+    AllRows,
+    Fingering,
+    Hand,
+    Keys,
+    LowestNote,
+    PlayPhraseNotes,
+    Quantize,
+    Refinger,
+    Split,
+    Tempo,
+    Thumb,
+    Track,
+    Transpose,
+    make_instrument,
+    make_options,
+)
+from pianobot.cli.terminal import err, out, said, write_json
+from pianobot.files import check_writable
+from pianobot.music.piece import pitch_name
+
+
+def inspect(
+    song: Path = typer.Argument(..., help="A .mid file (or a PIG fingering .txt file)."),
+    track: Optional[str] = Track,
+    tempo: Optional[float] = Tempo,
+    transpose: int = Transpose,
+    fingering: Optional[Path] = Fingering,
+    hand_part: Optional[str] = Hand,
+    split: str = Split,
+    quantize: Optional[str] = Quantize,
+    refinger: bool = Refinger,
+    lowest_note: str = LowestNote,
+    keys: int = Keys,
+    thumb: bool = Thumb,
+    phrase_notes: Optional[int] = PlayPhraseNotes,
+    models: Path = typer.Option(
+        Path("models"), "--models", help="Model store whose trained phrase split to show (as play uses it)."
+    ),
+    all_rows: bool = AllRows,
+    json_path: Optional[Path] = typer.Option(
+        None, "--json", help="Also write what inspect found to this JSON file ('-': standard output)."
+    ),
+):
+    """Explain what a file holds (tracks, hands, pedal, range, polyphony, fingering) and whether the hand can play it."""
+    from pianobot.cli import display
+    from pianobot.music import midi_io
+    from pianobot.music.instrument import check_playable
+    from pianobot.music.load import HANDS, hand_tracks
+    from pianobot.perform.compose import missing_phrases, trained_split
+    from pianobot.pianist.fingering import ensure_fingering
+    from pianobot.pianist.reduce import load_for_hand
+
+    keyboard, hand_spec = make_instrument(lowest_note, keys, thumb)
+    options = make_options(track, tempo, transpose, fingering, hand_part, split, quantize, refinger)
+    to_stdout = json_path is not None and str(json_path) == "-"
+    if json_path is not None and not to_stdout:
+        check_writable(json_path)
+    console = err if to_stdout else out  # standard output carries the JSON
+    tracks = []
+    if song.suffix.lower() != ".txt":
+        tracks = midi_io.describe_tracks(song)
+        hands = {i: h for h in HANDS for i in hand_tracks(tracks, h)}
+        console.print(display.tracks_table([replace(t, name=said(t.name)) for t in tracks], hands))
+        with_notes = [t for t in tracks if t.notes]
+        pedal = sum(t.pedal for t in tracks)
+        console.print(
+            f"{len(with_notes)} track(s) with notes"
+            + (f"; named for hands: {', '.join(f'{i} {h}' for i, h in sorted(hands.items()))}" if hands else "")
+            + (
+                f"; sustain pedal pressed {pedal} times (ignored: a note sounds while its key is down)"
+                if pedal
+                else "; no sustain pedal"
+            )
+        )
+        if len(with_notes) > 1 and track is None and hand_part is None:
+            console.print(
+                "[yellow]several tracks are merged; play one part with --track N or --hand right|left[/yellow]"
+            )
+    piece = load_for_hand(song, options, keyboard, hand_spec)
+    polyphony, _ = piece.max_polyphony()
+    given = sum(n.finger is not None for n in piece.notes)
+    low, high = min(n.pitch for n in piece.notes), max(n.pitch for n in piece.notes)
+    velocities = sorted({n.velocity for n in piece.notes})
+    console.print(
+        f"{len(piece)} notes, {piece.duration:.2f} s at {piece.bpm:.0f} bpm; range {pitch_name(low)}-{pitch_name(high)} "
+        f"({high - low} semitones); at most {polyphony} notes at once; velocities {velocities[0]}-{velocities[-1]}; "
+        f"{given}/{len(piece)} notes fingered in the file"
+    )
+    piece, plan = ensure_fingering(piece, keyboard, hand_spec, refinger)
+    if plan is not None:
+        console.print(
+            f"fingering planned for fingers {hand_spec.describe()}: wrist travel {plan.travel * 100:.1f} cm in {plan.moves} moves"
+        )
+        for problem in plan.problems:
+            console.print(f"[yellow]{problem}[/yellow]")
+    check_playable(piece.without_fingering(), keyboard, hand_spec)  # the keyboard and the chords, before the split
+    phrases = trained_split(models, piece, phrase_notes)
+    rows = None if all_rows else display.ROWS
+    console.print(display.notes_table(piece, phrases, rows))
+    missing = {p.index for p in missing_phrases(models, phrases)}
+    console.print(display.phrases_table(phrases, {p.index for p in phrases} - missing, rows))
+    check_playable(piece, keyboard, hand_spec)
+    console.print(f"[green]playable[/green] on {keyboard.describe()} with fingers {hand_spec.describe()}")
+    if json_path is not None:
+        write_json(
+            json_path,
+            {
+                "tracks": [{"index": t.index, "name": t.name, "notes": t.notes, "pedal": t.pedal} for t in tracks],
+                "notes": len(piece),
+                "duration": piece.duration,
+                "bpm": piece.bpm,
+                "range": [pitch_name(low), pitch_name(high)],
+                "polyphony": polyphony,
+                "fingered_in_file": given,
+                "playable": True,
+                "keyboard": keyboard.describe(),
+                "fingers": list(hand_spec.fingers),
+                "phrases": [
+                    {
+                        "index": p.index,
+                        "hash": p.hash,
+                        "notes": [n.name for n in p.notes],
+                        "start": p.start,
+                        "end": p.end,
+                        "trained": p.index not in missing,
+                    }
+                    for p in phrases
+                ],
+            },
+        )

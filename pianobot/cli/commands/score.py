@@ -1,0 +1,83 @@
+"""The `pianobot score` command."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Optional
+
+import typer
+
+from pianobot.cli.options import (
+    Fingering,
+    Hand,
+    Quantize,
+    Split,
+    Tempo,
+    Thumb,
+    Track,
+    Transpose,
+    make_instrument,
+    make_options,
+)
+from pianobot.cli.terminal import err, out, said, write_json
+from pianobot.errors import PianobotError
+from pianobot.files import check_writable
+from pianobot.music.instrument import KeyboardSpec
+from pianobot.music.metrics import DEFAULT_ONSET_TOLERANCE
+from pianobot.music.piece import pitch_name
+
+
+def score(
+    played: Path = typer.Argument(..., help="The performance, a .mid file (e.g. written by `pianobot play`)."),
+    reference: Path = typer.Argument(..., help="The reference score, a .mid file."),
+    onset_tolerance: float = typer.Option(
+        DEFAULT_ONSET_TOLERANCE, "--onset-tolerance", help="Seconds within which a played onset matches the reference."
+    ),
+    json_path: Optional[Path] = typer.Option(
+        None, "--json", help="Also write every figure and the per-note table to this JSON file."
+    ),
+    plot: Optional[Path] = typer.Option(
+        None, "--plot", help="Draw both piano rolls with the errors marked to this PNG file."
+    ),
+    notes: bool = typer.Option(True, "--notes/--no-notes", help="Print the per-note table."),
+    track: Optional[str] = Track,
+    tempo: Optional[float] = Tempo,
+    transpose: int = Transpose,
+    fingering: Optional[Path] = Fingering,
+    hand_part: Optional[str] = Hand,
+    split: str = Split,
+    quantize: Optional[str] = Quantize,
+    thumb: bool = Thumb,
+):
+    """Compare a performance with its reference: note F1, velocity and timing errors, fingering.
+
+    The reading options apply to the reference, as `play` applied them to the piece it played:
+    `pianobot score out.mid original.mid --hand right --transpose -3` compares like with like."""
+    from pianobot.cli import display
+    from pianobot.music import midi_io
+    from pianobot.music.metrics import compare, plot_report
+    from pianobot.pianist.reduce import load_for_hand
+
+    if not 0 < onset_tolerance <= 1:
+        raise PianobotError(f"--onset-tolerance {onset_tolerance}: give seconds between 0 and 1, e.g. 0.05")
+    if plot is not None and plot.suffix.lower() != ".png":
+        raise PianobotError(f"--plot {plot}: the plot is a PNG image, name the file *.png")
+    to_stdout = json_path is not None and str(json_path) == "-"
+    for target in (None if to_stdout else json_path, plot):
+        if target is not None:
+            check_writable(target)
+    console = err if to_stdout else out  # standard output carries the JSON
+    keyboard, hand = make_instrument(pitch_name(KeyboardSpec.lowest), KeyboardSpec.count, thumb)
+    options = make_options(track, tempo, transpose, fingering, hand_part, split, quantize)
+    reference_piece = load_for_hand(reference, options, keyboard, hand)  # with --hand, reduced as play reduces it
+    played_piece = midi_io.read_midi(played)
+    report = compare(reference_piece, played_piece, onset_tolerance=onset_tolerance)
+    tables = display.report_tables(report)
+    display.print_all(console, tables if notes else tables[:1])
+    if json_path is not None:
+        write_json(json_path, report.to_dict())
+        if not to_stdout:
+            console.print(f"figures written to {said(json_path)}")
+    if plot is not None:
+        plot_report(reference_piece, played_piece, report, plot)
+        console.print(f"piano rolls drawn to {said(plot)}")

@@ -1,0 +1,344 @@
+"""The `pianobot train` command."""
+
+from __future__ import annotations
+
+import os
+import warnings
+from pathlib import Path
+from typing import Optional
+
+import typer
+
+from pianobot.agent.config import ACTORS, SACConfig
+from pianobot.cli.options import (
+    Fingering,
+    Hand,
+    Keys,
+    LowestNote,
+    PhraseNotes,
+    Quantize,
+    Refinger,
+    Split,
+    Tempo,
+    Thumb,
+    Track,
+    Transpose,
+    make_instrument,
+    make_options,
+    option,
+    read_song,
+    refuse_training_into,
+)
+from pianobot.cli.terminal import err, out, said, write_json
+from pianobot.env.piano import EnvConfig
+from pianobot.env.rewards import RewardConfig
+from pianobot.errors import PianobotError, PianobotWarning, quote
+from pianobot.files import check_writable
+from pianobot.learn.config import LEARNERS, MAX_ENVS, DaggerConfig, TrainConfig
+from pianobot.learn.explore import EXPLORATIONS
+from pianobot.music.phrases import DEFAULT_MAX_NOTES
+from pianobot.music.tasks import FAMILIES, MELODY, TASKS
+from pianobot.sim.world import WorldConfig
+
+
+def train(
+    song: Optional[Path] = typer.Argument(None, help="A .mid file with fingering; leave out with --task."),
+    task: Optional[str] = typer.Option(
+        None,
+        "--task",
+        help=f"Train on a task family instead, a fresh random instance each episode: the paper's {', '.join(TASKS)}, "
+        f"or {MELODY} (random one-hand phrases of up to {DEFAULT_MAX_NOTES} notes in every key, fingered by the "
+        "planner; docs/training.md).",
+    ),
+    steps: int = typer.Option(
+        TrainConfig.steps,
+        "--steps",
+        help="Environment steps per phrase (of all --envs together), exploration included.",
+    ),
+    seed: int = typer.Option(
+        TrainConfig.seed, "--seed", help="Seed of the simulation, the exploration and the networks."
+    ),
+    learner: str = typer.Option(
+        TrainConfig.learner,
+        "--learner",
+        help="How policies learn: sac (Soft Actor-Critic from the rewards, the paper's) or dagger (imitating the "
+        f"scripted pianist in rounds of {DaggerConfig.round_steps} steps, every step labelled with its action; "
+        "needs --control velocity or position; docs/training.md).",
+    ),
+    round_steps: int = typer.Option(
+        DaggerConfig.round_steps,
+        "--round-steps",
+        help="With --learner dagger: environment steps gathered in a round, after which the policy learns from every "
+        "step gathered so far and is evaluated (a round ends at the first episode end after them).",
+    ),
+    until_f1: Optional[float] = typer.Option(
+        TrainConfig.until_f1,
+        "--until-f1",
+        help="Stop a phrase early once an evaluation reaches this note F1 (e.g. 0.95); default: train every step, "
+        f"or, starting from the general policy, stop at {TrainConfig.finetune_until_f1}.",
+    ),
+    from_general: bool = typer.Option(
+        TrainConfig.from_general,
+        "--from-general/--no-from-general",
+        help="Start every phrase from the general policy (the newest `pianobot train --task melody` policy in --models "
+        "whose options are this run's, or --general-policy): load its actor, encoder, critic and temperature (Adam "
+        "starts afresh), evaluate it before any training step, and stop the phrase at the first evaluation that "
+        f"reaches note F1 {TrainConfig.finetune_until_f1} (--until-f1 sets another), keeping the best evaluated "
+        "policy: a phrase the general policy already plays costs one evaluation, and none ends worse than the "
+        "general policy plays it. Without a general policy, or with --no-from-general, phrases train from scratch. "
+        "With --task: on only when --general-policy is given.",
+    ),
+    general_policy: Optional[Path] = typer.Option(
+        None,
+        "--general-policy",
+        help="The policy to start from (any trained policy; default: the newest `pianobot train --task melody` "
+        "policy in --models whose options fit). With --task there is no default: a task family trains from scratch, "
+        "or, given this, that policy's training goes on, on the family.",
+    ),
+    workers: int = typer.Option(1, "--workers", help="Train this many phrases at once, in separate processes."),
+    threads: int = typer.Option(
+        1, "--threads", help="Torch threads per training process (workers x threads should not exceed the cores)."
+    ),
+    envs: int = typer.Option(
+        TrainConfig.envs,
+        "--envs",
+        help="Environments each policy's training steps at once: 1 in the training process, more each in a worker "
+        "process of its own.",
+    ),
+    device: str = typer.Option(
+        TrainConfig.device,
+        "--device",
+        help="Where the learner's networks and updates run: auto (cuda when torch sees a GPU, else cpu), cpu or cuda.",
+    ),
+    control: str = typer.Option(
+        WorldConfig.control,
+        "--control",
+        help="Finger control: velocity (joint speeds), position (joint angle targets) or torque.",
+    ),
+    reward: str = typer.Option(RewardConfig.kind, "--reward", help="Reward: linear, squared or wasserstein."),
+    explore: str = typer.Option(
+        TrainConfig.explore, "--explore", help=f"Exploration before learning: {', '.join(EXPLORATIONS)}."
+    ),
+    exploration_steps: int = typer.Option(
+        SACConfig.exploration_steps, "--exploration-steps", help="Steps of exploration before learning starts."
+    ),
+    actor: Optional[str] = typer.Option(
+        None,
+        "--actor",
+        help=f"The actor's networks: {' or '.join(ACTORS)} (one MLP shared by the fingers; docs/training.md). "
+        f"Default: the start policy's when training from one, else {SACConfig.actor}.",
+    ),
+    tactile: bool = typer.Option(
+        EnvConfig.tactile, "--tactile/--no-tactile", help="Observe the fingertips' tactile images."
+    ),
+    joints: str = typer.Option(
+        ",".join(EnvConfig.actuated),
+        "--joints",
+        help="Finger joints the policy moves, from abd,mcp,pip,dip; the others hold still.",
+    ),
+    fingering_gate: bool = typer.Option(
+        RewardConfig.fingering_gate,
+        "--fingering-gate/--no-fingering-gate",
+        help="Reward a key only when the score's finger pressed it (the paper's fingering indicator).",
+    ),
+    force: bool = typer.Option(False, "--force", help="Retrain phrases that already have a stored policy."),
+    models: Path = typer.Option(Path("models"), "--models", help="Folder of the model store."),
+    cluster: str = typer.Option(
+        "local",
+        "--cluster",
+        help="Where phrases train: 'local' (--workers processes here) or 'ray' (Ray tasks on the cluster RAY_ADDRESS "
+        "names, or a local Ray runtime; needs pianobot[ray]).",
+    ),
+    json_path: Optional[Path] = typer.Option(
+        None, "--json", help="Also write each policy's figures and files to this JSON file ('-': standard output)."
+    ),
+    track: Optional[str] = Track,
+    tempo: Optional[float] = Tempo,
+    transpose: int = Transpose,
+    fingering: Optional[Path] = Fingering,
+    hand_part: Optional[str] = Hand,
+    split: str = Split,
+    quantize: Optional[str] = Quantize,
+    refinger: bool = Refinger,
+    lowest_note: str = LowestNote,
+    keys: int = Keys,
+    thumb: bool = Thumb,
+    phrase_notes: int = PhraseNotes,
+):
+    """Train one Soft Actor-Critic policy per phrase of a piece (or one for a task family) and store them."""
+    from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
+
+    from pianobot.agent import store
+    from pianobot.agent.general import find_general
+    from pianobot.agent.sac import resolve_device
+    from pianobot.cli import display
+    from pianobot.learn.jobs import general_start, phrase_jobs, plan_jobs, run_jobs, run_jobs_on_ray, task_job
+    from pianobot.learn.log import LOG_FILE, PLOT_FILE
+    from pianobot.learn.train import TASK_EVAL_EPISODES
+    from pianobot.music.phrases import split_phrases
+    from pianobot.sim.hand import HandConfig
+    from pianobot.sim.keyboard import KeyboardConfig
+
+    if (song is None) == (task is None):
+        raise PianobotError("give a .mid file to train on, or --task NAME (not both)")
+    if task is not None and task not in FAMILIES:
+        raise PianobotError(f"--task {quote(task)}: choose one of {', '.join(FAMILIES)}")
+    if workers < 1 or threads < 1:
+        raise PianobotError(f"--workers {workers} --threads {threads}: give 1 or more of each")
+    if not 1 <= envs <= MAX_ENVS:
+        raise PianobotError(f"--envs {envs}: give 1 to {MAX_ENVS} environments")
+    if learner not in LEARNERS:
+        raise PianobotError(f"--learner {quote(learner)}: choose one of {', '.join(LEARNERS)}")
+    if cluster not in ("local", "ray"):
+        raise PianobotError(f"--cluster {quote(cluster)}: choose local or ray")
+    resolve_device(device)  # a GPU asked for and missing: say so before any work
+    cores = os.cpu_count() or 1
+    # the environment workers step while the learner waits for them, and the learner updates while they wait
+    busy = workers * max(threads, envs)
+    if cluster == "local" and busy > cores:
+        asked = f"--workers {workers} x --{'threads' if threads >= envs else 'envs'} {max(threads, envs)}"
+        warnings.warn(
+            PianobotWarning(
+                f"{asked} asks for {busy} busy threads on {cores} cores: torch's thread pools then spin against each "
+                f"other (measured up to 20x slower); keep workers x threads (and workers x envs) <= {cores}"
+            )
+        )
+    if task is not None and workers > 1:
+        warnings.warn(
+            PianobotWarning(
+                f"--task trains one policy: --workers {workers} has nothing to share out (--envs steps several environments)"
+            )
+        )
+    if json_path is not None and str(json_path) != "-":
+        check_writable(json_path)
+    console = err if json_path is not None and str(json_path) == "-" else out  # standard output carries the JSON
+    if models.exists() and not models.is_dir():
+        raise PianobotError(f"--models {models} is a file: give a folder")
+    keyboard, hand = make_instrument(lowest_note, keys, thumb)
+    with option("--control", control):
+        world = WorldConfig(keyboard=KeyboardConfig(spec=keyboard), hand=HandConfig(spec=hand), control=control)
+    with option("--reward", reward):
+        rewards = RewardConfig(kind=reward, fingering_gate=fingering_gate)
+    with option("--joints", joints):
+        env = EnvConfig(
+            world=world,
+            reward=rewards,
+            tactile=tactile,
+            actuated=tuple(j.strip() for j in joints.split(",") if j.strip()),
+        )
+    with option("--round-steps", round_steps):
+        DaggerConfig(round_steps=round_steps)
+    if actor is not None and actor not in ACTORS:
+        raise PianobotError(f"--actor {quote(actor)}: choose one of {', '.join(ACTORS)}")
+    with option("--exploration-steps", exploration_steps):
+        sac = SACConfig(exploration_steps=exploration_steps, actor=actor or SACConfig.actor)
+    with option():
+        config = TrainConfig(
+            steps=steps,
+            seed=seed,
+            learner=learner,
+            dagger=DaggerConfig(round_steps=round_steps),
+            explore=explore,
+            until_f1=until_f1,
+            # a task family trains from scratch, or continues the policy --general-policy names
+            from_general=from_general and (task is None or general_policy is not None),
+            sac=sac,
+            env=env,
+            eval_episodes=TASK_EVAL_EPISODES if task is not None else TrainConfig.eval_episodes,
+            envs=envs,
+            device=device,
+        )
+    if general_policy is not None and not from_general:
+        raise PianobotError(
+            f"--general-policy {general_policy} and --no-from-general ask for opposite things: give one of them"
+        )
+    if general_policy is not None:
+        find_general(models, path=general_policy)  # a folder that holds no policy: said before any work
+    # where the run begins, before its folders are named: a run from a policy takes its networks
+    config, start = general_start(config, models, general_policy, networks_given=actor is not None)
+    if task is not None:
+        job = task_job(task, config, models)
+        refuse_training_into(general_policy, [job])
+        todo, done = plan_jobs([job], force)
+        label = f"task {task}"
+        if start is not None and todo and store.checkpoint_state(job.folder) is None:  # (else it resumes, and says so)
+            console.print(f"continuing the policy {said(start)} on {said(label)}: evaluated first", soft_wrap=True)
+    else:
+        piece = read_song(
+            song, make_options(track, tempo, transpose, fingering, hand_part, split, quantize, refinger), keyboard, hand
+        )
+        phrases = split_phrases(piece, phrase_notes)
+        jobs = phrase_jobs(phrases, config, models, piece=song.name)
+        refuse_training_into(general_policy, jobs)
+        label = f"{song.name}: {len(phrases)} phrases"
+        if force or not all(store.is_trained(job.folder) for job in jobs):  # (before --force removes a policy)
+            if start is not None:
+                console.print(
+                    f"starting every phrase from the general policy {said(start)}: evaluated first, a phrase stops at "
+                    f"note F1 {config.stop_f1} (--no-from-general trains from scratch)",
+                    soft_wrap=True,
+                )
+            elif from_general:
+                console.print(
+                    f"[dim]no general policy in {said(models)} (`pianobot train --task melody` trains one): "
+                    "training from scratch[/dim]"
+                )
+        todo, done = plan_jobs(jobs, force)
+    models.mkdir(parents=True, exist_ok=True)
+    for job in done:
+        console.print(
+            f"phrase {job.key} ({', '.join(map(str, job.phrases))}) already trained in {said(job.folder)}: skipped (--force retrains)"
+        )
+    console.print(f"training {len(todo)} polic{'y' if len(todo) == 1 else 'ies'} for {said(label)}, {steps} steps each")
+    returns: dict[str, float] = {}
+    with Progress(
+        TextColumn("{task.description}"),
+        BarColumn(),
+        TextColumn("{task.completed}/{task.total} steps"),
+        TextColumn("{task.fields[status]}"),
+        TimeRemainingColumn(),
+        console=console,
+    ) as bar:
+        rows = {
+            job.key: bar.add_task(f"phrase {job.key[:8]}" if task is None else job.key, total=steps, status="")
+            for job in todo
+        }
+
+        def on_progress(key: str, progress) -> None:
+            if progress.resumed:
+                bar.console.print(
+                    f"{bar.tasks[rows[key]].description}: resuming from its checkpoint at step {progress.step}"
+                )
+            if progress.finished:  # stopped early (--until-f1) or at its last step: the bar ends full
+                bar.update(rows[key], total=progress.step, completed=progress.step)
+                return
+            status = bar.tasks[rows[key]].fields.get("status", "")
+            if progress.episode_return is not None:
+                returns[key] = progress.episode_return
+            if progress.eval_f1 is not None:
+                status = f"eval F1 {progress.eval_f1:.2f}"
+            elif key in returns:
+                status = f"return {returns[key]:.1f}" + (f" | {status.split(' | ')[-1]}" if "eval" in status else "")
+            bar.update(rows[key], completed=progress.step, status=status)
+
+        if cluster == "ray":
+            results = run_jobs_on_ray(todo, config, on_progress, threads=threads, start=start)
+        else:
+            results = run_jobs(todo, config, workers, on_progress, threads=threads, start=start)
+    trained = [(job, results.get(job.key) or store.read_manifest(job.folder)) for job in done + todo]
+    console.print(display.training_table(trained))
+    console.print(f"learning curves: {LOG_FILE} and {PLOT_FILE} in each policy's folder")
+    if json_path is not None:
+        summary = [
+            {
+                "key": job.key,
+                "phrases": job.phrases,
+                "folder": str(job.folder),
+                "trained_now": job in todo,
+                **{k: manifest.get(k) for k in ("steps", "updates", "seconds", "start", "evaluation")},
+                "log": str(job.folder / LOG_FILE),
+                "plot": str(job.folder / PLOT_FILE),
+            }
+            for job, manifest in trained
+        ]
+        write_json(json_path, {"policies": summary})
