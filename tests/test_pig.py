@@ -128,16 +128,34 @@ def test_long_texts_in_pig_files_are_quoted_short(tmp_path):
 
 
 def test_sidecar_matching_takes_the_nearest_unused_note_quickly(tmp_path):
-    """Matching looks only at PIG notes of the same pitch near the onset (not every note for every note)."""
-    import time
+    """Matching looks only at PIG notes of the same pitch near the onset (not every note for every
+    note): the lines of Python it runs grow as the notes do, not as their square (the time it takes:
+    ``python benchmarks/reading.py``)."""
+    import sys
 
     from pianobot.music.piece import Note, Piece
 
-    piece = Piece(tuple(Note(i * 0.1, 60 + i % 12, i * 0.1 + 0.1, 80, 2 + i % 3) for i in range(20_000)))
-    write_pig(piece, tmp_path / "many.txt")
-    start = time.perf_counter()
-    assert apply_fingering(piece.without_fingering(), tmp_path / "many.txt") == piece
-    assert time.perf_counter() - start < 10  # every note against every note: 4e8 comparisons, minutes
+    def lines_run(notes: int) -> int:
+        piece = Piece(tuple(Note(i * 0.1, 60 + i % 12, i * 0.1 + 0.1, 80, 2 + i % 3) for i in range(notes)))
+        write_pig(piece, tmp_path / f"{notes}.txt")
+        unfingered, count = piece.without_fingering(), [0]
+
+        def trace(frame, event, arg):  # every line of Python it runs, in pig.py and below
+            if event == "line":
+                count[0] += 1
+            return trace
+
+        tracing = sys.gettrace()  # a coverage run's, say
+        sys.settrace(trace)
+        try:
+            matched = apply_fingering(unfingered, tmp_path / f"{notes}.txt")
+        finally:
+            sys.settrace(tracing)
+        assert matched == piece
+        return count[0]
+
+    small, large = lines_run(1_000), lines_run(4_000)
+    assert large / small < 5  # four times the notes, four times the work; every note against every note: 16
     near = Piece((Note(0.0, 60, 0.5, 80), Note(0.01, 60, 0.5, 80)))
     write_pig(Piece((Note(0.02, 60, 0.5, 80, 3), Note(0.0, 60, 0.5, 80, 2))), tmp_path / "near.txt")
     assert [n.finger for n in apply_fingering(near, tmp_path / "near.txt")] == [2, 3]

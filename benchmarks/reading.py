@@ -1,0 +1,99 @@
+"""Reading long files: the timed side of two unit tests that bound the work instead
+(tests/test_midi_io.py's tempo map, tests/test_pig.py's sidecar matching).
+
+    python benchmarks/reading.py [--repeats 5]
+
+- a tempo map of 8,000 tempo changes: the times of 16,000 ticks (each found by bisection;
+  walking the changes instead took several seconds);
+- a .mid file of those 8,000 tempo changes and 2,000 notes, read whole (``read_midi``);
+- a PIG sidecar's fingering applied to a piece of 20,000 notes (``apply_fingering``: each note
+  against the PIG notes of its pitch near its onset; every note against every note took minutes).
+
+Each figure is the median of ``--repeats`` runs, in a fresh temporary folder.
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import tempfile
+import time
+from pathlib import Path
+from typing import Callable
+
+import mido
+
+from pianobot.music.midi_io import _TempoMap, read_midi
+from pianobot.music.piece import Note, Piece
+from pianobot.music.pig import apply_fingering, write_pig
+
+TEMPO_CHANGES = 8_000
+LOOKUPS = 16_000
+NOTES_IN_MIDI = 2_000
+NOTES_IN_PIG = 20_000
+
+
+def tempo_midi(notes: int = 0) -> mido.MidiFile:
+    """A tempo change every 10 ticks (as the unit test has them), and ``notes`` notes of 40 ticks."""
+    midi = mido.MidiFile(ticks_per_beat=480)
+    midi.tracks.append(
+        mido.MidiTrack(mido.MetaMessage("set_tempo", tempo=400_000 + i % 7, time=10) for i in range(TEMPO_CHANGES))
+    )
+    track = mido.MidiTrack()
+    for i in range(notes):
+        track.append(mido.Message("note_on", note=60 + i % 12, velocity=80, time=0))
+        track.append(mido.Message("note_off", note=60 + i % 12, velocity=0, time=40))
+    midi.tracks.append(track)
+    return midi
+
+
+def median_seconds(work: Callable[[Path], Callable[[], object]], repeats: int) -> float:
+    """``work(folder)`` prepares one run and returns what to time."""
+    seconds = []
+    for _ in range(repeats):
+        with tempfile.TemporaryDirectory() as folder:
+            run = work(Path(folder))
+            start = time.perf_counter()
+            run()
+            seconds.append(time.perf_counter() - start)
+    return statistics.median(seconds)
+
+
+def tempo_lookups(folder: Path) -> Callable[[], object]:
+    tempo_map = _TempoMap(tempo_midi(), folder / "t.mid")
+    step = TEMPO_CHANGES * 10 // LOOKUPS
+    return lambda: [tempo_map.seconds(tick) for tick in range(0, TEMPO_CHANGES * 10, step)]
+
+
+def midi_read(folder: Path) -> Callable[[], object]:
+    path = folder / "tempos.mid"
+    tempo_midi(NOTES_IN_MIDI).save(path)
+    return lambda: read_midi(path)
+
+
+def pig_matching(folder: Path) -> Callable[[], object]:
+    piece = Piece(tuple(Note(i * 0.1, 60 + i % 12, i * 0.1 + 0.1, 80, 2 + i % 3) for i in range(NOTES_IN_PIG)))
+    write_pig(piece, folder / "many.txt")
+    unfingered = piece.without_fingering()
+    return lambda: apply_fingering(unfingered, folder / "many.txt")
+
+
+def main(argv: list[str] | None = None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--repeats", type=int, default=5)
+    args = parser.parse_args(argv)
+    if args.repeats < 1:
+        parser.error("--repeats must be at least 1")
+    figures = (
+        (f"{LOOKUPS:,} tick times, {TEMPO_CHANGES:,} tempo changes", tempo_lookups),
+        (f"read_midi: {TEMPO_CHANGES:,} tempo changes, {NOTES_IN_MIDI:,} notes", midi_read),
+        (f"apply_fingering: a PIG sidecar of {NOTES_IN_PIG:,} notes", pig_matching),
+    )
+    print(f"| figure | median of {args.repeats} |")
+    print("| --- | ---: |")
+    for name, work in figures:
+        print(f"| {name} | {median_seconds(work, args.repeats):.3f} s |", flush=True)
+
+
+if __name__ == "__main__":
+    main()
