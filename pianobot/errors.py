@@ -6,9 +6,29 @@ and how to fix it. The CLI prints that line and exits with code 2; nothing else 
 reach the user as a traceback.
 """
 
+from __future__ import annotations
+
 
 class PianobotError(Exception):
     """A problem with the user's input, worded as one line: what is wrong and how to fix it."""
+
+
+class SettingError(PianobotError):
+    """A problem with one or more settings, each named in the message by its field's dotted path
+    (``load.tempo`` for :class:`~pianobot.music.load.LoadOptions`' tempo, ``keyboard.count``,
+    ``hand.fingers``, ``phrases.max_notes``, ``train.device``, ``jobs.force``): a Python caller
+    reads the field it set, and the command line writes its option in that place
+    (:mod:`pianobot.cli.flags`). ``fields`` lists the settings the message names, the one at
+    fault first."""
+
+    def __init__(self, message: str, *fields: str):
+        super().__init__(message)
+        self.fields = fields
+
+    @property
+    def field(self) -> str | None:
+        """The setting at fault (the first one the message names)."""
+        return self.fields[0] if self.fields else None
 
 
 class PianobotWarning(UserWarning):

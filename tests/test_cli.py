@@ -219,7 +219,9 @@ def test_play_bad_requests_answer_with_one_line(tmp_path, scale):
     song = EXAMPLES / "one-note.mid"
     assert_one_line_error(run("play", song, "-o", tmp_path / "out.wav"), "*.mid")
     assert_one_line_error(run("play", song, "-o", song), "overwrite")
-    assert_one_line_error(run("play", song, "-o", tmp_path / "x.mid", "--controller", "robot"), "--controller robot")
+    assert_one_line_error(
+        run("play", song, "-o", tmp_path / "x.mid", "--controller", "robot"), "'--controller'", "'robot'"
+    )
     assert_one_line_error(run("play", song, "-o", tmp_path / "x.mid", "--video", tmp_path / "v.gif"), "*.mp4")
     assert_one_line_error(run("play", song, "-o", tmp_path / "x.mid", "--wav", tmp_path / "a.mp3"), "*.wav")
     assert_one_line_error(
@@ -244,11 +246,13 @@ def test_train_bad_requests_answer_with_one_line(tmp_path):
     song = EXAMPLES / "one-note.mid"
     assert_one_line_error(run("train"), "--task")
     assert_one_line_error(run("train", song, "--task", "one-note"), "not both")
-    assert_one_line_error(run("train", "--task", "sonata"), "--task sonata")
+    assert_one_line_error(run("train", "--task", "sonata"), "'--task'", "'sonata'", "'melody'")
     assert_one_line_error(run("train", song, "--steps", "100"), "100 steps must exceed the 15000 exploration steps")
-    assert_one_line_error(run("train", song, "--control", "joint"), "--control joint", "velocity, position, torque")
-    assert_one_line_error(run("train", song, "--reward", "cubic"), "--reward cubic", "linear, squared, wasserstein")
-    assert_one_line_error(run("train", song, "--explore", "wild"), "exploration must be one of", "'wild'")
+    assert_one_line_error(
+        run("train", song, "--control", "joint"), "'--control'", "'joint'", "'velocity', 'position', 'torque'"
+    )
+    assert_one_line_error(run("train", song, "--reward", "cubic"), "'--reward'", "'linear', 'squared', 'wasserstein'")
+    assert_one_line_error(run("train", song, "--explore", "wild"), "'--explore'", "'wild'", "'scripted'")
     assert_one_line_error(
         run("train", song, "--explore", "scripted", "--control", "torque"), "needs velocity or position control"
     )

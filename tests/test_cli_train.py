@@ -90,7 +90,7 @@ def test_train_envs_and_device_options(tmp_path, monkeypatch):
     for args, words in (
         (("--envs", "0"), ("--envs 0", "give 1 to 256")),
         (("--envs", "1000"), ("--envs 1000", "give 1 to 256")),
-        (("--device", "gpu"), ("--device gpu", "auto, cpu, cuda")),
+        (("--device", "gpu"), ("'--device'", "'gpu'", "'auto', 'cpu', 'cuda'")),
     ):
         result = run("train", song, *QUICK, *args, "--models", tmp_path)
         assert result.exit_code == 2 and len(result.stderr.strip().splitlines()) == 1, result.output
@@ -121,7 +121,7 @@ def test_train_with_the_dagger_learner_in_rounds_of_round_steps(tmp_path):
     rounds = [e["round"] for e in manifest["evaluations"] if "round" in e]
     assert rounds == [1, 2, 3]  # rounds end at the first episode ends after 40, 80 and 100 steps
     for args, words in (
-        (("--learner", "ppo"), ("--learner ppo", "sac, dagger")),
+        (("--learner", "ppo"), ("'--learner'", "'ppo'", "'sac', 'dagger'")),
         (("--learner", "dagger", "--round-steps", "0"), ("--round-steps 0",)),
         (("--learner", "dagger", "--control", "torque", "--explore", "prior"), ("velocity or position",)),
     ):

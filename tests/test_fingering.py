@@ -91,7 +91,7 @@ def test_the_planner_is_deterministic():
 
 def test_too_fast_a_leap_is_reported_with_its_notes():
     plan = plan_fingering(melody("C4 B5 C4", beat=0.15))
-    assert plan.problems and "C4" in plan.problems[0] and "B5" in plan.problems[0] and "--tempo" in plan.problems[0]
+    assert plan.problems and "C4" in plan.problems[0] and "B5" in plan.problems[0] and "load.tempo" in plan.problems[0]
     assert not plan_fingering(melody("C4 B5 C4", beat=1.0)).problems
 
 
@@ -180,7 +180,7 @@ def test_hand_option_without_named_tracks(tmp_path):
         piece = load_piece(path, LoadOptions(hand="right"))
     assert min(n.pitch for n in piece.notes) >= 67
     one = write_midi(Piece((Note(0, 48, 1), Note(0, 72, 1), Note(1, 50, 2), Note(1, 74, 2))), tmp_path / "one.mid")
-    with pytest.warns(UserWarning, match="--split"):
+    with pytest.warns(UserWarning, match="load.split"):
         piece = load_piece(one, LoadOptions(hand="right"))
     assert [n.pitch for n in piece.notes] == [72, 74]
 

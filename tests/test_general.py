@@ -313,7 +313,7 @@ def test_a_phrase_trained_from_the_general_policy_takes_its_actor(tmp_path):
     itself = run("train", "--task", "melody", *QUICK, "--general-policy", general, "--models", models, "--force")
     one_line_error(itself, "--general-policy", "the folder this run trains into")
     one_line_error(
-        run("train", "--task", "melody", *QUICK, "--actor", "cnn"), "--actor cnn", "choose one of mlp, fingers"
+        run("train", "--task", "melody", *QUICK, "--actor", "cnn"), "'--actor'", "'cnn'", "'mlp', 'fingers'"
     )
 
 

@@ -20,7 +20,8 @@ def test_notes_outside_the_keyboard_are_named_with_a_transpose_hint():
         check_playable(piece, KEYS, HAND)
     message = str(e.value)
     assert "C3 at 0.000 s" in message and "D3 at 1.000 s" in message
-    assert "--transpose 12" in message and "--lowest-note" in message
+    assert "load.transpose 12" in message and "keyboard.lowest" in message  # the settings; the CLI names its options
+    assert e.value.fields == ("keyboard.lowest", "keyboard.count", "load.transpose")
 
 
 def test_transpose_suggestion_prefers_octaves_and_fails_for_wide_pieces():

@@ -51,8 +51,9 @@ def test_notes_are_sorted_and_transforms_return_new_pieces(scale):
 
 
 def test_transpose_out_of_midi_range_is_an_error(scale):
-    with pytest.raises(PianobotError, match="--transpose 70"):
+    with pytest.raises(PianobotError, match="load.transpose 70") as e:  # the setting, named for Python's callers
         scale.transpose(70)
+    assert e.value.field == "load.transpose"
 
 
 def test_chords_and_polyphony():

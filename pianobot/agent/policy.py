@@ -19,7 +19,7 @@ from pianobot.agent.config import SACConfig
 from pianobot.agent.tasks import make_env
 from pianobot.config import ConfigError, from_dict
 from pianobot.env.piano import EnvConfig, PianoEnv, idle_pose
-from pianobot.errors import PianobotError, quote
+from pianobot.errors import PianobotError, SettingError, quote
 from pianobot.music.piece import Note, Piece
 from pianobot.music.tasks import FAMILIES
 
@@ -59,10 +59,14 @@ def policy_configs(folder: Path) -> tuple[EnvConfig, SACConfig]:
         idle_pose(env.world)  # a hand that can reach the keys at all
         return replace(env, world=replace(env.world, gui=False)), sac
     except ConfigError as e:
-        raise PianobotError(f"{folder / store.MANIFEST_FILE}: {e}: retrain the phrase with --force") from None
+        raise SettingError(
+            f"{folder / store.MANIFEST_FILE}: {e}: retrain the phrase with jobs.force", "jobs.force"
+        ) from None
     except ValueError as e:
-        raise PianobotError(
-            f"{folder / store.MANIFEST_FILE} describes a world pianobot cannot build ({e}): retrain the phrase with --force"
+        raise SettingError(
+            f"{folder / store.MANIFEST_FILE} describes a world pianobot cannot build ({e}): retrain the phrase with "
+            "jobs.force",
+            "jobs.force",
         ) from None
 
 
@@ -73,15 +77,17 @@ def policy_target(folder: Path) -> Piece | str:
     where = folder / store.MANIFEST_FILE
     if isinstance(target, str):
         if target not in FAMILIES:
-            raise PianobotError(
-                f"{where}: task {quote(target)} is not one pianobot knows ({', '.join(FAMILIES)}): retrain with --force"
+            raise SettingError(
+                f"{where}: task {quote(target)} is not one pianobot knows ({', '.join(FAMILIES)}): retrain with "
+                "jobs.force",
+                "jobs.force",
             )
         return target
     try:
         return Piece(tuple(Note(**note) for note in target))
     except (TypeError, ValueError, PianobotError) as e:
-        raise PianobotError(
-            f"{where} does not record the phrase it was trained on ({e}): retrain with --force"
+        raise SettingError(
+            f"{where} does not record the phrase it was trained on ({e}): retrain with jobs.force", "jobs.force"
         ) from None
 
 
@@ -101,7 +107,9 @@ def load_policy(folder: Path, env: PianoEnv) -> SAC:
     try:
         agent.load_tensors(tensors, with_training_state=False)
     except ValueError as e:
-        raise PianobotError(
-            f"{folder / store.POLICY_FILE} does not fit its manifest's configuration ({e}): retrain the phrase with --force"
+        raise SettingError(
+            f"{folder / store.POLICY_FILE} does not fit its manifest's configuration ({e}): retrain the phrase with "
+            "jobs.force",
+            "jobs.force",
         ) from None
     return agent

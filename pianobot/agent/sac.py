@@ -26,7 +26,7 @@ from torch import nn
 from torch.nn import functional as F
 
 from pianobot.agent.config import DEVICES, SACConfig
-from pianobot.errors import PianobotError, quote
+from pianobot.errors import SettingError, quote
 
 # -- observation layout -----------------------------------------------------------------------
 VECTOR_KEYS = ("score", "wrist", "joints", "joint_velocities", "targets", "keys", "key_velocities")
@@ -289,13 +289,14 @@ def resolve_device(name: str) -> torch.device:
     """The device the learner runs on: 'cpu', 'cuda', or 'auto' (cuda when torch sees a GPU, else
     cpu). Asking for cuda where torch sees none is a one-line :class:`PianobotError`."""
     if name not in DEVICES:
-        raise PianobotError(f"--device {quote(name)}: choose one of {', '.join(DEVICES)}")
+        raise SettingError(f"train.device {quote(name)}: choose one of {', '.join(DEVICES)}", "train.device")
     if name == "auto":
         name = "cuda" if torch.cuda.is_available() else "cpu"
     if name == "cuda" and not torch.cuda.is_available():
-        raise PianobotError(
-            f"--device cuda: torch {torch.__version__} sees no CUDA GPU on this machine: use --device cpu, or auto "
-            "(cuda where there is one)"
+        raise SettingError(
+            f"train.device cuda: torch {torch.__version__} sees no CUDA GPU on this machine: use train.device cpu, "
+            "or auto (cuda where there is one)",
+            "train.device",
         )
     return torch.device(name)
 

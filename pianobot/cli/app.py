@@ -8,10 +8,13 @@ that need them, so that `pianobot --version` and `pianobot score` start quickly.
 
 from __future__ import annotations
 
+import contextlib
 import functools
+import re
 import warnings
 
 import typer
+from typer.core import TyperGroup
 
 from pianobot import __version__
 from pianobot.cli.commands.export import export
@@ -20,22 +23,54 @@ from pianobot.cli.commands.inspect import inspect
 from pianobot.cli.commands.play import play
 from pianobot.cli.commands.score import score
 from pianobot.cli.commands.train import train
+from pianobot.cli.flags import phrase
 from pianobot.cli.terminal import err, out, said
-from pianobot.errors import PianobotError, PianobotWarning
+from pianobot.errors import QUOTE_LIMIT, PianobotError, PianobotWarning, quote
 from pianobot.files import why
 
+EXIT_BAD_INPUT = 2
+USAGE_ERROR = typer.BadParameter.__base__  # click's UsageError (typer re-exports only its subclass)
+
+
+@contextlib.contextmanager
+def usage_in_one_line():
+    """Typer's own usage errors (a value not among an option's choices, an unknown option, a
+    missing argument) as one red line and exit 2, like every other error, instead of a panel."""
+    try:
+        yield
+    except USAGE_ERROR as e:
+        if type(e).__name__ == "NoArgsIsHelpError":  # (`pianobot` alone: the help, as typer prints it)
+            raise
+        where = f" (`{e.ctx.command_path} --help` lists the options)" if e.ctx is not None else ""
+        message = re.sub(r"'([^']{%d,})'" % (QUOTE_LIMIT + 1), lambda m: f"'{quote(m.group(1))}'", e.format_message())
+        err.print(f"[red]error:[/red] {said(message + where)}", highlight=False, emoji=False, soft_wrap=True)
+        raise typer.Exit(e.exit_code) from None
+
+
+class OneLineUsageGroup(TyperGroup):
+    """The command group, parsing its own and its commands' arguments through :func:`usage_in_one_line`."""
+
+    def make_context(self, *args, **kwargs):
+        with usage_in_one_line():
+            return super().make_context(*args, **kwargs)
+
+    def invoke(self, ctx):
+        with usage_in_one_line():
+            return super().invoke(ctx)
+
+
 app = typer.Typer(
+    cls=OneLineUsageGroup,
     help="Teach a simulated robot hand with touch sensors to play the piano from MIDI files.",
     no_args_is_help=True,
     add_completion=True,
     pretty_exceptions_enable=False,
 )
 
-EXIT_BAD_INPUT = 2
-
 
 def friendly(command):
-    """Turn PianobotError into one red line + exit 2, and show warnings in yellow.
+    """Turn PianobotError into one red line + exit 2, and show warnings in yellow; either names
+    the settings it mentions by their options (:func:`pianobot.cli.flags.phrase`).
 
     An OSError that escaped the library (the file system failed us where no one expected it)
     gets the same one line, never a traceback.
@@ -48,7 +83,9 @@ def friendly(command):
             try:
                 return command(*args, **kwargs)
             except PianobotError as e:
-                err.print(f"[red]error:[/red] {said(e)}", markup=True, highlight=False, emoji=False, soft_wrap=True)
+                err.print(
+                    f"[red]error:[/red] {said(phrase(e))}", markup=True, highlight=False, emoji=False, soft_wrap=True
+                )
                 raise typer.Exit(EXIT_BAD_INPUT) from None
             except OSError as e:
                 where = f"{e.filename}: " if e.filename else ""
@@ -61,7 +98,10 @@ def friendly(command):
                 for w in caught:
                     if issubclass(w.category, PianobotWarning):
                         err.print(
-                            f"[yellow]warning:[/yellow] {said(w.message)}", highlight=False, emoji=False, soft_wrap=True
+                            f"[yellow]warning:[/yellow] {said(phrase(w.message))}",
+                            highlight=False,
+                            emoji=False,
+                            soft_wrap=True,
                         )
 
     return wrapper

@@ -3,17 +3,29 @@
 from __future__ import annotations
 
 import contextlib
+import functools
+import inspect
 import os
 import warnings
+from dataclasses import dataclass
+from enum import StrEnum
 from pathlib import Path
+from typing import Optional
 
 import typer
 
+from pianobot.agent.config import ACTORS, DEVICES
+from pianobot.env.rewards import REWARDS
 from pianobot.errors import PianobotError, PianobotWarning, quote
+from pianobot.learn.config import LEARNERS
+from pianobot.learn.explore import EXPLORATIONS
 from pianobot.music.instrument import HandSpec, KeyboardSpec
-from pianobot.music.load import LoadOptions
+from pianobot.music.load import HANDS, LoadOptions
 from pianobot.music.phrases import DEFAULT_MAX_NOTES
 from pianobot.music.piece import Piece, parse_pitch, pitch_name
+from pianobot.music.tasks import FAMILIES
+from pianobot.perform.controllers import CONTROLLERS
+from pianobot.sim.world import CONTROL_MODES
 
 
 @contextlib.contextmanager
@@ -26,20 +38,33 @@ def option(name: str | None = None, value=None):
         raise PianobotError(f"{name} {quote(str(value))}: {e}" if name else str(e)) from None
 
 
+# -- choices -----------------------------------------------------------------------------------
+def choices(name: str, values: tuple[str, ...]) -> type[StrEnum]:
+    """The allowed values of an option, from the library's tuple of them: typer lists them in
+    ``--help`` and refuses any other value with its own usage error (exit 2). A command passes
+    ``.value`` on to the library."""
+    return StrEnum(name, {value: value for value in values})
+
+
+Controller = choices("Controller", CONTROLLERS)
+Fallback = choices("Fallback", ("scripted",))
+Learner = choices("Learner", LEARNERS)
+Cluster = choices("Cluster", ("local", "ray"))
+Task = choices("Task", FAMILIES)
+Control = choices("Control", CONTROL_MODES)
+Reward = choices("Reward", REWARDS)
+Explore = choices("Explore", EXPLORATIONS)
+Actor = choices("Actor", ACTORS)
+HandPart = choices("HandPart", HANDS)
+Device = choices("Device", DEVICES)
+
+
+def value(choice: StrEnum | None) -> str | None:
+    """The plain string of a choice (None stays None), for the library's configurations."""
+    return None if choice is None else choice.value
+
+
 # -- shared options --------------------------------------------------------------------------
-Track = typer.Option(None, "--track", help="Read only this track (index or name); default: merge all tracks.")
-Tempo = typer.Option(None, "--tempo", help="Re-time the piece at this constant tempo in bpm (the paper uses 60).")
-Transpose = typer.Option(LoadOptions.transpose, "--transpose", help="Shift every note by this many semitones.")
-Fingering = typer.Option(
-    None,
-    "--fingering",
-    help="PIG fingering file for the notes (default: <song>_fingering.txt beside the .mid, if any).",
-)
-LowestNote = typer.Option(
-    pitch_name(KeyboardSpec.lowest), "--lowest-note", help="Lowest key of the keyboard (name like C4, or MIDI number)."
-)
-Keys = typer.Option(KeyboardSpec.count, "--keys", help="Number of keys on the keyboard.")
-Thumb = typer.Option(False, "--thumb", help="Let the hand use its thumb (finger 1) too.")
 PhraseNotes = typer.Option(DEFAULT_MAX_NOTES, "--phrase-notes", help="Most notes in one phrase (one policy each).")
 GeneralPolicy = typer.Option(
     None,
@@ -52,41 +77,155 @@ PlayPhraseNotes = typer.Option(
     "--phrase-notes",
     help=f"Most notes in one phrase (default: the longest phrases, up to {DEFAULT_MAX_NOTES} notes, whose policies are all trained).",
 )
-Hand = typer.Option(
-    None,
-    "--hand",
-    help="Play one hand's part of a two-hand piece: right or left (tracks named for it, else split by pitch).",
-)
-Split = typer.Option(
-    pitch_name(LoadOptions.split),
-    "--split",
-    help="With --hand and no track named for it: lowest note of the right hand's part.",
-)
-Quantize = typer.Option(
-    None, "--quantize", help="Move onsets and offsets to a grid, e.g. 1/16 (for recordings of human players)."
-)
 AllRows = typer.Option(False, "--all", help="List every note and phrase (by default the tables stop after 100 rows).")
-Refinger = typer.Option(
-    LoadOptions.refinger,
-    "--refinger",
-    help="Replace the file's fingering with the planner's (e.g. human fingering for five fingers).",
-)
+
+# -- reading a piece, once for every command that reads one ---------------------------------------
+PIECE = "Reading the piece"
+INSTRUMENT = "Keyboard and hand"
+READING = {  # parameter name: (type, option); the commands' --help shows them in two panels of their own
+    "track": (
+        Optional[str],
+        typer.Option(
+            None,
+            "--track",
+            help="Read only this track (index or name); default: merge all tracks.",
+            rich_help_panel=PIECE,
+        ),
+    ),
+    "tempo": (
+        Optional[float],
+        typer.Option(
+            None,
+            "--tempo",
+            help="Re-time the piece at this constant tempo in bpm (the paper uses 60).",
+            rich_help_panel=PIECE,
+        ),
+    ),
+    "transpose": (
+        int,
+        typer.Option(
+            LoadOptions.transpose, "--transpose", help="Shift every note by this many semitones.", rich_help_panel=PIECE
+        ),
+    ),
+    "fingering": (
+        Optional[Path],
+        typer.Option(
+            None,
+            "--fingering",
+            help="PIG fingering file for the notes (default: <song>_fingering.txt beside the .mid, if any).",
+            rich_help_panel=PIECE,
+        ),
+    ),
+    "hand_part": (
+        Optional[HandPart],
+        typer.Option(
+            None,
+            "--hand",
+            help="Play one hand's part of a two-hand piece: right or left (tracks named for it, else split by pitch).",
+            rich_help_panel=PIECE,
+        ),
+    ),
+    "split": (
+        str,
+        typer.Option(
+            pitch_name(LoadOptions.split),
+            "--split",
+            help="With --hand and no track named for it: lowest note of the right hand's part.",
+            rich_help_panel=PIECE,
+        ),
+    ),
+    "quantize": (
+        Optional[str],
+        typer.Option(
+            None,
+            "--quantize",
+            help="Move onsets and offsets to a grid, e.g. 1/16 (for recordings of human players).",
+            rich_help_panel=PIECE,
+        ),
+    ),
+    "refinger": (
+        bool,
+        typer.Option(
+            LoadOptions.refinger,
+            "--refinger",
+            help="Replace the file's fingering with the planner's (e.g. human fingering for five fingers).",
+            rich_help_panel=PIECE,
+        ),
+    ),
+    "lowest_note": (
+        str,
+        typer.Option(
+            pitch_name(KeyboardSpec.lowest),
+            "--lowest-note",
+            help="Lowest key of the keyboard (name like C4, or MIDI number).",
+            rich_help_panel=INSTRUMENT,
+        ),
+    ),
+    "keys": (
+        int,
+        typer.Option(KeyboardSpec.count, "--keys", help="Number of keys on the keyboard.", rich_help_panel=INSTRUMENT),
+    ),
+    "thumb": (
+        bool,
+        typer.Option(False, "--thumb", help="Let the hand use its thumb (finger 1) too.", rich_help_panel=INSTRUMENT),
+    ),
+}
 
 
-def make_options(
-    track, tempo, transpose, fingering, hand=None, split=None, quantize=None, refinger=False
-) -> LoadOptions:
-    split = LoadOptions.split if split is None else parse_pitch(split)
-    return LoadOptions(
-        track=track,
-        tempo=tempo,
-        transpose=transpose,
-        fingering=fingering,
-        hand=hand,
-        split=split,
-        quantize=quantize,
-        refinger=refinger,
+@dataclass(frozen=True)
+class Reading:
+    """What the reading options say: how to read the piece, and the keyboard and hand it is read for."""
+
+    options: LoadOptions
+    keyboard: KeyboardSpec
+    hand: HandSpec
+
+
+def make_reading(**given) -> Reading:
+    """The :class:`Reading` of the reading options' values; an option a command does not offer
+    keeps its default."""
+    values = {name: option.default for name, (_, option) in READING.items()} | given
+    return Reading(
+        options=LoadOptions(
+            track=values["track"],
+            tempo=values["tempo"],
+            transpose=values["transpose"],
+            fingering=values["fingering"],
+            hand=value(values["hand_part"]),
+            split=parse_pitch(values["split"]),
+            quantize=values["quantize"],
+            refinger=values["refinger"],
+        ),
+        keyboard=KeyboardSpec(lowest=parse_pitch(values["lowest_note"]), count=values["keys"]),
+        hand=HandSpec(fingers=(1,) + HandSpec.fingers if values["thumb"] else HandSpec.fingers),
     )
+
+
+def reads(*, without: tuple[str, ...] = ()):
+    """Give a command the reading options (all of them but ``without``): they are added to its
+    signature, after its own parameters, and reach it as one ``reading: Reading`` argument."""
+    unknown = set(without) - set(READING)
+    assert not unknown, f"no reading options {unknown}"
+
+    def decorate(command):
+        own = inspect.signature(command, eval_str=True)
+        added = [
+            inspect.Parameter(name, inspect.Parameter.KEYWORD_ONLY, default=option, annotation=kind)
+            for name, (kind, option) in READING.items()
+            if name not in without
+        ]
+        parameters = [p for p in own.parameters.values() if p.name != "reading"] + added
+
+        @functools.wraps(command)
+        def wrapper(*args, **kwargs):
+            given = {name: kwargs.pop(name) for name in READING if name in kwargs}
+            return command(*args, reading=make_reading(**given), **kwargs)
+
+        wrapper.__signature__ = own.replace(parameters=parameters)
+        wrapper.__annotations__ = {p.name: p.annotation for p in parameters}
+        return wrapper
+
+    return decorate
 
 
 def check_midi_output(output: Path, song: Path, what: str) -> None:
@@ -117,11 +256,6 @@ def read_song(song: Path, options: LoadOptions, keyboard: KeyboardSpec, hand: Ha
             warnings.warn(PianobotWarning(problem))
     check_playable(piece, keyboard, hand)
     return piece
-
-
-def make_instrument(lowest_note: str, keys: int, thumb: bool) -> tuple[KeyboardSpec, HandSpec]:
-    hand = HandSpec(fingers=(1,) + HandSpec.fingers if thumb else HandSpec.fingers)
-    return KeyboardSpec(lowest=parse_pitch(lowest_note), count=keys), hand
 
 
 def refuse_training_into(start: Path | None, jobs) -> None:

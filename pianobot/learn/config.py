@@ -7,7 +7,7 @@ from dataclasses import dataclass, field
 from pianobot.agent.config import DEVICES, SACConfig
 from pianobot.config import ConfigError, check_ranges, from_dict
 from pianobot.env.piano import EnvConfig
-from pianobot.errors import PianobotError
+from pianobot.errors import SettingError
 from pianobot.learn.explore import EXPLORATIONS
 
 MAX_ENVS = 256
@@ -129,4 +129,4 @@ def config_from_manifest(manifest: dict) -> TrainConfig:
     try:
         return from_dict(TrainConfig, manifest["config"])
     except ConfigError as e:
-        raise PianobotError(f"model manifest: {e}: retrain with --force") from None
+        raise SettingError(f"model manifest: {e}: retrain with jobs.force", "jobs.force") from None

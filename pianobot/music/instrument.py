@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from pianobot.errors import PianobotError
+from pianobot.errors import PianobotError, SettingError
 from pianobot.music.piece import FINGER_NAMES, Piece, pitch_name
 
 _BLACK = {1, 3, 6, 8, 10}
@@ -25,11 +25,13 @@ class KeyboardSpec:
 
     def __post_init__(self) -> None:
         if not 1 <= self.count <= 88:
-            raise PianobotError(f"--keys {self.count}: a keyboard has 1 to 88 keys")
+            raise SettingError(f"keyboard.count {self.count}: a keyboard has 1 to 88 keys", "keyboard.count")
         if not 0 <= self.lowest or self.lowest + self.count - 1 > 127:
-            raise PianobotError(
+            raise SettingError(
                 f"a keyboard of {self.count} keys from {pitch_name(self.lowest)} goes past MIDI's "
-                "highest pitch G9: lower --lowest-note or use fewer --keys"
+                "highest pitch G9: lower keyboard.lowest or use fewer keyboard.count",
+                "keyboard.lowest",
+                "keyboard.count",
             )
 
     @property
@@ -105,28 +107,34 @@ def check_playable(piece: Piece, keyboard: KeyboardSpec, hand: HandSpec) -> None
         shift = suggest_transpose(piece, keyboard)
         low, high = min(n.pitch for n in piece.notes), max(n.pitch for n in piece.notes)
         fix = (
-            f"use --transpose {shift}"
+            f"use load.transpose {shift}"
             if shift is not None
             else f"the piece spans {pitch_name(low)}-{pitch_name(high)}, more than the keyboard: if it holds both "
-            "hands' parts, play one with --hand right (or --hand left)"
+            "hands' parts, play one with load.hand right (or load.hand left)"
         )
-        raise PianobotError(
+        raise SettingError(
             f"{len(outside)} note(s) outside the keyboard {keyboard.describe()}: {names}; "
-            f"{fix}, or widen the keyboard with --lowest-note / --keys"
+            f"{fix}, or widen the keyboard with keyboard.lowest / keyboard.count",
+            "keyboard.lowest",
+            "keyboard.count",
+            "load.transpose" if shift is not None else "load.hand",
         )
     polyphony, when = piece.max_polyphony()
     if polyphony > len(hand.fingers):
         sounding = [n.name for n in piece.notes if n.onset <= when < n.offset]
-        raise PianobotError(
+        raise SettingError(
             f"{polyphony} notes sound at once at {when:.3f} s ({', '.join(sounding)}) but the hand has "
-            f"{len(hand.fingers)} fingers: drop notes from that chord (e.g. with --track) or enable the thumb with --thumb"
+            f"{len(hand.fingers)} fingers: drop notes from that chord (e.g. with load.track) or enable the thumb with "
+            "hand.fingers",
+            "hand.fingers",
+            "load.track",
         )
     for note in piece.notes:
         if note.finger is not None and note.finger not in hand.fingers:
             raise PianobotError(
                 f"{note.describe()} is fingered {note.finger} ({FINGER_NAMES[note.finger]}) but the hand "
                 f"plays with fingers {hand.describe()}: change that note's fingering"
-                + (" or enable the thumb with --thumb" if note.finger == 1 else "")
+                + (" or enable the thumb with hand.fingers" if note.finger == 1 else "")
             )
     busy: dict[int, float] = {}
     for note in piece.notes:

@@ -7,7 +7,7 @@ import warnings
 from dataclasses import dataclass, replace
 from pathlib import Path
 
-from pianobot.errors import PianobotError, PianobotWarning, quote
+from pianobot.errors import PianobotError, PianobotWarning, SettingError, quote
 from pianobot.music import midi_io, pig
 from pianobot.music.instrument import HandSpec
 from pianobot.music.piece import Note, Piece, pitch_name
@@ -108,9 +108,9 @@ def _read_midi(path: Path, options: LoadOptions, bpm: float | None = None) -> Pi
     if options.hand is None:
         return midi_io.read_midi(path, track=options.track, bpm=bpm, grid=grid)
     if options.hand not in HANDS:
-        raise PianobotError(f"--hand {quote(options.hand)}: choose right or left")
+        raise SettingError(f"load.hand {quote(options.hand)}: choose right or left", "load.hand")
     if options.track is not None:
-        raise PianobotError("give --track or --hand, not both")
+        raise SettingError("give load.track or load.hand, not both", "load.track", "load.hand")
     tracks = midi_io.describe_tracks(path)
     named = hand_tracks(tracks, options.hand)
     if named:
@@ -127,7 +127,7 @@ def _read_midi(path: Path, options: LoadOptions, bpm: float | None = None) -> Pi
         return midi_io.read_midi(path, tracks=[chosen.index], bpm=bpm, grid=grid)
     warnings.warn(
         PianobotWarning(
-            f"no track is named for a hand: took the notes {'at or above' if options.hand == 'right' else 'below'} {pitch_name(options.split)} (--split)"
+            f"no track is named for a hand: took the notes {'at or above' if options.hand == 'right' else 'below'} {pitch_name(options.split)} (load.split)"
         )
     )
     piece = midi_io.read_midi(path, bpm=bpm, grid=grid)
@@ -136,9 +136,10 @@ def _read_midi(path: Path, options: LoadOptions, bpm: float | None = None) -> Pi
     else:
         notes = [n for n in piece.notes if n.pitch < options.split]
     if not notes:
-        raise PianobotError(
+        raise SettingError(
             f"{path.name} has no notes {'at or above' if options.hand == 'right' else 'below'} "
-            f"{pitch_name(options.split)} for the {options.hand} hand: move the split with --split"
+            f"{pitch_name(options.split)} for the {options.hand} hand: move the split with load.split",
+            "load.split",
         )
     return Piece(tuple(notes), bpm=piece.bpm)
 
@@ -148,11 +149,13 @@ def load_piece(path: str | Path, options: LoadOptions = LoadOptions()) -> Piece:
     path = Path(path)
     if path.suffix.lower() == ".txt":
         if options.tempo is not None:
-            raise PianobotError("--tempo needs a MIDI file: a PIG file has times in seconds but no beats")
+            raise SettingError(
+                "load.tempo needs a MIDI file: a PIG file has times in seconds but no beats", "load.tempo"
+            )
         if options.fingering is not None:
-            raise PianobotError("a PIG file carries its own fingering: drop --fingering")
+            raise SettingError("a PIG file carries its own fingering: drop load.fingering", "load.fingering")
         if options.hand is not None or options.quantize is not None:
-            raise PianobotError("--hand and --quantize need a MIDI file")
+            raise SettingError("load.hand and load.quantize need a MIDI file", "load.hand", "load.quantize")
         piece = pig.read_pig(path)
     elif options.tempo is not None and options.fingering is None and not pig.sidecar_for(path).exists():
         piece = _read_midi(path, options, bpm=options.tempo)  # the file's tempo map is never needed

@@ -22,7 +22,7 @@ from pathlib import Path
 
 import mido
 
-from pianobot.errors import PianobotError, PianobotWarning, quote
+from pianobot.errors import PianobotError, PianobotWarning, SettingError, quote
 from pianobot.files import atomic_write, read_input
 from pianobot.music.piece import MAX_SECONDS, Note, Piece, pitch_name
 
@@ -153,9 +153,10 @@ class _TempoMap:
         self.points: list[tuple[int, float, int]] = [(0, 0.0, 500_000)]  # (tick, seconds at tick, tempo from there)
         for change_tick, new_tempo in changes:
             if new_tempo <= 0:
-                raise PianobotError(
+                raise SettingError(
                     f"{path} sets a tempo of 0 (no time per beat) at beat {change_tick / self.tpb:.0f}: "
-                    "re-export it, or give the tempo with --tempo BPM"
+                    "re-export it, or give the tempo with load.tempo BPM",
+                    "load.tempo",
                 )
             tick, seconds, tempo = self.points[-1]
             self.points.append(
@@ -205,8 +206,8 @@ def parse_grid(text: str) -> float:
         if top < 1 or bottom < 1:
             raise ValueError
     except ValueError:
-        raise PianobotError(
-            f"--quantize {quote(text)}: give a note value like 1/8, 1/16 or 1/12 (triplet eighths)"
+        raise SettingError(
+            f"load.quantize {quote(text)}: give a note value like 1/8, 1/16 or 1/12 (triplet eighths)", "load.quantize"
         ) from None
     return top / bottom
 
@@ -285,7 +286,7 @@ def read_midi(
     midi = _load(path)
     if bpm is not None:
         if not 10 <= bpm <= 1000:
-            raise PianobotError(f"--tempo {bpm}: choose a tempo between 10 and 1000 bpm")
+            raise SettingError(f"load.tempo {bpm}: choose a tempo between 10 and 1000 bpm", "load.tempo")
         tpb = midi.ticks_per_beat
         seconds = lambda tick: tick / tpb * 60.0 / bpm  # noqa: E731
         nominal = bpm
@@ -306,10 +307,12 @@ def read_midi(
             fingering = {snap(tick): fingers for tick, fingers in fingering.items()}
         last = max(raw, key=lambda item: item[1], default=None)
         if last is not None and seconds(last[1]) > MAX_SECONDS:
-            raise PianobotError(
+            raise SettingError(
                 f"{path} track {index} lasts {seconds(last[1]) / 60:,.0f} minutes ({pitch_name(last[2])} ends at "
                 f"{seconds(last[1]):,.3f} s): pianobot reads at most {MAX_SECONDS / 60:.0f} minutes of music; "
-                "cut the file, or choose a part with --track or a faster --tempo"
+                "cut the file, or choose a part with load.track or a faster load.tempo",
+                "load.track",
+                "load.tempo",
             )
         by_tick: dict[int, list[tuple[int, int, int, int]]] = defaultdict(list)
         for item in raw:

@@ -13,7 +13,7 @@ import json
 import statistics
 from dataclasses import dataclass
 
-from pianobot.errors import PianobotError
+from pianobot.errors import SettingError
 from pianobot.music.piece import Note, Piece
 
 DEFAULT_MAX_NOTES = 6
@@ -75,14 +75,15 @@ def split_phrases(piece: Piece, max_notes: int = DEFAULT_MAX_NOTES) -> list[Phra
     phrase so that, other things equal, phrases come out even.
     """
     if max_notes < 1:
-        raise PianobotError(f"--phrase-notes {max_notes}: a phrase needs at least one note")
+        raise SettingError(f"phrases.max_notes {max_notes}: a phrase needs at least one note", "phrases.max_notes")
     chords = piece.chords()
     if not chords:
         return []
     for chord in chords:
         if len(chord) > max_notes:
-            raise PianobotError(
-                f"the chord at {chord[0].onset:.3f} s has {len(chord)} notes, more than --phrase-notes {max_notes}"
+            raise SettingError(
+                f"the chord at {chord[0].onset:.3f} s has {len(chord)} notes, more than phrases.max_notes {max_notes}",
+                "phrases.max_notes",
             )
     penalty = _break_penalties(chords)
     sizes = [len(c) for c in chords]

@@ -18,7 +18,7 @@ import re
 from dataclasses import dataclass, field, replace
 from typing import Iterable, Sequence
 
-from pianobot.errors import PianobotError, quote
+from pianobot.errors import PianobotError, SettingError, quote
 
 FINGER_NAMES = {1: "thumb", 2: "index", 3: "middle", 4: "ring", 5: "little"}
 _NAMES = ("C", "C#", "D", "D#", "E", "F", "F#", "G", "G#", "A", "A#", "B")
@@ -28,7 +28,7 @@ TIME_RESOLUTION = 1e-3
 MAX_SECONDS = 3600.0
 """The longest piece pianobot reads: every note ends within 60 minutes. It bounds what a file can
 ask for (the score tensor, the simulation, the metrics grow with the piece's length), whatever
-its times say; a longer piece is cut into parts (e.g. with --track) or re-timed with --tempo."""
+its times say; a longer piece is cut into parts (e.g. with ``load.track``) or re-timed with ``load.tempo``."""
 
 
 def pitch_name(pitch: int) -> str:
@@ -190,8 +190,9 @@ class Piece:
         out = []
         for n in self.notes:
             if not 0 <= n.pitch + semitones <= 127:
-                raise PianobotError(
-                    f"--transpose {semitones} moves {n.describe()} outside MIDI's range 0-127: use a smaller shift"
+                raise SettingError(
+                    f"load.transpose {semitones} moves {n.describe()} outside MIDI's range 0-127: use a smaller shift",
+                    "load.transpose",
                 )
             out.append(replace(n, pitch=n.pitch + semitones))
         return Piece(tuple(out), bpm=self.bpm)

@@ -47,7 +47,7 @@ def read_pig_rows(path: str | Path) -> list[tuple[Note, int]]:
         path,
         limit=MAX_FILE_BYTES,
         kind="PIG fingering file",
-        missing=f"fingering file {path} does not exist: check the path given to --fingering",
+        missing=f"fingering file {path} does not exist: check the path given to load.fingering",
     )
     try:
         text = data.decode("utf-8")

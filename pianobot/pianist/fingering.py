@@ -37,7 +37,7 @@ from typing import Sequence
 
 import numpy as np
 
-from pianobot.errors import PianobotError
+from pianobot.errors import PianobotError, SettingError
 from pianobot.music.instrument import HandSpec, KeyboardSpec, check_playable
 from pianobot.music.piece import Note, Piece, pitch_name
 from pianobot.pianist.layout import KeyLayout
@@ -230,9 +230,12 @@ class Planner:
         chords = piece.chords()
         too_many = next((c for c in chords if len(c) > len(self.fingers)), None)
         if too_many is not None:
-            raise PianobotError(
+            raise SettingError(
                 f"{len(too_many)} notes start together at {too_many[0].onset:.3f} s ({', '.join(n.name for n in too_many)}) "
-                f"but the hand has {len(self.fingers)} fingers: drop notes from that chord (e.g. with --track) or enable the thumb with --thumb"
+                f"but the hand has {len(self.fingers)} fingers: drop notes from that chord (e.g. with load.track) or "
+                "enable the thumb with hand.fingers",
+                "hand.fingers",
+                "load.track",
             )
         reaches, back = [], [None]
         for i, chord in enumerate(chords):
@@ -253,10 +256,12 @@ class Planner:
         index = int(np.argmin(reaches[-1].cost))
         if not reaches[-1].possible:
             i = next(i for i, reach in enumerate(reaches) if not reach.possible)
-            raise PianobotError(
+            raise SettingError(
                 f"no fingering lets this hand go from {' '.join(n.name for n in chords[i - 1])} to "
                 f"{' '.join(n.name for n in chords[i])} at {chords[i][0].onset:.3f} s: the notes held there cross or lie "
-                "too far apart for its fingers; play one voice (--track or --hand) or shorten the held notes"
+                "too far apart for its fingers; play one voice (load.track or load.hand) or shorten the held notes",
+                "load.track",
+                "load.hand",
             )
         path = [index]
         for i in range(len(chords) - 1, 0, -1):
@@ -284,7 +289,7 @@ class Planner:
                 problems.append(
                     f"{' '.join(n.name for n in chords[i - 1])} at {chords[i - 1][0].onset:.3f} s -> "
                     f"{' '.join(n.name for n in chords[i])} at {chords[i][0].onset:.3f} s: {what}, "
-                    "faster than this hand can (slow down with --tempo)"
+                    "faster than this hand can (slow down with load.tempo)"
                 )
         moves = np.abs(np.diff(wrist)) > 1e-9
         fingered = piece.with_fingers(fingers)

@@ -3,43 +3,27 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Optional
 
 import typer
 
+from pianobot.cli.flags import phrase
 from pianobot.cli.options import (
     AllRows,
-    Hand,
-    Keys,
-    LowestNote,
-    Quantize,
-    Split,
-    Tempo,
-    Thumb,
-    Track,
-    Transpose,
+    Reading,
     check_midi_output,
-    make_instrument,
-    make_options,
+    reads,
 )
 from pianobot.cli.terminal import out, said
 from pianobot.files import check_writable
 from pianobot.music.phrases import DEFAULT_MAX_NOTES
 
 
+@reads(without=("fingering", "refinger"))
 def finger(
     song: Path = typer.Argument(..., help="A .mid file, with or without fingering."),
     output: Path = typer.Option(..., "--output", "-o", help="Write the fingered piece to this .mid file."),
-    track: Optional[str] = Track,
-    tempo: Optional[float] = Tempo,
-    transpose: int = Transpose,
-    hand_part: Optional[str] = Hand,
-    split: str = Split,
-    quantize: Optional[str] = Quantize,
-    lowest_note: str = LowestNote,
-    keys: int = Keys,
-    thumb: bool = Thumb,
     all_rows: bool = AllRows,
+    reading: Reading = None,
 ):
     """Plan a fingering for the robot hand (least wrist travel within its reach) and write it to a MIDI file."""
     from pianobot.cli import display
@@ -50,9 +34,8 @@ def finger(
 
     check_midi_output(output, song, "the fingered piece")
     check_writable(output)
-    keyboard, hand_spec = make_instrument(lowest_note, keys, thumb)
-    options = make_options(track, tempo, transpose, None, hand_part, split, quantize)
-    piece = load_for_hand(song, options, keyboard, hand_spec)
+    keyboard, hand_spec = reading.keyboard, reading.hand
+    piece = load_for_hand(song, reading.options, keyboard, hand_spec)
     piece, plan = ensure_fingering(piece, keyboard, hand_spec, refinger=True)
     write_midi(piece, output, name=f"{song.stem} fingered by pianobot")
     out.print(display.notes_table(piece, split_phrases(piece, DEFAULT_MAX_NOTES), None if all_rows else display.ROWS))
@@ -61,4 +44,4 @@ def finger(
         f"in {plan.moves} moves over {len(piece)} notes"
     )
     for problem in plan.problems:
-        out.print(f"[yellow]cannot be played at this tempo:[/yellow] {problem}")
+        out.print(f"[yellow]cannot be played at this tempo:[/yellow] {said(phrase(problem))}")

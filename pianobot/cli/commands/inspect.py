@@ -8,41 +8,21 @@ from typing import Optional
 
 import typer
 
+from pianobot.cli.flags import phrase
 from pianobot.cli.options import (
     AllRows,
-    Fingering,
-    Hand,
-    Keys,
-    LowestNote,
     PlayPhraseNotes,
-    Quantize,
-    Refinger,
-    Split,
-    Tempo,
-    Thumb,
-    Track,
-    Transpose,
-    make_instrument,
-    make_options,
+    Reading,
+    reads,
 )
 from pianobot.cli.terminal import err, out, said, write_json
 from pianobot.files import check_writable
 from pianobot.music.piece import pitch_name
 
 
+@reads()
 def inspect(
     song: Path = typer.Argument(..., help="A .mid file (or a PIG fingering .txt file)."),
-    track: Optional[str] = Track,
-    tempo: Optional[float] = Tempo,
-    transpose: int = Transpose,
-    fingering: Optional[Path] = Fingering,
-    hand_part: Optional[str] = Hand,
-    split: str = Split,
-    quantize: Optional[str] = Quantize,
-    refinger: bool = Refinger,
-    lowest_note: str = LowestNote,
-    keys: int = Keys,
-    thumb: bool = Thumb,
     phrase_notes: Optional[int] = PlayPhraseNotes,
     models: Path = typer.Option(
         Path("models"), "--models", help="Model store whose trained phrase split to show (as play uses it)."
@@ -51,6 +31,7 @@ def inspect(
     json_path: Optional[Path] = typer.Option(
         None, "--json", help="Also write what inspect found to this JSON file ('-': standard output)."
     ),
+    reading: Reading = None,
 ):
     """Explain what a file holds (tracks, hands, pedal, range, polyphony, fingering) and whether the hand can play it."""
     from pianobot.cli import display
@@ -61,8 +42,7 @@ def inspect(
     from pianobot.pianist.fingering import ensure_fingering
     from pianobot.pianist.reduce import load_for_hand
 
-    keyboard, hand_spec = make_instrument(lowest_note, keys, thumb)
-    options = make_options(track, tempo, transpose, fingering, hand_part, split, quantize, refinger)
+    options, keyboard, hand_spec = reading.options, reading.keyboard, reading.hand
     to_stdout = json_path is not None and str(json_path) == "-"
     if json_path is not None and not to_stdout:
         check_writable(json_path)
@@ -83,7 +63,7 @@ def inspect(
                 else "; no sustain pedal"
             )
         )
-        if len(with_notes) > 1 and track is None and hand_part is None:
+        if len(with_notes) > 1 and options.track is None and options.hand is None:
             console.print(
                 "[yellow]several tracks are merged; play one part with --track N or --hand right|left[/yellow]"
             )
@@ -97,13 +77,13 @@ def inspect(
         f"({high - low} semitones); at most {polyphony} notes at once; velocities {velocities[0]}-{velocities[-1]}; "
         f"{given}/{len(piece)} notes fingered in the file"
     )
-    piece, plan = ensure_fingering(piece, keyboard, hand_spec, refinger)
+    piece, plan = ensure_fingering(piece, keyboard, hand_spec, options.refinger)
     if plan is not None:
         console.print(
             f"fingering planned for fingers {hand_spec.describe()}: wrist travel {plan.travel * 100:.1f} cm in {plan.moves} moves"
         )
         for problem in plan.problems:
-            console.print(f"[yellow]{problem}[/yellow]")
+            console.print(f"[yellow]{said(phrase(problem))}[/yellow]")
     check_playable(piece.without_fingering(), keyboard, hand_spec)  # the keyboard and the chords, before the split
     phrases = trained_split(models, piece, phrase_notes)
     rows = None if all_rows else display.ROWS

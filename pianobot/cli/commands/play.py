@@ -11,44 +11,36 @@ from typing import Optional
 import typer
 
 from pianobot.cli.options import (
-    Fingering,
+    Controller,
+    Fallback,
     GeneralPolicy,
-    Hand,
-    Keys,
-    LowestNote,
     PlayPhraseNotes,
-    Quantize,
-    Refinger,
-    Split,
-    Tempo,
-    Thumb,
-    Track,
-    Transpose,
+    Reading,
     check_midi_output,
-    make_instrument,
-    make_options,
     read_song,
+    reads,
 )
 from pianobot.cli.terminal import err, out, said
-from pianobot.errors import PianobotError, quote
+from pianobot.errors import PianobotError
 from pianobot.files import atomic_write, check_writable
 from pianobot.music.phrases import DEFAULT_MAX_NOTES
 from pianobot.perform.controllers import CONTROLLERS
 from pianobot.sim.world import WorldConfig
 
 
+@reads()
 def play(
     song: Path = typer.Argument(..., help="The piece to play, a .mid file with fingering."),
     output: Path = typer.Option(
         ..., "--output", "-o", help="Write what the simulated piano sounded to this .mid file."
     ),
-    controller: str = typer.Option(
+    controller: Controller = typer.Option(
         CONTROLLERS[0],
         "--controller",
         help="Who plays: 'sac' (the trained phrase policies), 'scripted' (the hand-written pianist) or 'random'.",
     ),
     models: Path = typer.Option(Path("models"), "--models", help="Folder of the model store (for --controller sac)."),
-    fallback: Optional[str] = typer.Option(
+    fallback: Optional[Fallback] = typer.Option(
         None,
         "--fallback",
         help="'scripted': play phrases that have no trained policy with the scripted pianist (when no general policy "
@@ -81,17 +73,7 @@ def play(
         "else sine waves).",
     ),
     gui: bool = typer.Option(False, "--gui", help="Show the simulation in a PyBullet window (needs a display)."),
-    track: Optional[str] = Track,
-    tempo: Optional[float] = Tempo,
-    transpose: int = Transpose,
-    fingering: Optional[Path] = Fingering,
-    hand_part: Optional[str] = Hand,
-    split: str = Split,
-    quantize: Optional[str] = Quantize,
-    refinger: bool = Refinger,
-    lowest_note: str = LowestNote,
-    keys: int = Keys,
-    thumb: bool = Thumb,
+    reading: Reading = None,
 ):
     """Perform a piece in the simulator; write the played notes (velocities, fingers) and a velocity-error report."""
     from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
@@ -128,24 +110,18 @@ def play(
         check_soundfont(soundfont)
     if gui and not os.environ.get("DISPLAY"):
         raise PianobotError("--gui needs a display (DISPLAY is not set): drop --gui, or use --video to watch it later")
-    if controller not in CONTROLLERS:
-        raise PianobotError(f"--controller {quote(controller)}: choose one of {', '.join(CONTROLLERS)}")
-    if fallback not in (None, "scripted"):
-        raise PianobotError(f"--fallback {quote(fallback)}: the only fallback is 'scripted'")
     if general_policy is not None and not use_general:
         raise PianobotError(f"--general-policy {general_policy} and --no-general ask for opposite things: give one")
     if general_policy is not None:
         find_general(models, path=general_policy)  # a folder that holds no policy: said before any work
-    keyboard, hand = make_instrument(lowest_note, keys, thumb)
-    piece = read_song(
-        song, make_options(track, tempo, transpose, fingering, hand_part, split, quantize, refinger), keyboard, hand
-    )
+    keyboard, hand = reading.keyboard, reading.hand
+    piece = read_song(song, reading.options, keyboard, hand)
     world = WorldConfig(keyboard=KeyboardConfig(spec=keyboard), hand=HandConfig(spec=hand), gui=gui)
     config = replace(PLAY_CONFIG, world=world)
     sources: dict = {}
     guards: list = []  # the wrist guard the general policy played through (one, shared by its sections)
     general = None  # the general policy's folder, when it plays a phrase
-    who = controller
+    who = controller.value
     if controller == "sac":
         import torch
 

@@ -8,25 +8,16 @@ from typing import Optional
 import typer
 
 from pianobot.cli.options import (
-    Fingering,
-    Hand,
-    Quantize,
-    Split,
-    Tempo,
-    Thumb,
-    Track,
-    Transpose,
-    make_instrument,
-    make_options,
+    Reading,
+    reads,
 )
 from pianobot.cli.terminal import err, out, said, write_json
 from pianobot.errors import PianobotError
 from pianobot.files import check_writable
-from pianobot.music.instrument import KeyboardSpec
 from pianobot.music.metrics import DEFAULT_ONSET_TOLERANCE
-from pianobot.music.piece import pitch_name
 
 
+@reads(without=("refinger", "lowest_note", "keys"))
 def score(
     played: Path = typer.Argument(..., help="The performance, a .mid file (e.g. written by `pianobot play`)."),
     reference: Path = typer.Argument(..., help="The reference score, a .mid file."),
@@ -40,14 +31,7 @@ def score(
         None, "--plot", help="Draw both piano rolls with the errors marked to this PNG file."
     ),
     notes: bool = typer.Option(True, "--notes/--no-notes", help="Print the per-note table."),
-    track: Optional[str] = Track,
-    tempo: Optional[float] = Tempo,
-    transpose: int = Transpose,
-    fingering: Optional[Path] = Fingering,
-    hand_part: Optional[str] = Hand,
-    split: str = Split,
-    quantize: Optional[str] = Quantize,
-    thumb: bool = Thumb,
+    reading: Reading = None,
 ):
     """Compare a performance with its reference: note F1, velocity and timing errors, fingering.
 
@@ -67,9 +51,9 @@ def score(
         if target is not None:
             check_writable(target)
     console = err if to_stdout else out  # standard output carries the JSON
-    keyboard, hand = make_instrument(pitch_name(KeyboardSpec.lowest), KeyboardSpec.count, thumb)
-    options = make_options(track, tempo, transpose, fingering, hand_part, split, quantize)
-    reference_piece = load_for_hand(reference, options, keyboard, hand)  # with --hand, reduced as play reduces it
+    reference_piece = load_for_hand(
+        reference, reading.options, reading.keyboard, reading.hand
+    )  # with --hand, reduced as play reduces it
     played_piece = midi_io.read_midi(played)
     report = compare(reference_piece, played_piece, onset_tolerance=onset_tolerance)
     tables = display.report_tables(report)

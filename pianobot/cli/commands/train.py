@@ -11,39 +11,38 @@ import typer
 
 from pianobot.agent.config import ACTORS, SACConfig
 from pianobot.cli.options import (
-    Fingering,
-    Hand,
-    Keys,
-    LowestNote,
+    Actor,
+    Cluster,
+    Control,
+    Device,
+    Explore,
+    Learner,
     PhraseNotes,
-    Quantize,
-    Refinger,
-    Split,
-    Tempo,
-    Thumb,
-    Track,
-    Transpose,
-    make_instrument,
-    make_options,
+    Reading,
+    Reward,
+    Task,
     option,
     read_song,
+    reads,
     refuse_training_into,
+    value,
 )
 from pianobot.cli.terminal import err, out, said, write_json
 from pianobot.env.piano import EnvConfig
 from pianobot.env.rewards import RewardConfig
-from pianobot.errors import PianobotError, PianobotWarning, quote
+from pianobot.errors import PianobotError, PianobotWarning
 from pianobot.files import check_writable
-from pianobot.learn.config import LEARNERS, MAX_ENVS, DaggerConfig, TrainConfig
+from pianobot.learn.config import MAX_ENVS, DaggerConfig, TrainConfig
 from pianobot.learn.explore import EXPLORATIONS
 from pianobot.music.phrases import DEFAULT_MAX_NOTES
-from pianobot.music.tasks import FAMILIES, MELODY, TASKS
+from pianobot.music.tasks import MELODY, TASKS
 from pianobot.sim.world import WorldConfig
 
 
+@reads()
 def train(
     song: Optional[Path] = typer.Argument(None, help="A .mid file with fingering; leave out with --task."),
-    task: Optional[str] = typer.Option(
+    task: Optional[Task] = typer.Option(
         None,
         "--task",
         help=f"Train on a task family instead, a fresh random instance each episode: the paper's {', '.join(TASKS)}, "
@@ -58,7 +57,7 @@ def train(
     seed: int = typer.Option(
         TrainConfig.seed, "--seed", help="Seed of the simulation, the exploration and the networks."
     ),
-    learner: str = typer.Option(
+    learner: Learner = typer.Option(
         TrainConfig.learner,
         "--learner",
         help="How policies learn: sac (Soft Actor-Critic from the rewards, the paper's) or dagger (imitating the "
@@ -105,24 +104,24 @@ def train(
         help="Environments each policy's training steps at once: 1 in the training process, more each in a worker "
         "process of its own.",
     ),
-    device: str = typer.Option(
+    device: Device = typer.Option(
         TrainConfig.device,
         "--device",
         help="Where the learner's networks and updates run: auto (cuda when torch sees a GPU, else cpu), cpu or cuda.",
     ),
-    control: str = typer.Option(
+    control: Control = typer.Option(
         WorldConfig.control,
         "--control",
         help="Finger control: velocity (joint speeds), position (joint angle targets) or torque.",
     ),
-    reward: str = typer.Option(RewardConfig.kind, "--reward", help="Reward: linear, squared or wasserstein."),
-    explore: str = typer.Option(
+    reward: Reward = typer.Option(RewardConfig.kind, "--reward", help="Reward: linear, squared or wasserstein."),
+    explore: Explore = typer.Option(
         TrainConfig.explore, "--explore", help=f"Exploration before learning: {', '.join(EXPLORATIONS)}."
     ),
     exploration_steps: int = typer.Option(
         SACConfig.exploration_steps, "--exploration-steps", help="Steps of exploration before learning starts."
     ),
-    actor: Optional[str] = typer.Option(
+    actor: Optional[Actor] = typer.Option(
         None,
         "--actor",
         help=f"The actor's networks: {' or '.join(ACTORS)} (one MLP shared by the fingers; docs/training.md). "
@@ -143,7 +142,7 @@ def train(
     ),
     force: bool = typer.Option(False, "--force", help="Retrain phrases that already have a stored policy."),
     models: Path = typer.Option(Path("models"), "--models", help="Folder of the model store."),
-    cluster: str = typer.Option(
+    cluster: Cluster = typer.Option(
         "local",
         "--cluster",
         help="Where phrases train: 'local' (--workers processes here) or 'ray' (Ray tasks on the cluster RAY_ADDRESS "
@@ -152,18 +151,8 @@ def train(
     json_path: Optional[Path] = typer.Option(
         None, "--json", help="Also write each policy's figures and files to this JSON file ('-': standard output)."
     ),
-    track: Optional[str] = Track,
-    tempo: Optional[float] = Tempo,
-    transpose: int = Transpose,
-    fingering: Optional[Path] = Fingering,
-    hand_part: Optional[str] = Hand,
-    split: str = Split,
-    quantize: Optional[str] = Quantize,
-    refinger: bool = Refinger,
-    lowest_note: str = LowestNote,
-    keys: int = Keys,
-    thumb: bool = Thumb,
     phrase_notes: int = PhraseNotes,
+    reading: Reading = None,
 ):
     """Train one Soft Actor-Critic policy per phrase of a piece (or one for a task family) and store them."""
     from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
@@ -181,17 +170,11 @@ def train(
 
     if (song is None) == (task is None):
         raise PianobotError("give a .mid file to train on, or --task NAME (not both)")
-    if task is not None and task not in FAMILIES:
-        raise PianobotError(f"--task {quote(task)}: choose one of {', '.join(FAMILIES)}")
     if workers < 1 or threads < 1:
         raise PianobotError(f"--workers {workers} --threads {threads}: give 1 or more of each")
     if not 1 <= envs <= MAX_ENVS:
         raise PianobotError(f"--envs {envs}: give 1 to {MAX_ENVS} environments")
-    if learner not in LEARNERS:
-        raise PianobotError(f"--learner {quote(learner)}: choose one of {', '.join(LEARNERS)}")
-    if cluster not in ("local", "ray"):
-        raise PianobotError(f"--cluster {quote(cluster)}: choose local or ray")
-    resolve_device(device)  # a GPU asked for and missing: say so before any work
+    resolve_device(device.value)  # a GPU asked for and missing: say so before any work
     cores = os.cpu_count() or 1
     # the environment workers step while the learner waits for them, and the learner updates while they wait
     busy = workers * max(threads, envs)
@@ -214,11 +197,11 @@ def train(
     console = err if json_path is not None and str(json_path) == "-" else out  # standard output carries the JSON
     if models.exists() and not models.is_dir():
         raise PianobotError(f"--models {models} is a file: give a folder")
-    keyboard, hand = make_instrument(lowest_note, keys, thumb)
+    keyboard, hand = reading.keyboard, reading.hand
     with option("--control", control):
-        world = WorldConfig(keyboard=KeyboardConfig(spec=keyboard), hand=HandConfig(spec=hand), control=control)
+        world = WorldConfig(keyboard=KeyboardConfig(spec=keyboard), hand=HandConfig(spec=hand), control=control.value)
     with option("--reward", reward):
-        rewards = RewardConfig(kind=reward, fingering_gate=fingering_gate)
+        rewards = RewardConfig(kind=reward.value, fingering_gate=fingering_gate)
     with option("--joints", joints):
         env = EnvConfig(
             world=world,
@@ -227,18 +210,16 @@ def train(
             actuated=tuple(j.strip() for j in joints.split(",") if j.strip()),
         )
     with option("--round-steps", round_steps):
-        DaggerConfig(round_steps=round_steps)
-    if actor is not None and actor not in ACTORS:
-        raise PianobotError(f"--actor {quote(actor)}: choose one of {', '.join(ACTORS)}")
+        dagger = DaggerConfig(round_steps=round_steps)
     with option("--exploration-steps", exploration_steps):
-        sac = SACConfig(exploration_steps=exploration_steps, actor=actor or SACConfig.actor)
+        sac = SACConfig(exploration_steps=exploration_steps, actor=value(actor) or SACConfig.actor)
     with option():
         config = TrainConfig(
             steps=steps,
             seed=seed,
-            learner=learner,
-            dagger=DaggerConfig(round_steps=round_steps),
-            explore=explore,
+            learner=learner.value,
+            dagger=dagger,
+            explore=explore.value,
             until_f1=until_f1,
             # a task family trains from scratch, or continues the policy --general-policy names
             from_general=from_general and (task is None or general_policy is not None),
@@ -246,7 +227,7 @@ def train(
             env=env,
             eval_episodes=TASK_EVAL_EPISODES if task is not None else TrainConfig.eval_episodes,
             envs=envs,
-            device=device,
+            device=device.value,
         )
     if general_policy is not None and not from_general:
         raise PianobotError(
@@ -257,16 +238,14 @@ def train(
     # where the run begins, before its folders are named: a run from a policy takes its networks
     config, start = general_start(config, models, general_policy, networks_given=actor is not None)
     if task is not None:
-        job = task_job(task, config, models)
+        job = task_job(task.value, config, models)
         refuse_training_into(general_policy, [job])
         todo, done = plan_jobs([job], force)
         label = f"task {task}"
         if start is not None and todo and store.checkpoint_state(job.folder) is None:  # (else it resumes, and says so)
             console.print(f"continuing the policy {said(start)} on {said(label)}: evaluated first", soft_wrap=True)
     else:
-        piece = read_song(
-            song, make_options(track, tempo, transpose, fingering, hand_part, split, quantize, refinger), keyboard, hand
-        )
+        piece = read_song(song, reading.options, keyboard, hand)
         phrases = split_phrases(piece, phrase_notes)
         jobs = phrase_jobs(phrases, config, models, piece=song.name)
         refuse_training_into(general_policy, jobs)

@@ -1,0 +1,101 @@
+"""Errors in one layer: typer refuses an option's value outside its choices, the library names the
+setting at fault by its field, and the command line names the option that sets it."""
+
+from pathlib import Path
+
+import pytest
+import typer.main
+from typer.testing import CliRunner
+
+from pianobot.cli import flags
+from pianobot.cli.app import app
+from pianobot.cli.options import READING, Controller, Learner
+from pianobot.errors import SettingError
+from pianobot.learn.config import LEARNERS
+from pianobot.music.instrument import KeyboardSpec
+from pianobot.music.midi_io import read_midi
+from pianobot.perform.controllers import CONTROLLERS
+
+runner = CliRunner()
+EXAMPLES = Path(__file__).parent.parent / "examples" / "midi"
+SONG = EXAMPLES / "one-note.mid"
+
+
+def run(*args):
+    return runner.invoke(app, [str(a) for a in args])
+
+
+def one_line(result, *words):
+    assert result.exit_code == 2, result.output
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: "), result.output
+    assert "Traceback" not in result.output
+    for word in words:
+        assert word in lines[0], lines[0]
+    return lines[0]
+
+
+@pytest.mark.parametrize(
+    "args, option, bad",
+    [
+        (("play", SONG, "-o", "x.mid", "--controller", "robot"), "--controller", "robot"),
+        (("play", SONG, "-o", "x.mid", "--fallback", "general"), "--fallback", "general"),
+        (("train", SONG, "--learner", "ppo"), "--learner", "ppo"),
+        (("train", SONG, "--cluster", "slurm"), "--cluster", "slurm"),
+        (("train", SONG, "--device", "gpu"), "--device", "gpu"),
+        (("train", SONG, "--actor", "cnn"), "--actor", "cnn"),
+        (("inspect", SONG, "--hand", "middle"), "--hand", "middle"),
+        (("score", SONG, SONG, "--hand", "both"), "--hand", "both"),
+    ],
+)
+def test_a_value_outside_the_choices_is_typers_one_line_and_exit_2(args, option, bad, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    line = one_line(run(*args), f"'{option}'", f"'{bad}'", "is not one of", "--help")
+    assert "Usage" not in line
+
+
+def test_the_choices_come_from_the_library_and_show_in_help():
+    assert [c.value for c in Controller] == list(CONTROLLERS) and [c.value for c in Learner] == list(LEARNERS)
+    wide = {"COLUMNS": "250"}
+    assert "<sac|scripted|random>" in runner.invoke(app, ["play", "--help"], env=wide).output
+    assert "<sac|dagger>" in runner.invoke(app, ["train", "--help"], env=wide).output
+
+
+def test_other_usage_errors_are_one_line_too():
+    one_line(run("plya"), "No such command", "play")
+    one_line(run("finger"), "Missing argument")
+    one_line(run("inspect", SONG, "--tempi", "60"), "No such option", "--tempi")
+    assert run().exit_code == 2 and "Usage" in run().output  # no arguments: the help, as typer shows it
+
+
+def test_a_library_error_names_the_field_and_the_cli_names_the_option(tmp_path):
+    with pytest.raises(SettingError, match=r"^load\.tempo 5: choose a tempo between 10 and 1000 bpm$") as e:
+        read_midi(SONG, bpm=5)
+    assert e.value.field == "load.tempo" and "--" not in str(e.value)
+    with pytest.raises(SettingError, match=r"^keyboard\.count 100: a keyboard has 1 to 88 keys$") as e:
+        KeyboardSpec(count=100)
+    assert e.value.field == "keyboard.count"
+
+    line = one_line(run("inspect", SONG, "--tempo", "5"), "--tempo 5.0: choose a tempo between 10 and 1000 bpm")
+    assert "load." not in line
+    one_line(run("finger", SONG, "-o", tmp_path / "f.mid", "--keys", "100"), "--keys 100: a keyboard has 1 to 88 keys")
+    one_line(run("score", SONG, SONG, "--quantize", "1/0"), "--quantize 1/0: give a note value")
+    one_line(run("inspect", SONG, "--phrase-notes", "0"), "--phrase-notes 0: a phrase needs at least one note")
+
+
+def test_the_flag_table_phrases_every_field_and_nothing_else():
+    for field, option in flags.FLAGS.items():
+        assert flags.phrase(f"give {field} 3, or {field}: x ({field})") == f"give {option} 3, or {option}: x ({option})"
+    assert flags.phrase("song.load.tempo.mid and reload.tempo stay") == "song.load.tempo.mid and reload.tempo stay"
+    assert flags.flag("train.unknown") == "train.unknown"
+
+
+def test_the_reading_options_are_declared_once_and_offered_where_they_apply():
+    commands = typer.main.get_command(app).commands
+    offered = {name: {p.name for p in command.params} & set(READING) for name, command in commands.items()}
+    assert offered["inspect"] == offered["play"] == offered["train"] == set(READING)
+    assert offered["finger"] == set(READING) - {"fingering", "refinger"}
+    assert offered["score"] == set(READING) - {"refinger", "lowest_note", "keys"}
+    assert offered["export"] == set()
+    help_text = runner.invoke(app, ["play", "--help"], env={"COLUMNS": "250"}).output
+    assert "Reading the piece" in help_text and "Keyboard and hand" in help_text and "right|left" in help_text
