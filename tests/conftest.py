@@ -9,6 +9,7 @@ from contextlib import contextmanager
 
 import mido
 import pytest
+from typer.testing import CliRunner
 
 from pianobot.music.midi_io import write_midi
 from pianobot.music.piece import Note, Piece
@@ -104,3 +105,21 @@ def fail_in(folder, error):
         return real(*args, dir=dir, **kwargs)
 
     return mkstemp
+
+
+def run(*args):
+    """``pianobot ARGS`` in this process (typer's runner); the result has exit_code, output and stderr."""
+    from pianobot.cli.app import app
+
+    return CliRunner().invoke(app, [str(a) for a in args])
+
+
+def assert_one_line_error(result, *words):
+    """Exit code 2 and exactly one line on stderr (inspect may still have printed what it found)."""
+    assert result.exit_code == 2, result.output
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: "), result.output
+    assert "Traceback" not in result.output
+    for word in words:
+        assert word in lines[0], lines[0]
+    return lines[0]

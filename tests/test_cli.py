@@ -6,29 +6,16 @@ from pathlib import Path
 import mido
 import numpy as np
 import pytest
+from conftest import assert_one_line_error, run
 from typer.testing import CliRunner
 
-from pianobot.cli.app import app
+from pianobot.agent.general import PACKAGED
 from pianobot.music.midi_io import write_midi
 from pianobot.music.piece import Note, Piece
 from pianobot.music.pig import sidecar_for, write_pig
 
 runner = CliRunner()
 EXAMPLES = Path(__file__).parent.parent / "examples" / "midi"
-
-
-def run(*args):
-    return runner.invoke(app, [str(a) for a in args])
-
-
-def assert_one_line_error(result, *words):
-    """Exit code 2 and exactly one line on stderr (inspect may still have printed what it found)."""
-    assert result.exit_code == 2, result.output
-    lines = result.stderr.strip().splitlines()
-    assert len(lines) == 1 and lines[0].startswith("error: "), result.output
-    assert "Traceback" not in result.output
-    for word in words:
-        assert word in lines[0], lines[0]
 
 
 def test_score_of_a_file_against_itself(scale_file):
@@ -196,7 +183,7 @@ def test_play_scripted_writes_a_performance_that_scores_well(tmp_path):
     )
     assert result.exit_code == 0, result.output
     report = json.loads((tmp_path / "out.report.json").read_text())
-    assert report["f1"] >= 0.95 and report["velocity_mae"] <= 10 and report["controller"] == "scripted"
+    assert report["f1"] >= 0.95 and report["velocity_mae"] <= 10 and report["performer"] == "scripted pianist"
     from pianobot.music.midi_io import read_midi, write_midi
 
     played = read_midi(out)
@@ -239,7 +226,7 @@ def test_play_gui_without_a_display_is_refused(tmp_path, monkeypatch):
 def test_play_random_controller(tmp_path):
     result = run("play", EXAMPLES / "one-note.mid", "-o", tmp_path / "r.mid", "--controller", "random", "--seed", "3")
     assert result.exit_code == 0, result.output
-    assert json.loads((tmp_path / "r.report.json").read_text())["controller"] == "random"
+    assert json.loads((tmp_path / "r.report.json").read_text())["performer"] == "random actions"
 
 
 def test_train_bad_requests_answer_with_one_line(tmp_path):
@@ -350,7 +337,7 @@ def test_play_sac_composes_trained_and_fallback_phrases(tmp_path):
     assert result.exit_code == 0, result.output
     assert "phrases 1 had no trained policy" in result.output
     report = json.loads((tmp_path / "out.report.json").read_text())
-    assert report["phrases"]["0"].startswith("policy ") and report["phrases"]["1"] == "scripted (fallback)"
+    assert report["phrases"]["0"].startswith("own policy ") and report["phrases"]["1"] == "scripted pianist"
     played = [n for n in read_played(tmp_path / "out.mid") if n.pitch == 67 and n.onset >= 2.0]
     assert played and played[0].finger == 4  # the scripted pianist took over and played phrase 1
 
@@ -381,7 +368,7 @@ def test_play_composes_policies_with_different_agent_settings(tmp_path):
     result = run("play", song, "-o", tmp_path / "out.mid", "--models", tmp_path / "models", "--phrase-notes", "1")
     assert result.exit_code == 0, result.output
     report = json.loads((tmp_path / "out.report.json").read_text())
-    assert report["phrases"]["0"].startswith("policy ") and report["phrases"]["1"].startswith("policy ")
+    assert report["phrases"]["0"].startswith("own policy ") and report["phrases"]["1"].startswith("own policy ")
 
 
 def read_played(path):
@@ -535,18 +522,20 @@ def test_committed_policies_play_their_example_from_a_fresh_checkout(tmp_path, s
         result = run("play", song, "-o", tmp_path / "o.mid", "--controller", "sac", "--models", MODELS, "--seed", seed)
         assert result.exit_code == 0, result.output
         report = json.loads((tmp_path / "o.report.json").read_text())
-        assert all(source.startswith("policy ") for source in report["phrases"].values())
+        assert all(source.startswith("own policy ") for source in report["phrases"].values())
         f1s.append(report["f1"])
     assert sum(f1s) / 3 >= 0.9, f1s
 
 
 @pytest.mark.parametrize("song", ["mary", "ode-to-joy", "c-major-scale"])
-def test_the_committed_general_policy_plays_unseen_songs_from_a_fresh_checkout(tmp_path, song):
-    """No phrase of these songs has a policy of its own: `play` uses the general policy committed
-    in models/ (trained by `--learner dagger`, models/README.md) for every one, and says so."""
-    result = run("play", EXAMPLES / f"{song}.mid", "-o", tmp_path / "o.mid", "--models", MODELS)
+def test_the_committed_general_policy_plays_unseen_songs_from_any_folder(tmp_path, song, monkeypatch):
+    """No phrase of these songs has a policy of its own: `play`, run from another folder, uses the
+    general policy that ships in the package (trained by `--learner dagger`, models/README.md) for
+    every one, and says so."""
+    monkeypatch.chdir(tmp_path)
+    result = run("play", EXAMPLES / f"{song}.mid", "-o", tmp_path / "o.mid")
     assert result.exit_code == 0, result.output
     report = json.loads((tmp_path / "o.report.json").read_text())
     assert report["phrases"] and all(s.startswith("general policy task-melody-") for s in report["phrases"].values())
-    assert report["general_policy"]["path"].endswith(tuple(p.name for p in MODELS.glob("task-melody-*")))
+    assert report["general_policy"]["path"].endswith(tuple(p.name for p in PACKAGED.glob("task-melody-*")))
     assert report["f1"] >= 0.9, report["f1"]

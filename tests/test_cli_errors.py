@@ -5,6 +5,7 @@ from pathlib import Path
 
 import pytest
 import typer.main
+from conftest import assert_one_line_error, run
 from typer.testing import CliRunner
 
 from pianobot.cli import flags
@@ -16,23 +17,9 @@ from pianobot.music.instrument import KeyboardSpec
 from pianobot.music.midi_io import read_midi
 from pianobot.perform.controllers import CONTROLLERS
 
-runner = CliRunner()
 EXAMPLES = Path(__file__).parent.parent / "examples" / "midi"
 SONG = EXAMPLES / "one-note.mid"
-
-
-def run(*args):
-    return runner.invoke(app, [str(a) for a in args])
-
-
-def one_line(result, *words):
-    assert result.exit_code == 2, result.output
-    lines = result.stderr.strip().splitlines()
-    assert len(lines) == 1 and lines[0].startswith("error: "), result.output
-    assert "Traceback" not in result.output
-    for word in words:
-        assert word in lines[0], lines[0]
-    return lines[0]
+runner = CliRunner()
 
 
 @pytest.mark.parametrize(
@@ -50,7 +37,7 @@ def one_line(result, *words):
 )
 def test_a_value_outside_the_choices_is_typers_one_line_and_exit_2(args, option, bad, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
-    line = one_line(run(*args), f"'{option}'", f"'{bad}'", "is not one of", "--help")
+    line = assert_one_line_error(run(*args), f"'{option}'", f"'{bad}'", "is not one of", "--help")
     assert "Usage" not in line
 
 
@@ -62,9 +49,9 @@ def test_the_choices_come_from_the_library_and_show_in_help():
 
 
 def test_other_usage_errors_are_one_line_too():
-    one_line(run("plya"), "No such command", "play")
-    one_line(run("finger"), "Missing argument")
-    one_line(run("inspect", SONG, "--tempi", "60"), "No such option", "--tempi")
+    assert_one_line_error(run("plya"), "No such command", "play")
+    assert_one_line_error(run("finger"), "Missing argument")
+    assert_one_line_error(run("inspect", SONG, "--tempi", "60"), "No such option", "--tempi")
     assert run().exit_code == 2 and "Usage" in run().output  # no arguments: the help, as typer shows it
 
 
@@ -76,11 +63,17 @@ def test_a_library_error_names_the_field_and_the_cli_names_the_option(tmp_path):
         KeyboardSpec(count=100)
     assert e.value.field == "keyboard.count"
 
-    line = one_line(run("inspect", SONG, "--tempo", "5"), "--tempo 5.0: choose a tempo between 10 and 1000 bpm")
+    line = assert_one_line_error(
+        run("inspect", SONG, "--tempo", "5"), "--tempo 5.0: choose a tempo between 10 and 1000 bpm"
+    )
     assert "load." not in line
-    one_line(run("finger", SONG, "-o", tmp_path / "f.mid", "--keys", "100"), "--keys 100: a keyboard has 1 to 88 keys")
-    one_line(run("score", SONG, SONG, "--quantize", "1/0"), "--quantize 1/0: give a note value")
-    one_line(run("inspect", SONG, "--phrase-notes", "0"), "--phrase-notes 0: a phrase needs at least one note")
+    assert_one_line_error(
+        run("finger", SONG, "-o", tmp_path / "f.mid", "--keys", "100"), "--keys 100: a keyboard has 1 to 88 keys"
+    )
+    assert_one_line_error(run("score", SONG, SONG, "--quantize", "1/0"), "--quantize 1/0: give a note value")
+    assert_one_line_error(
+        run("inspect", SONG, "--phrase-notes", "0"), "--phrase-notes 0: a phrase needs at least one note"
+    )
 
 
 def test_the_flag_table_phrases_every_field_and_nothing_else():

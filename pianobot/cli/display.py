@@ -185,6 +185,6 @@ def training_table(rows) -> Table:
             _opt(evaluation.get("f1"), ".3f"),
             _opt(evaluation.get("velocity_mae"), ".1f"),
             _opt(manifest.get("seconds", 0) / 60 if manifest.get("seconds") is not None else None, ".1f"),
-            str(job.folder),
+            str(job.folder) if manifest.get("kept") != "start" else "none: the general policy plays it",
         )
     return table

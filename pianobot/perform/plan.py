@@ -132,7 +132,11 @@ class PerformancePlan:
 
     def to_dict(self) -> dict:
         """What a report says of the plan: the performer, each stretch, and the general policy's weights."""
-        out: dict = {"performer": self.performer, "stretches": [s.to_dict() for s in self.stretches]}
+        out: dict = {
+            "performer": self.performer,
+            "stretches": [s.to_dict() for s in self.stretches],
+            "phrases": {str(p.index): s.describe() for s in self.stretches for p in s.phrases},
+        }
         if self.general is not None:
             out["general_policy"] = describe(self.general)
         return out

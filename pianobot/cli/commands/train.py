@@ -304,9 +304,36 @@ def train(
             results = run_jobs_on_ray(todo, config, on_progress, threads=threads, start=start)
         else:
             results = run_jobs(todo, config, workers, on_progress, threads=threads, start=start)
-    trained = [(job, results.get(job.key) or store.read_manifest(job.folder)) for job in done + todo]
+
+    def manifest(job) -> dict:  # what training left: a policy, or the store's word that the general policy plays it
+        if job.key in results:
+            return results[job.key]
+        if store.is_trained(job.folder):
+            return store.read_manifest(job.folder)
+        return {"kept": "start", "start": store.general_plays(models).get(job.folder.name, {}), "steps": 0}
+
+    trained = [(job, manifest(job)) for job in done + todo]
     console.print(display.training_table(trained))
     console.print(f"learning curves: {LOG_FILE} and {PLOT_FILE} in each policy's folder")
+    verdict = None
+    if task is None and start is not None:  # the whole piece, as play performs it: no phrase policy makes it worse
+        from pianobot.learn.accept import JUDGE_SEEDS, settle_piece
+
+        started = {
+            job.folder.name: m["evaluation"]["f1"] for job, m in trained if job in todo and m.get("kept") == "start"
+        }
+        seeds = ", ".join(map(str, JUDGE_SEEDS))
+        console.print(
+            f"playing {said(song.name)} whole from hand starts {seeds}, as `pianobot play` does, to judge its phrase policies"
+        )
+        verdict = settle_piece(piece, phrases, models, start, started)
+        before, after = sum(verdict.before) / len(JUDGE_SEEDS), sum(verdict.after) / len(JUDGE_SEEDS)
+        console.print(
+            f"{said(song.name)}: note F1 {before:.3f} with the general policy alone, {after:.3f} as it plays now "
+            f"(own policies for phrases {', '.join(map(str, verdict.used)) or 'none'})"
+        )
+        for number, why in verdict.dropped.items():
+            console.print(f"[yellow]phrase {number}'s own policy is not used: {said(why)}[/yellow]")
     if json_path is not None:
         summary = [
             {
@@ -314,10 +341,10 @@ def train(
                 "phrases": job.phrases,
                 "folder": str(job.folder),
                 "trained_now": job in todo,
-                **{k: manifest.get(k) for k in ("steps", "updates", "seconds", "start", "evaluation")},
+                **{k: manifest.get(k) for k in ("steps", "updates", "seconds", "start", "evaluation", "kept")},
                 "log": str(job.folder / LOG_FILE),
                 "plot": str(job.folder / PLOT_FILE),
             }
             for job, manifest in trained
         ]
-        write_json(json_path, {"policies": summary})
+        write_json(json_path, {"policies": summary, **({"piece": verdict.to_dict()} if verdict else {})})
