@@ -332,6 +332,41 @@ def test_fine_tuning_never_ends_worse_than_its_start_policy(tmp_path, monkeypatc
         assert all(torch.equal(kept[k], start[k]) for k in start) == (kept_step == 0)
 
 
+def test_a_start_policy_that_already_plays_the_phrase_stores_nothing(tmp_path, monkeypatch):
+    """Fine-tuning whose step-0 evaluation reaches stop_f1 stores no copy of the start policy: the
+    run removes its log and its folder (or, in a folder that holds other files, only what it
+    wrote) and returns the manifest, which says ``kept: start``; a run that stores its policy
+    says ``kept: trained``. Both learners."""
+    import pianobot.learn.dagger as dagger
+    import pianobot.learn.train as train
+
+    config = small(steps=80)
+    assert train_policy(PHRASE, config, tmp_path / "start")["kept"] == "trained"
+    assert store.read_manifest(tmp_path / "start")["kept"] == "trained"
+    perfect = {"f1": 1.0, "velocity_mae": 0.0, "return": 1.0}
+    for module in (train, dagger):
+        monkeypatch.setattr(module, "evaluate", lambda *a: dict(perfect))
+    tuned = replace(config, from_general=True)
+    for learn, learner in ((train_policy, "sac"), (dagger.dagger_policy, "dagger")):
+        seen: list[Progress] = []
+        folder = tmp_path / f"tuned-{learner}"
+        manifest = learn(
+            PHRASE, replace(tuned, learner=learner), folder, seen.append, about={"key": "k"}, start=tmp_path / "start"
+        )
+        assert manifest["kept"] == "start" and manifest["key"] == "k"
+        assert manifest["steps"] == 0 and manifest["updates"] == 0
+        assert manifest["evaluations"] == [manifest["evaluation"]] == [{"step": 0, **perfect}]
+        assert manifest["start"]["path"] == str(tmp_path / "start") and manifest["config"]["from_general"] is True
+        assert not folder.exists()  # no policy, no log, no folder
+        assert seen[-1].finished and seen[-1].step == 0
+
+    kept = tmp_path / "kept"  # a folder with a file of its own keeps it, and only it
+    kept.mkdir()
+    (kept / "notes.txt").write_text("mine")
+    assert train_policy(PHRASE, tuned, kept, start=tmp_path / "start")["kept"] == "start"
+    assert sorted(p.name for p in kept.iterdir() if p.name != store.LOCK_FILE) == ["notes.txt"]
+
+
 def test_the_best_evaluated_policy_is_kept_across_an_interruption(tmp_path, monkeypatch):
     import pianobot.learn.train as train
 

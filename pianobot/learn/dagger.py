@@ -23,123 +23,45 @@ steps, which is how the general policy is trained (docs/training.md).
 
 A round ends at the first episode end after its steps, so the last one may run past ``steps``
 by part of an episode. The run stops after its last round, or at an evaluation reaching ``TrainConfig.stop_f1``
-(fine-tuning from the general policy evaluates the start first, as SAC's loop does). The stored
-policy is the best evaluated one, with the files of a SAC policy (actor and encoder); it has no
-critic, so SAC fine-tuning from it begins with fresh Q heads.
+(fine-tuning from the general policy evaluates the start first, as SAC's loop does, and stores
+nothing when the start already reaches it). The stored policy is the best evaluated one, with
+the files of a SAC policy (actor and encoder); it has no critic, so SAC fine-tuning from it
+begins with fresh Q heads. The run's set-up, beginning, start evaluation, best policy,
+checkpoints and manifest are SAC's too: :mod:`pianobot.learn.run`.
 """
 
 from __future__ import annotations
 
-import contextlib
 import math
-import time
-from dataclasses import asdict, replace
-from pathlib import Path
-from typing import Callable
 
 import numpy as np
-import torch
 
-from pianobot.agent import general, store
-from pianobot.agent.buffer import ReplayBuffer
 from pianobot.agent.imitation import Imitation
-from pianobot.agent.policy import make_agent
-from pianobot.agent.sac import resolve_device, vector_size
-from pianobot.config import to_dict
-from pianobot.errors import PianobotError
-from pianobot.learn.config import TrainConfig
 from pianobot.learn.explore import Explorer
-from pianobot.learn.log import TrainingLog
-from pianobot.learn.train import (
-    BEST_PREFIX,
-    Progress,
-    better,
-    env_generators,
-    evaluate,
-    make_envs,
-    resume_envs,
-    split_kept,
-)
-from pianobot.music.piece import Piece
+from pianobot.learn.run import Progress, Run, evaluate, open_run
 
 
-def dagger_policy(
-    target: Piece | str,
-    config: TrainConfig,
-    folder: Path,
-    report: Callable[[Progress], None] = lambda p: None,
-    stop_after: int | None = None,
-    about: dict | None = None,
-    start: Path | None = None,
-) -> dict:
+def dagger_policy(target, config, folder, report=lambda p: None, stop_after=None, about=None, start=None) -> dict:
     """Train one policy for a phrase or a task family by DAgger; store it in ``folder``. The
-    arguments are :func:`~pianobot.learn.train.train_policy`'s; ``stop_after`` interrupts the
-    run at the first round end after that many steps."""
-    if start is not None and not config.from_general:
-        raise ValueError("a start policy was given to a run with from_general=False")
-    with store.training_lock(folder), TrainingLog(folder) as log:
-        store.remove_temporary_files(folder)
-        device = resolve_device(config.device)
-        with contextlib.closing(make_envs(target, config.env, config.envs)) as envs:
-            return _dagger(target, config, folder, report, stop_after, about, log, envs, device, start)
+    arguments (and their types) are :func:`~pianobot.learn.train.train_policy`'s; ``stop_after``
+    interrupts the run at the first round end after that many steps."""
+    with open_run(target, config, folder, report, about, start, evaluate, critic=False) as run:
+        return _dagger(run, stop_after)
 
 
-def _dagger(target, config: TrainConfig, folder: Path, report, stop_after, about, log, envs, device, start) -> dict:
-    torch.manual_seed(config.seed)
-    env_config, n, settings = config.env, config.envs, config.dagger
-    agent = make_agent(envs, config.sac, device)
+def _dagger(run: Run, stop_after: int | None) -> dict:
+    settings = run.config.dagger
+    agent, dataset, rng = run.setup(settings.dataset_size)
     learner = Imitation(agent, settings.learning_rate)
-    space, action_size = envs.single_observation_space, envs.single_action_space.shape[0]
-    tactile_shape = space["tactile"].shape if "tactile" in space.spaces else None
-    dataset = ReplayBuffer(
-        min(settings.dataset_size, config.steps), vector_size(space, config.sac.score_input), tactile_shape, action_size
-    )
-    rng = np.random.default_rng(config.seed)
-    teachers = [Explorer("scripted", action_size, env_config, rng) for _ in range(n)]  # one per environment
-    step, episode, rounds, evaluations = 0, 0, 0, []
-    best, best_tensors, began, seconds_before = None, None, None, 0.0
-
-    checkpoint = store.load_checkpoint(folder)
-    if checkpoint is not None:  # continue an interrupted run from its last round's end
-        tensors, state, data_folder = checkpoint
-        agent.load_tensors({k: v for k, v in tensors.items() if not k.startswith(BEST_PREFIX)})
-        learner.load_tensors(tensors)
-        best = state.get("best")
-        best_tensors = {k[len(BEST_PREFIX) :]: v for k, v in tensors.items() if k.startswith(BEST_PREFIX)} or None
-        torch.set_rng_state(tensors["torch_rng"])
-        dataset.load(data_folder, state["buffer_size"], state["buffer_cursor"])
-        rng.bit_generator.state = state["rng"]
-        step, episode, rounds, evaluations = state["step"], state["episode"], state["rounds"], state["evaluations"]
-        agent.updates = state["updates"]
-        seconds_before, began = state["seconds"], state["start"]
-        observations = resume_envs(envs, state["env_rng"], config.seed, step)
-        report(Progress(step, config.steps, resumed=True))
-    else:
-        if start is not None:  # fine-tuning: the start policy's actor and encoder
-            began = general.describe(start)
-            try:
-                agent.load_start(*general.start_tensors(start))
-            except ValueError as e:
-                raise PianobotError(
-                    f"the policy {start} does not fit this run's networks ({e}): train with its options, or from scratch"
-                ) from None
-        observations, _ = envs.reset(seed=config.seed)
-    config = replace(config, from_general=began is not None)
-
-    def policy_tensors() -> dict[str, torch.Tensor]:  # what a stored policy keeps: actor and encoder
-        return agent.tensors(with_training_state=False)
-
-    started = time.perf_counter()
-    log.start(resumed_at=step if checkpoint is not None else None)
-    final, losses, returns = None, None, np.zeros(n)
-    if began is not None and checkpoint is None:  # evaluate the start before any step: it counts
-        figures = evaluate(agent, target, env_config, config.eval_episodes)
-        evaluations.append({"step": 0, **figures})
-        best, best_tensors = {"step": 0, **figures}, policy_tensors()
-        log.evaluation(0, time.perf_counter() - started, figures)
-        report(Progress(0, config.steps, eval_f1=figures["f1"]))
-        if config.stop_f1 is not None and figures["f1"] >= config.stop_f1:
-            final = {"step": 0, **figures}
+    observations, state, saved = run.begin(agent, dataset, rng)  # afresh (from the start policy) or from a checkpoint
+    if run.resumed:
+        learner.load_tensors(saved)  # Adam's moments
+    config, envs, n = run.config, run.envs, run.config.envs
+    action_size = envs.single_action_space.shape[0]
+    teachers = [Explorer("scripted", action_size, config.env, rng) for _ in range(n)]  # one per environment
+    step, episode, rounds = state["step"], state["episode"], state.get("rounds", 0)
+    losses, returns = None, np.zeros(n)
+    final = run.evaluate_start(agent)  # fine-tuning: the start's figures, when it already plays well enough
 
     def new_episodes(which: np.ndarray) -> np.ndarray:  # who plays each new episode: True for the teacher
         for i in np.flatnonzero(which):
@@ -166,18 +88,18 @@ def _dagger(target, config: TrainConfig, folder: Path, report, stop_after, about
             gathered += n
             ended = terminations | truncations
             if ended.any():
-                seconds = seconds_before + time.perf_counter() - started
+                seconds = run.seconds()
                 for i in np.flatnonzero(ended):
                     episode += 1
-                    report(Progress(step, config.steps, episode_return=float(returns[i]), losses=losses))
-                    log.row(step, episode, seconds, float(returns[i]), losses, None)
+                    run.report(Progress(step, config.steps, episode_return=float(returns[i]), losses=losses))
+                    run.log.row(step, episode, seconds, float(returns[i]), losses, None)
                     returns[i] = 0.0
                 if step >= round_end:
                     break  # (the other environments' episodes go on in the next round)
                 observations, _ = envs.reset(options={"reset_mask": ended})
                 teacher_plays = np.where(ended, new_episodes(ended), teacher_plays)
             elif step % 200 < n:
-                report(Progress(step, config.steps))
+                run.report(Progress(step, config.steps))
 
         # 2. learn from everything gathered so far, the step size falling along a cosine over the run
         count = max(1, round(settings.updates_per_step * gathered))
@@ -189,62 +111,23 @@ def _dagger(target, config: TrainConfig, folder: Path, report, stop_after, about
         rounds += 1
 
         # 3. evaluate, keep the best, checkpoint
-        figures = evaluate(agent, target, env_config, config.eval_episodes)
-        evaluations.append({"step": step, "round": rounds, **figures})
-        if better(figures, best):
-            best, best_tensors = {"step": step, **figures}, policy_tensors()
-        seconds = seconds_before + time.perf_counter() - started
-        log.evaluation(step, seconds, figures, episode)
-        report(Progress(step, config.steps, eval_f1=figures["f1"], losses=losses))
-        if config.stop_f1 is not None and figures["f1"] >= config.stop_f1:
+        figures = run.evaluate(agent)
+        run.evaluations.append({"step": step, "round": rounds, **figures})
+        run.keep_if_best(step, figures, agent)
+        run.log.evaluation(step, run.seconds(), figures, episode)
+        run.report(Progress(step, config.steps, eval_f1=figures["f1"], losses=losses))
+        if run.reached(figures):
             final = {"step": step, **figures}
             break
         if step < config.steps:
-            state = {
-                "step": step,
-                "episode": episode,
-                "rounds": rounds,
-                "updates": agent.updates,
-                "evaluations": evaluations,
-                "rng": rng.bit_generator.state,
-                "env_rng": env_generators(envs),
-                "buffer_size": dataset.size,
-                "buffer_cursor": dataset.cursor,
-                "best": best,
-                "seconds": seconds,
-                "start": began,
-            }
-            kept = {BEST_PREFIX + k: v for k, v in (best_tensors or {}).items()}
-            store.save_checkpoint(
-                folder,
-                {**agent.tensors(), **learner.tensors(), "torch_rng": torch.get_rng_state(), **kept},
-                state,
-                dataset,
-            )
+            run.checkpoint(agent, dataset, rng, step, episode, {"rounds": rounds}, learner.tensors())
         if stop_after is not None and step >= stop_after:
             return {"interrupted_at": step}
         observations, _ = envs.reset(options={"reset_mask": ended})  # the episodes that ended the round
         teacher_plays = np.where(ended, new_episodes(ended), teacher_plays)
 
     if final is None:  # every round ended in an evaluation: the best of them is the policy
-        final, tensors = best, best_tensors
+        final, tensors = run.best, run.best_tensors
     else:
-        tensors = policy_tensors()
-    manifest = {
-        **(about or {}),
-        "target": target if isinstance(target, str) else [asdict(note) for note in target.notes],
-        "steps": step,
-        "updates": agent.updates,
-        "seconds": round(seconds_before + time.perf_counter() - started, 1),
-        "device": agent.device.type,
-        "start": began,
-        "evaluation": final,
-        "evaluations": evaluations,
-        "config": to_dict(config),
-    }
-    policy, _ = split_kept(tensors)
-    store.save_policy(folder, policy, manifest)
-    store.drop_checkpoint(folder)
-    log.plot()
-    report(Progress(step, config.steps, finished=True))
-    return manifest
+        tensors = run.policy_tensors(agent)
+    return run.finish(agent, step, final, tensors)
