@@ -303,10 +303,17 @@ def test_train_a_task_family_evaluates_on_many_instances(tmp_path):
 
 
 def test_play_sac_without_policies_names_the_phrase_and_the_train_command(tmp_path):
-    """The trained policies play by default: without them, one line says how to get them or what else to do."""
-    result = run("play", EXAMPLES / "three-note.mid", "-o", tmp_path / "x.mid", "--models", tmp_path)
+    """The trained policies play by default: without them (and without the general policy), one
+    line says where it looked and how to get them or what else to do."""
+    result = run("play", EXAMPLES / "three-note.mid", "-o", tmp_path / "x.mid", "--models", tmp_path, "--no-general")
     assert_one_line_error(
-        result, "phrase 0 (C4 D4 E4)", "pianobot train", "--fallback scripted", "--controller scripted"
+        result,
+        "phrase 0 (C4 D4 E4)",
+        str(tmp_path),
+        "pianobot train",
+        "--models",
+        "--fallback scripted",
+        "--controller scripted",
     )
     assert not (tmp_path / "x.mid").exists()
 

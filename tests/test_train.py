@@ -663,10 +663,10 @@ def test_the_learner_runs_on_the_cpu_here_and_a_missing_gpu_is_one_line(tmp_path
 
     monkeypatch.setattr(torch.cuda, "is_available", lambda: False)
     assert resolve_device("auto") == resolve_device("cpu") == torch.device("cpu")
-    with pytest.raises(PianobotError, match="--device cuda: torch .* sees no CUDA GPU") as error:
+    with pytest.raises(PianobotError, match="train.device cuda: torch .* sees no CUDA GPU") as error:
         resolve_device("cuda")
     assert "\n" not in str(error.value)
-    with pytest.raises(PianobotError, match="--device cuda"):
+    with pytest.raises(PianobotError, match="train.device cuda"):
         train_policy(PHRASE, small(device="cuda"), tmp_path / "m")
     with pytest.raises(ValueError, match="device must be one of auto, cpu, cuda"):
         small(device="gpu")
