@@ -82,94 +82,28 @@ AllRows = typer.Option(False, "--all", help="List every note and phrase (by defa
 # -- reading a piece, once for every command that reads one ---------------------------------------
 PIECE = "Reading the piece"
 INSTRUMENT = "Keyboard and hand"
+
+
+def _reading(kind, default, flag: str, text: str, panel: str = PIECE) -> tuple:
+    """One reading option: its type, and its typer option in its help panel."""
+    return kind, typer.Option(default, flag, help=text, rich_help_panel=panel)
+
+
+# fmt: off
 READING = {  # parameter name: (type, option); the commands' --help shows them in two panels of their own
-    "track": (
-        Optional[str],
-        typer.Option(
-            None,
-            "--track",
-            help="Read only this track (index or name); default: merge all tracks.",
-            rich_help_panel=PIECE,
-        ),
-    ),
-    "tempo": (
-        Optional[float],
-        typer.Option(
-            None,
-            "--tempo",
-            help="Re-time the piece at this constant tempo in bpm (the paper uses 60).",
-            rich_help_panel=PIECE,
-        ),
-    ),
-    "transpose": (
-        int,
-        typer.Option(
-            LoadOptions.transpose, "--transpose", help="Shift every note by this many semitones.", rich_help_panel=PIECE
-        ),
-    ),
-    "fingering": (
-        Optional[Path],
-        typer.Option(
-            None,
-            "--fingering",
-            help="PIG fingering file for the notes (default: <song>_fingering.txt beside the .mid, if any).",
-            rich_help_panel=PIECE,
-        ),
-    ),
-    "hand_part": (
-        Optional[HandPart],
-        typer.Option(
-            None,
-            "--hand",
-            help="Play one hand's part of a two-hand piece: right or left (tracks named for it, else split by pitch).",
-            rich_help_panel=PIECE,
-        ),
-    ),
-    "split": (
-        str,
-        typer.Option(
-            pitch_name(LoadOptions.split),
-            "--split",
-            help="With --hand and no track named for it: lowest note of the right hand's part.",
-            rich_help_panel=PIECE,
-        ),
-    ),
-    "quantize": (
-        Optional[str],
-        typer.Option(
-            None,
-            "--quantize",
-            help="Move onsets and offsets to a grid, e.g. 1/16 (for recordings of human players).",
-            rich_help_panel=PIECE,
-        ),
-    ),
-    "refinger": (
-        bool,
-        typer.Option(
-            LoadOptions.refinger,
-            "--refinger",
-            help="Replace the file's fingering with the planner's (e.g. human fingering for five fingers).",
-            rich_help_panel=PIECE,
-        ),
-    ),
-    "lowest_note": (
-        str,
-        typer.Option(
-            pitch_name(KeyboardSpec.lowest),
-            "--lowest-note",
-            help="Lowest key of the keyboard (name like C4, or MIDI number).",
-            rich_help_panel=INSTRUMENT,
-        ),
-    ),
-    "keys": (
-        int,
-        typer.Option(KeyboardSpec.count, "--keys", help="Number of keys on the keyboard.", rich_help_panel=INSTRUMENT),
-    ),
-    "thumb": (
-        bool,
-        typer.Option(False, "--thumb", help="Let the hand use its thumb (finger 1) too.", rich_help_panel=INSTRUMENT),
-    ),
+    "track": _reading(Optional[str], None, "--track", "Read only this track (index or name); default: merge all tracks."),
+    "tempo": _reading(Optional[float], None, "--tempo", "Re-time the piece at this constant tempo in bpm (the paper uses 60)."),
+    "transpose": _reading(int, LoadOptions.transpose, "--transpose", "Shift every note by this many semitones."),
+    "fingering": _reading(Optional[Path], None, "--fingering", "PIG fingering file for the notes (default: <song>_fingering.txt beside the .mid, if any)."),
+    "hand_part": _reading(Optional[HandPart], None, "--hand", "Play one hand's part of a two-hand piece: right or left (tracks named for it, else split by pitch)."),
+    "split": _reading(str, pitch_name(LoadOptions.split), "--split", "With --hand and no track named for it: lowest note of the right hand's part."),
+    "quantize": _reading(Optional[str], None, "--quantize", "Move onsets and offsets to a grid, e.g. 1/16 (for recordings of human players)."),
+    "refinger": _reading(bool, LoadOptions.refinger, "--refinger", "Replace the file's fingering with the planner's (e.g. human fingering for five fingers)."),
+    "lowest_note": _reading(str, pitch_name(KeyboardSpec.lowest), "--lowest-note", "Lowest key of the keyboard (name like C4, or MIDI number).", INSTRUMENT),
+    "keys": _reading(int, KeyboardSpec.count, "--keys", "Number of keys on the keyboard.", INSTRUMENT),
+    "thumb": _reading(bool, False, "--thumb", "Let the hand use its thumb (finger 1) too.", INSTRUMENT),
 }
+# fmt: on
 
 
 @dataclass(frozen=True)
