@@ -23,6 +23,7 @@ from pianobot.sim.world import WorldConfig
 EXAMPLES = sorted((Path(__file__).parent.parent / "examples" / "midi").glob("*.mid"))
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("path", EXAMPLES, ids=lambda p: p.stem)
 def test_scripted_pianist_plays_every_example(path):
     """The performance-style files are read (and reduced) as `--hand right` would, and fingered by the planner."""

@@ -82,6 +82,7 @@ def test_the_two_hand_recordings_look_like_recordings(name):
     assert len({n.velocity for n in piece.notes}) >= 25
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", RECORDINGS)
 def test_a_recordings_right_hand_plays_without_editing(name, tmp_path):
     """`pianobot play FILE --hand right --controller scripted`, scored with `pianobot score out.mid

@@ -130,6 +130,7 @@ def test_ensure_fingering_keeps_given_fingering_unless_asked():
     assert plan is not None and [n.finger for n in refingered.notes] != [2, 2, 2]
 
 
+@pytest.mark.slow
 def test_scripted_pianist_plays_planner_fingered_tunes():
     """Six random tunes: mean note F1 >= 0.95 and none below 0.9 (a late note after a hop beside
     a black key is what remains, docs/fingering.md)."""

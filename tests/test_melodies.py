@@ -5,6 +5,7 @@ The full set (4 per key) is ``python benchmarks/melodies.py``; this plays 2 per 
 """
 
 import numpy as np
+import pytest
 
 from pianobot.music.instrument import HandSpec, KeyboardSpec
 from pianobot.music.melodies import MelodyKey, melody_set, random_melody
@@ -51,6 +52,7 @@ def test_the_set_has_black_keys_leaps_repeats_and_rests():
     assert any(KeyboardSpec.is_black(a) != KeyboardSpec.is_black(b) for a, b in hops)  # hops onto and off black keys
 
 
+@pytest.mark.slow
 def test_the_scripted_pianist_plays_a_random_melody_in_every_key():
     results = []
     for melody in melody_set(2, _playable):
