@@ -342,7 +342,7 @@ def test_play_sac_composes_trained_and_fallback_phrases(tmp_path):
     assert_one_line_error(run(*args), "phrase 1 (G4)")
     result = run(*args, "--fallback", "scripted")
     assert result.exit_code == 0, result.output
-    assert "phrases 1 had no trained policy" in result.output
+    assert "phrase 1: scripted pianist" in result.output
     report = json.loads((tmp_path / "out.report.json").read_text())
     assert report["phrases"]["0"].startswith("own policy ") and report["phrases"]["1"] == "scripted pianist"
     played = [n for n in read_played(tmp_path / "out.mid") if n.pitch == 67 and n.onset >= 2.0]
@@ -496,7 +496,7 @@ def test_train_workers_train_phrases_in_parallel(tmp_path):
     assert played.exit_code == 0, played.output
     assert "2 phrases of at most 1 note:" in played.output
     phrases = json.loads((tmp_path / "out.report.json").read_text())["phrases"]
-    assert sorted(phrases) == ["0", "1"] and all(v.startswith("policy ") for v in phrases.values())
+    assert sorted(phrases) == ["0", "1"] and all(v.startswith("own policy ") for v in phrases.values())
 
 
 MODELS = Path(__file__).parent.parent / "models"

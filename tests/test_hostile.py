@@ -71,7 +71,7 @@ def test_file_names_outside_latin_1_finger_and_play(tmp_path):
     assert describe_tracks(tmp_path / "指 使い.mid")[0].name == "音 楽 fingered by pianobot"
     played = run("play", song, "-o", tmp_path / "演奏.mid", "--controller", "scripted")
     assert played.exit_code == 0, played.output
-    assert describe_tracks(tmp_path / "演奏.mid")[0].name == "pianobot scripted: 音 楽"
+    assert describe_tracks(tmp_path / "演奏.mid")[0].name == "pianobot (scripted pianist): 音 楽"
     assert read_midi(tmp_path / "演奏.mid").has_fingering
     assert run("score", tmp_path / "演奏.mid", song).exit_code == 0
 

@@ -34,10 +34,11 @@ from pianobot.music.instrument import HandSpec, KeyboardSpec
 from pianobot.music.metrics import Report
 from pianobot.music.phrases import DEFAULT_MAX_NOTES, Phrase, split_phrases
 from pianobot.music.piece import Piece
+from pianobot.perform import perform as simulation  # (called through the module: tests replace simulation.perform)
 from pianobot.perform.compose import CompositionalController, find_policy, trained_split
 from pianobot.perform.controllers import CONTROLLERS
 from pianobot.perform.guard import WristGuard
-from pianobot.perform.perform import PLAY_CONFIG, perform
+from pianobot.perform.perform import PLAY_CONFIG
 from pianobot.perform.rollout import Rollout
 from pianobot.sim.hand import HandConfig
 from pianobot.sim.keyboard import KeyboardConfig
@@ -188,8 +189,9 @@ def assign(
             raise PianobotError(
                 f"phrase {phrase.index} ({notes}) has no policy of its own in the model store {models} "
                 f"({Path(models).resolve()}) and no general policy plays it (looked there and in {PACKAGED}): "
-                "train it with `pianobot train` (same reading options), name another store with --models DIR, "
-                "add --fallback scripted, or play with --controller scripted"
+                "train it with `pianobot train` (same reading options), train a general policy with "
+                "`pianobot train --task melody`, name another store with --models DIR, add --fallback scripted, "
+                "or play with --controller scripted"
             )
     return stretches_for(phrases, own, general)
 
@@ -317,14 +319,14 @@ def perform_plan(
     (first, *others) = plan.stretches
     if not others and first.player in (Player.SCRIPTED, Player.RANDOM):
         name = "scripted" if first.player is Player.SCRIPTED else "random"
-        return Performance(plan, perform(plan.piece, name, plan.config, seed, video, on_step), seed)
+        return Performance(plan, simulation.perform(plan.piece, name, plan.config, seed, video, on_step), seed)
     made: list[CompositionalController] = []
 
     def controller(env):
         made.append(CompositionalController(env, plan.stretches, plan.wrist_guard))
         return made[0]
 
-    played = perform(plan.piece, controller, plan.config, seed, video, on_step)
+    played = simulation.perform(plan.piece, controller, plan.config, seed, video, on_step)
     guards = [s.controller for s in made[0].sections if isinstance(s.controller, WristGuard)]
     return Performance(plan, played, seed, guards[0].capped if guards else None)
 
