@@ -60,7 +60,9 @@ def test_one_player_plans_and_refusals(tmp_path):
     with pytest.raises(PianobotError, match="controller 'sac2'"):
         plan_performance(piece, "sac2")
     # with the thumb the packaged policy (three fingers) does not fit: nobody plays, said with where it looked
-    with pytest.raises(PianobotError, match=r"no general policy plays it \(looked there and in .*policies\).*--models"):
+    with pytest.raises(
+        PianobotError, match=r"no general policy plays it \(looked there and in .*policies\).*store.models"
+    ):
         plan_performance(piece, models=tmp_path, hand=HandSpec(fingers=(1, 2, 3, 4)))
     assert plan_performance(piece, models=tmp_path, general=False, fallback=True).performer == "scripted pianist"
     with pytest.raises(ValueError):
@@ -107,3 +109,21 @@ def test_a_phrase_policy_that_makes_the_piece_worse_is_not_used(tmp_path):
     assert "made the piece play worse" in store.general_plays(models)[still.name]["why"]
     after = [play(piece, models=models, seed=s).report().f1 for s in JUDGE_SEEDS]
     assert after == before and play(piece, models=models).plan.performer == "general policy"
+
+
+def test_the_library_names_settings_and_the_command_line_their_options(tmp_path):
+    from pianobot.cli.flags import phrase
+    from pianobot.errors import SettingError
+
+    piece = pianobot.load_piece(EXAMPLES / "mary.mid")
+    with pytest.raises(SettingError) as refused:
+        plan_performance(piece, models=tmp_path, general=False)
+    assert refused.value.field == "store.models" and "play.fallback scripted" in str(refused.value)
+    assert "--models DIR" in phrase(refused.value) and "--fallback scripted" in phrase(refused.value)
+    (tmp_path / "bad").mkdir()
+    (tmp_path / "bad" / store.MANIFEST_FILE).write_text("{")
+    with pytest.raises(SettingError) as unreadable:
+        store.read_manifest(tmp_path / "bad")
+    assert unreadable.value.field == "jobs.force" and phrase(unreadable.value).endswith(
+        "retrain the phrase with --force"
+    )

@@ -25,7 +25,7 @@ from pianobot.agent.config import SACConfig
 from pianobot.agent.policy import policy_configs
 from pianobot.config import to_dict
 from pianobot.env.piano import EnvConfig
-from pianobot.errors import PianobotError
+from pianobot.errors import PianobotError, SettingError
 from pianobot.music.tasks import MELODY
 
 if TYPE_CHECKING:
@@ -41,18 +41,19 @@ PACKAGED = Path(__file__).resolve().parent.parent / "policies"
 NETWORK_FIELDS = ("hidden", "actor", "score_input", "score_features", "tactile_channels", "tactile_features")
 """The :class:`SACConfig` fields that shape the networks: a start policy's must be the run's."""
 
-OPTIONS = {
-    "env.tactile": "--tactile/--no-tactile",
-    "env.actuated": "--joints",
-    "env.world.control": "--control",
-    "env.world.keyboard.spec": "--lowest-note/--keys",
-    "env.world.hand.spec": "--thumb",
-    "env.reward.kind": "--reward",
-    "env.reward.fingering_gate": "--fingering-gate/--no-fingering-gate",
-    "sac.actor": "--actor",
-    "sac.": "the agent's network settings (SACConfig)",
-}
-"""The command-line option that sets a configuration field (by dotted prefix)."""
+SETTINGS = (
+    "env.tactile",
+    "env.actuated",
+    "env.world.control",
+    "env.world.keyboard.spec",
+    "env.world.hand.spec",
+    "env.reward.kind",
+    "env.reward.fingering_gate",
+    "sac.actor",
+    "sac",
+)
+"""The settings a difference is named by (a field's dotted path under :class:`TrainConfig`, as
+``train.<path>``, the longest that contains it): the command line says which option sets each."""
 
 
 def _difference(ours: Any, theirs: Any, path: str) -> tuple[str, Any, Any] | None:
@@ -80,9 +81,10 @@ def difference(
     return found
 
 
-def option_for(path: str) -> str:
-    """The command-line option behind a configuration field (its dotted path), else the path."""
-    return next((option for prefix, option in OPTIONS.items() if path.startswith(prefix)), f"config.{path}")
+def setting_for(path: str) -> str:
+    """The setting (``train.<dotted path>``) a differing field belongs to, else the field itself."""
+    found = next((s for s in SETTINGS if path == s or path.startswith(s + ".")), path)
+    return f"train.{found}"
 
 
 def _show(value: Any) -> str:
@@ -94,11 +96,12 @@ def _show(value: Any) -> str:
 
 
 def explain(folder: Path, found: tuple[str, Any, Any], ours: str) -> str:
-    """'the general policy F was trained with PATH X, OURS with Y (OPTION)'."""
+    """'the general policy F was trained with PATH X, OURS with Y (SETTING)': the setting by its
+    field (:func:`setting_for`), which the command line names as its option."""
     path, mine, theirs = found
     return (
         f"the general policy {folder} was trained with {path} {_show(theirs)}, {ours} with {_show(mine)} "
-        f"({option_for(path)})"
+        f"({setting_for(path)})"
     )
 
 
@@ -130,7 +133,7 @@ def find_general(
     if path is not None:
         if not store.is_trained(Path(path)):
             raise PianobotError(
-                f"--general-policy {path}: not a trained policy folder (one holding {store.POLICY_FILE} and "
+                f"general.path {path}: not a trained policy folder (one holding {store.POLICY_FILE} and "
                 f"{store.MANIFEST_FILE}, e.g. {Path(models) / GENERAL_KEY}-<config hash>)"
             )
         candidates = [Path(path)]
@@ -151,7 +154,7 @@ def find_general(
     if first is None:
         return None
     folder, found = first
-    raise PianobotError(explain(folder, found, ours) + (f": {remedy}" if remedy else ""))
+    raise SettingError(explain(folder, found, ours) + (f": {remedy}" if remedy else ""), setting_for(found[0]))
 
 
 def describe(folder: Path) -> dict:

@@ -35,7 +35,7 @@ from typing import TYPE_CHECKING
 from safetensors import SafetensorError
 
 from pianobot.config import to_dict
-from pianobot.errors import PianobotError
+from pianobot.errors import PianobotError, SettingError
 from pianobot.files import atomic_write, move_into_place, temporary_beside
 
 if TYPE_CHECKING:  # torch is imported by the functions that read and write tensors: finding models needs none
@@ -135,10 +135,10 @@ def load_tensors(path: Path) -> dict[str, torch.Tensor]:
     try:
         return load_file(path)
     except FileNotFoundError:
-        raise PianobotError(f"model file {path} is missing: retrain the phrase with --force") from None
+        raise SettingError(f"model file {path} is missing: retrain the phrase with jobs.force", "jobs.force") from None
     except (SafetensorError, OSError, ValueError) as e:
-        raise PianobotError(
-            f"model file {path} is not a readable safetensors file ({e}): retrain with --force"
+        raise SettingError(
+            f"model file {path} is not a readable safetensors file ({e}): retrain with jobs.force", "jobs.force"
         ) from None
 
 
@@ -183,16 +183,20 @@ def read_manifest(folder: Path) -> dict:
     except FileNotFoundError:
         raise PianobotError(f"{folder} holds no {MANIFEST_FILE}: it is not a trained pianobot policy") from None
     except (OSError, UnicodeDecodeError, json.JSONDecodeError) as e:
-        raise PianobotError(f"{path} is not a readable manifest ({e}): retrain the phrase with --force") from None
+        raise SettingError(
+            f"{path} is not a readable manifest ({e}): retrain the phrase with jobs.force", "jobs.force"
+        ) from None
     if not isinstance(manifest, dict) or manifest.get("format") not in range(1, FORMAT + 1):
-        raise PianobotError(
-            f"{path} is not a pianobot model manifest (formats 1 to {FORMAT}): retrain the phrase with --force"
+        raise SettingError(
+            f"{path} is not a pianobot model manifest (formats 1 to {FORMAT}): retrain the phrase with jobs.force",
+            "jobs.force",
         )
     if not isinstance(manifest.get("config"), dict) or not all(
         isinstance(manifest["config"].get(k), dict) for k in ("env", "sac")
     ):
-        raise PianobotError(
-            f"{path} does not record the configuration its policy was trained with: retrain the phrase with --force"
+        raise SettingError(
+            f"{path} does not record the configuration its policy was trained with: retrain the phrase with jobs.force",
+            "jobs.force",
         )
     return upgrade_manifest(manifest)
 
@@ -371,8 +375,9 @@ def training_lock(folder: Path):
         except BlockingIOError:
             lock.seek(0)
             holder = lock.read().strip() or "another process"
-            raise PianobotError(
-                f"{folder} is being trained by {holder}: wait for it to finish, or train into another --models folder"
+            raise SettingError(
+                f"{folder} is being trained by {holder}: wait for it to finish, or train into another store.models folder",
+                "store.models",
             ) from None
         lock.seek(0)
         lock.truncate()

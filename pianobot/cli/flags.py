@@ -27,6 +27,19 @@ FLAGS = {
     "jobs.force": "--force",
     "train.device": "--device",
     "train.dagger.round_steps": "--round-steps",
+    "store.models": "--models",
+    "general.path": "--general-policy",
+    "play.controller": "--controller",
+    "play.fallback": "--fallback",
+    "train.env.tactile": "--tactile/--no-tactile",
+    "train.env.actuated": "--joints",
+    "train.env.world.control": "--control",
+    "train.env.world.keyboard.spec": "--lowest-note/--keys",
+    "train.env.world.hand.spec": "--thumb",
+    "train.env.reward.kind": "--reward",
+    "train.env.reward.fingering_gate": "--fingering-gate/--no-fingering-gate",
+    "train.sac.actor": "--actor",
+    "train.sac": "the agent's network settings (SACConfig)",
 }
 """Setting (its dotted field path) -> the option that sets it. Training fields are ``train.``
 and their path in :class:`~pianobot.learn.config.TrainConfig` (``train.env.world.control``)."""

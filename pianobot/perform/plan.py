@@ -29,7 +29,7 @@ from pianobot.agent import store
 from pianobot.agent.general import PACKAGED, describe, find_general, general_candidates
 from pianobot.agent.policy import policy_configs
 from pianobot.env.piano import EnvConfig
-from pianobot.errors import PianobotError
+from pianobot.errors import PianobotError, SettingError
 from pianobot.music.instrument import HandSpec, KeyboardSpec
 from pianobot.music.metrics import Report
 from pianobot.music.phrases import DEFAULT_MAX_NOTES, Phrase, split_phrases
@@ -186,12 +186,13 @@ def assign(
     for phrase in phrases:
         if phrase.index not in own and general is None and not fallback:
             notes = " ".join(n.name for n in phrase.notes)
-            raise PianobotError(
+            raise SettingError(
                 f"phrase {phrase.index} ({notes}) has no policy of its own in the model store {models} "
                 f"({Path(models).resolve()}) and no general policy plays it (looked there and in {PACKAGED}): "
                 "train it with `pianobot train` (same reading options), train a general policy with "
-                "`pianobot train --task melody`, name another store with --models DIR, add --fallback scripted, "
-                "or play with --controller scripted"
+                "`pianobot train --task melody`, name another store with store.models DIR, add play.fallback scripted, "
+                "or play with play.controller scripted",
+                "store.models",
             )
     return stretches_for(phrases, own, general)
 
@@ -250,11 +251,12 @@ def _general_for(
     if not theirs:  # (the packaged policy plays its own keyboard and hand only)
         return None
     world = policy_configs(theirs[0])[0].world
-    raise PianobotError(
+    raise SettingError(
         f"the general policy {theirs[0]} plays {world.keyboard.spec.describe()} with fingers "
         f"{world.hand.spec.describe()}, this piece is read for {keyboard.describe()} with fingers {hand.describe()} "
-        "(--lowest-note/--keys/--thumb): play with --controller scripted, or train a general policy for them "
-        "with `pianobot train --task melody` and the same options"
+        "(keyboard.lowest, keyboard.count, hand.fingers): play with play.controller scripted, or train a general policy for them "
+        "with `pianobot train --task melody` and the same options",
+        "keyboard.lowest",
     )
 
 
@@ -283,7 +285,7 @@ def plan_performance(
     split (default: the longest whose phrases all have a player in the store). ``gui``: show the
     simulation."""
     if controller not in CONTROLLERS:
-        raise PianobotError(f"controller {controller!r}: choose one of {', '.join(CONTROLLERS)}")
+        raise SettingError(f"play.controller {controller!r}: choose one of {', '.join(CONTROLLERS)}", "play.controller")
     if general_policy is not None and not general:
         raise PianobotError(f"--general-policy {general_policy} and --no-general ask for opposite things: give one")
     keyboard, hand = keyboard or KeyboardSpec(), hand or HandSpec()
@@ -303,11 +305,16 @@ def plan_performance(
     if env is None:  # the scripted pianist plays every phrase
         env = replace(PLAY_CONFIG, world=world)
     if env.world.keyboard.spec != keyboard or env.world.hand.spec != hand:
-        raise PianobotError(
-            f"the policies in {models} were trained for another keyboard or hand: use the same --lowest-note/--keys/--thumb"
+        raise SettingError(
+            f"the policies in {models} were trained for another keyboard or hand: use the same keyboard.lowest, "
+            "keyboard.count and hand.fingers",
+            "keyboard.lowest",
         )
     if any(s.player is Player.SCRIPTED for s in stretches) and env.world.control == "torque":
-        raise PianobotError("--fallback scripted needs policies trained with --control velocity or position")
+        raise SettingError(
+            "play.fallback scripted needs policies trained with train.env.world.control velocity or position",
+            "play.fallback",
+        )
     return PerformancePlan(piece, replace(env, world=replace(env.world, gui=gui)), stretches, wrist_guard)
 
 
