@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import torch
-from typer.testing import CliRunner
+from conftest import assert_one_line_error, run
 
 from pianobot.agent import store
 from pianobot.agent.general import GENERAL_KEY, PACKAGED, describe
@@ -23,18 +23,6 @@ EXAMPLES = Path(__file__).parent.parent / "examples" / "midi"
 MODELS = Path(__file__).parent.parent / "models"
 ONE_NOTE_POLICY = MODELS / "5755063dc478979f-080639abf744"  # committed: plays one-note.mid at F1 1.0
 QUICK = ("--steps", "60", "--exploration-steps", "30", "--no-tactile")
-
-
-def run(*args):
-    return CliRunner().invoke(app, [str(a) for a in args])
-
-
-def one_line_error(result, *words):
-    assert result.exit_code == 2, result.output
-    lines = result.stderr.strip().splitlines()
-    assert len(lines) == 1 and lines[0].startswith("error: "), result.output
-    for word in words:
-        assert word in lines[0], lines[0]
 
 
 @pytest.fixture(scope="module")
@@ -87,9 +75,9 @@ def test_train_starts_each_phrase_from_the_general_policy_unless_told_not_to(mod
     # the store's general policy observes no touch; the packaged one does, and fits: the run starts from it
     assert tactile.exit_code == 0 and str(PACKAGED) in " ".join(tactile.output.split()), tactile.output
     wrong = run("train", EXAMPLES / "one-note.mid", *QUICK, "--general-policy", models / "nothing", "--models", models)
-    one_line_error(wrong, "--general-policy", "not a trained policy folder")
+    assert_one_line_error(wrong, "--general-policy", "not a trained policy folder")
     unused = run("train", EXAMPLES / "one-note.mid", *QUICK, "--no-from-general", "--general-policy", general)
-    one_line_error(unused, "--general-policy", "--no-from-general")
+    assert_one_line_error(unused, "--general-policy", "--no-from-general")
 
 
 def test_train_task_with_general_policy_continues_that_policy(tmp_path, general):
@@ -112,7 +100,7 @@ def test_train_task_with_general_policy_continues_that_policy(tmp_path, general)
     itself = run(
         "train", "--task", "melody", *QUICK, "--general-policy", general, "--models", general.parent, "--force"
     )
-    one_line_error(itself, "--general-policy", "the folder this run trains into", "copy it")
+    assert_one_line_error(itself, "--general-policy", "the folder this run trains into", "copy it")
     assert {f.name: f.read_bytes() for f in general.iterdir() if f.is_file()} == files
 
 
@@ -198,16 +186,18 @@ def test_play_uses_a_phrases_own_policy_then_the_general_policy_and_says_so(tmp_
     assert report["general_policy"] == describe(general)
 
     # own policy > general policy > scripted fallback: without the general policy, as before
-    one_line_error(run(*args, "--no-general"), "phrase 1 (G4)", "--fallback scripted", "pianobot train --task melody")
+    assert_one_line_error(
+        run(*args, "--no-general"), "phrase 1 (G4)", "--fallback scripted", "pianobot train --task melody"
+    )
     fallback = run(*args, "--no-general", "--fallback", "scripted")
     assert fallback.exit_code == 0, fallback.output
     report = json.loads((tmp_path / "out.report.json").read_text())
     assert report["phrases"]["1"] == "scripted pianist" and "general_policy" not in report
-    one_line_error(run(*args, "--no-general", "--general-policy", general), "--general-policy", "--no-general")
+    assert_one_line_error(run(*args, "--no-general", "--general-policy", general), "--general-policy", "--no-general")
 
     # a general policy trained in another environment than the phrase policies is refused
     other = run(*args, "--general-policy", ONE_NOTE_POLICY)
-    one_line_error(other, f"the general policy {ONE_NOTE_POLICY} was trained with env.", "--no-general")
+    assert_one_line_error(other, f"the general policy {ONE_NOTE_POLICY} was trained with env.", "--no-general")
 
 
 def test_play_with_only_the_general_policy_plays_every_phrase_in_its_environment(tmp_path, models):
@@ -300,7 +290,7 @@ def test_a_phrase_trained_from_the_general_policy_takes_its_actor(tmp_path):
         store.config_hash(config_from_manifest(manifest))
     )  # its networks name it
     mlp = run("train", EXAMPLES / "one-note.mid", *QUICK, "--actor", "mlp", "--models", models, "--force")
-    one_line_error(mlp, "sac.actor fingers", "this run with mlp", "--actor", "--no-from-general")
+    assert_one_line_error(mlp, "sac.actor fingers", "this run with mlp", "--actor", "--no-from-general")
     kept = (Path(policy["folder"]) / store.POLICY_FILE).read_bytes()
     scratch = run("train", EXAMPLES / "one-note.mid", *QUICK, "--no-from-general", "--models", models, "--json", "-")
     assert scratch.exit_code == 0, scratch.output
@@ -310,8 +300,10 @@ def test_a_phrase_trained_from_the_general_policy_takes_its_actor(tmp_path):
     assert (Path(policy["folder"]) / store.POLICY_FILE).read_bytes() == kept
     # continuing the fingers policy with its own options would train into its folder: refused
     itself = run("train", "--task", "melody", *QUICK, "--general-policy", general, "--models", models, "--force")
-    one_line_error(itself, "--general-policy", "the folder this run trains into")
-    one_line_error(run("train", "--task", "melody", *QUICK, "--actor", "cnn"), "'--actor'", "'cnn'", "'mlp', 'fingers'")
+    assert_one_line_error(itself, "--general-policy", "the folder this run trains into")
+    assert_one_line_error(
+        run("train", "--task", "melody", *QUICK, "--actor", "cnn"), "'--actor'", "'cnn'", "'mlp', 'fingers'"
+    )
 
 
 def test_the_newest_general_policy_is_the_last_trained_not_the_last_checked_out(tmp_path, general):

@@ -153,14 +153,7 @@ class PianoWorld:
     def _hold(self, finger_angles: np.ndarray, wrist: float) -> None:
         """Motors hold the current pose until the first action arrives."""
         c, hand = self.client, self.config.hand
-        p.setJointMotorControl2(
-            self.hand,
-            self.wrist_joint,
-            p.POSITION_CONTROL,
-            targetPosition=wrist,
-            force=hand.wrist_force,
-            physicsClientId=c,
-        )
+        self._drive_wrist(p.POSITION_CONTROL, targetPosition=wrist)
         p.setJointMotorControlArray(
             self.hand,
             self.finger_joints,
@@ -256,24 +249,21 @@ class PianoWorld:
             )
         if cfg.discrete_wrist:
             target = self.discrete_wrist_position(wrist)
-            p.setJointMotorControl2(
-                self.hand,
-                self.wrist_joint,
-                p.POSITION_CONTROL,
-                targetPosition=target,
-                maxVelocity=hand.max_wrist_speed,
-                force=hand.wrist_force,
-                physicsClientId=c,
-            )
+            self._drive_wrist(p.POSITION_CONTROL, targetPosition=target, maxVelocity=hand.max_wrist_speed)
         else:
-            p.setJointMotorControl2(
-                self.hand,
-                self.wrist_joint,
-                p.VELOCITY_CONTROL,
-                targetVelocity=wrist * hand.max_wrist_speed,
-                force=hand.wrist_force,
-                physicsClientId=c,
-            )
+            self._drive_wrist(p.VELOCITY_CONTROL, targetVelocity=wrist * hand.max_wrist_speed)
+
+    def _drive_wrist(self, mode: int, **target: float) -> None:
+        """The wrist's motor in ``mode`` towards ``target`` (pybullet's targetPosition, maxVelocity,
+        targetVelocity), with at most the hand's wrist force."""
+        p.setJointMotorControl2(
+            self.hand,
+            self.wrist_joint,
+            mode,
+            force=self.config.hand.wrist_force,
+            physicsClientId=self.client,
+            **target,
+        )
 
     def _drive_fingers(self, torque: bool, left: int) -> None:
         """Apply the finger command for one physics step, never driving a joint past its limit.
