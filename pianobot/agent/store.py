@@ -51,7 +51,9 @@ reading (:func:`upgrade_manifest`), so every model a user has keeps playing.
   policy training began from, fine-tuning; docs/training.md), ``config.finetune_until_f1``
   (unused without ``from_general``), ``config.envs`` and ``config.device`` (1, auto),
   ``config.sac.actor`` ('mlp'), ``saved`` (when the policy was stored: the manifest file's
-  modification time stands in); the file
+  modification time stands in), ``kept`` ('trained': a stored policy; a run whose start policy
+  already played its phrase now stores none, returns ``kept: 'start'`` and is recorded in
+  :data:`GENERAL_INDEX`; before, it stored a copy of the start); the file
   ``critic.safetensors`` (missing: the policy cannot pass its critic on to a fine-tuning run,
   which then begins with fresh Q heads).
 - 1: the agent's ``config.sac.tactile_resolution`` overrode ``config.env.tactile_pool``; the
@@ -172,6 +174,7 @@ def upgrade_manifest(manifest: dict) -> dict:
     if isinstance(manifest.get("config"), dict):  # fields added within format 2 (see FORMAT)
         manifest["config"].setdefault("from_general", False)
     manifest.setdefault("start", None)
+    manifest.setdefault("kept", "trained")  # (a stored policy was trained, or copied from its start before ``kept``)
     return manifest
 
 
