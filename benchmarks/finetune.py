@@ -1,4 +1,4 @@
-"""Fine-tuning from the general policy: wall time per phrase to note F1 >= 0.95, on phrases no run has seen.
+"""Fine-tuning from the general policy: wall time per phrase until its evaluation reaches note F1 >= 0.95, on unseen phrases.
 
     python benchmarks/finetune.py [--general DIR] [--learner sac|dagger] [--steps N] [--round-steps N]
                                   [--melodies 20] [--seed 2027] [--workers 2] [--json out.json]
@@ -7,11 +7,18 @@ The phrases: those of the example songs that have no policy of their own (mary, 
 c-major-scale, split as ``pianobot train`` splits them), and ``--melodies`` phrases of the
 ``melody`` task family drawn with generators seeded ``[--seed, index]`` (training draws from the
 environment's generator, seeded from the run's seed). Each phrase is trained as ``pianobot train
-song.mid`` trains it, from the general policy (evaluated first, on the 3 evaluation hand starts),
-stopping at the first evaluation at note F1 >= ``--until-f1`` (0.95) or after ``--steps``, with
-one torch thread, ``--workers`` phrases at a time (one per core). Prints a table per phrase
-(note F1 at the start and at the end, wall time, steps) and the median wall time, counting a
-phrase that never reached the target as slower than any that did.
+song.mid`` trains a phrase, from the general policy (evaluated first, at step 0, on the 3
+evaluation hand starts), stopping at the first evaluation at note F1 >= ``--until-f1`` (0.95) or
+after ``--steps``, with one torch thread, ``--workers`` phrases at a time (one per core).
+
+What it measures is the training run's own evaluation, nothing more. Per phrase it prints the
+note F1 of the step-0 evaluation and of the kept policy's evaluation, wall time and steps, then
+the median wall time, counting a phrase whose kept evaluation never reached the target as slower
+than any that did. The kept policy is the best evaluated, the step-0 one included, so its F1
+is never below the start's; and "reached" is judged on the same evaluation hand starts that
+chose it. Neither says how the phrase plays from other hand starts or in its piece: that is
+``pianobot train``'s last step (``pianobot/learn/accept.py``: the whole piece from ``play``'s
+hand starts 0-2), which this benchmark does not run.
 """
 
 from __future__ import annotations
@@ -66,7 +73,7 @@ def fine_tune(name: str, piece: Piece, config: TrainConfig, general: Path, folde
         "phrase": name,
         "notes": len(piece),
         "start_f1": manifest["evaluations"][0]["f1"],
-        "end_f1": manifest["evaluation"]["f1"],
+        "kept_f1": manifest["evaluation"]["f1"],  # the best evaluated, step 0 included
         "reached": manifest["evaluation"]["f1"] >= config.stop_f1,
         "seconds": round(seconds, 1),
         "steps": manifest["steps"],
@@ -106,22 +113,26 @@ def main() -> None:
             for i, (name, piece) in enumerate(todo)
         ]
         rows = [f.result() for f in futures]
-    print(f"general policy {general}, learner {args.learner}, at most {args.steps} steps, target F1 {args.until_f1}\n")
-    print("| phrase | notes | F1 at start | F1 at end | wall time (s) | steps |")
+    print(f"general policy {general}, learner {args.learner}, at most {args.steps} steps, target F1 {args.until_f1}")
+    print(
+        "note F1 on the evaluation hand starts: at step 0, and the kept policy's (the best evaluated, step 0 included)\n"
+    )
+    print("| phrase | notes | F1 at step 0 | F1 kept | wall time (s) | steps |")
     print("| --- | ---: | ---: | ---: | ---: | ---: |")
     for r in rows:
         mark = "" if r["reached"] else " (not reached)"
         print(
-            f"| {r['phrase']} | {r['notes']} | {r['start_f1']:.3f} | {r['end_f1']:.3f} | {r['seconds']:.0f}{mark} | {r['steps']} |"
+            f"| {r['phrase']} | {r['notes']} | {r['start_f1']:.3f} | {r['kept_f1']:.3f} | {r['seconds']:.0f}{mark} | {r['steps']} |"
         )
     times = sorted(r["seconds"] if r["reached"] else float("inf") for r in rows)
     median = np.median(times)
     median = f"{median:.0f} s" if np.isfinite(median) else "not reached: more than half never got there"
     reached = sum(r["reached"] for r in rows)
-    worse = sum(r["end_f1"] < r["start_f1"] for r in rows)
+    at_start = sum(r["start_f1"] >= args.until_f1 for r in rows)
     print(
-        f"\n{len(rows)} phrases: {reached} reached F1 >= {args.until_f1} ({sum(r['start_f1'] >= args.until_f1 for r in rows)} "
-        f"at the start); median wall time {median}; {worse} ended worse than they started"
+        f"\n{len(rows)} phrases: the kept policy's evaluation reached F1 >= {args.until_f1} on the hand starts that "
+        f"chose it for {reached} ({at_start} at step 0); median wall time {median}. Not judged here: other hand "
+        "starts, or the phrase in its piece (pianobot train does that)"
     )
     if args.json:
         with open(args.json, "w") as f:
