@@ -97,3 +97,17 @@ def test_key_press_f1_scores_empty_steps_as_one():
     assert recall == pytest.approx(20 / 30)
     extra = Piece(reference.notes + (Note(0.5, 64, 1.0),))
     assert key_press_f1(reference, extra)[0] == pytest.approx(20 / 30)
+
+
+def test_duration_ratio_is_the_median_of_played_over_written_by_length_class():
+    # written: two short notes (0.2 s), one medium (0.5 s), no long one
+    reference = Piece((Note(0.0, 60, 0.2), Note(0.5, 62, 0.7), Note(1.0, 64, 1.5)))
+    # played: the first short note held half its length, the second in full, the medium one 80 %
+    played = Piece((Note(0.0, 60, 0.1), Note(0.5, 62, 0.7), Note(1.0, 64, 1.4)))
+    report = compare(reference, played)
+    assert report.duration_ratio_short == pytest.approx(0.75)  # median of 0.5 and 1.0
+    assert report.duration_ratio_medium == pytest.approx(0.8)
+    assert report.duration_ratio_long is None
+    # a missed note has no ratio; a note of exactly 0.35 s is medium
+    missed = compare(Piece((Note(0.0, 60, 0.35), Note(1.0, 62, 1.2))), Piece((Note(0.0, 60, 0.7),)))
+    assert missed.duration_ratio_medium == pytest.approx(2.0) and missed.duration_ratio_short is None

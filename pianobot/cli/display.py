@@ -117,6 +117,13 @@ def report_tables(report: Report) -> list[Table]:
             _opt(None if report.onset_error_max is None else report.onset_error_max * 1000, ".1f"),
         ),
         ("key-press F1 per step (RoboPianist)", f"{report.step_f1:.3f}"),
+        (
+            "held / written duration, median (< 0.35 s / 0.35-0.7 s / longer)",
+            " / ".join(
+                _opt(r, ".2f")
+                for r in (report.duration_ratio_short, report.duration_ratio_medium, report.duration_ratio_long)
+            ),
+        ),
         ("fingering accuracy", _opt(report.fingering_accuracy, ".3f")),
         ("onset tolerance (ms)", f"{report.onset_tolerance * 1000:.0f}"),
     ]

@@ -4,7 +4,9 @@ Note-level figures come from mir_eval's transcription metrics (notes match one-t
 pitch agrees and the onsets are within the tolerance); velocity and onset errors are measured
 over those matched pairs in plain MIDI units and seconds. The per-step key-press F1 is
 RoboPianist's: at each control step compare the set of keys that should be down with the set
-that is down (an empty step scores 1), then average over steps. See docs/metrics.md.
+that is down (an empty step scores 1), then average over steps. Articulation is the played/written
+duration ratio of matched notes, its median per note-length class (:data:`LENGTH_CLASSES`).
+See docs/metrics.md.
 """
 
 from __future__ import annotations
@@ -21,6 +23,9 @@ from pianobot.music.tensor import ScoreSpec, note_steps
 
 DEFAULT_ONSET_TOLERANCE = 0.05
 """Seconds; mir_eval's and the MIREX standard."""
+LENGTH_CLASSES = (("short", 0.0, 0.35), ("medium", 0.35, 0.7), ("long", 0.7, float("inf")))
+"""Note-length classes for the duration ratio: (name, shortest, longest) written duration in
+seconds, shortest included (eighth notes at 90 bpm are short, quarters medium, halves long)."""
 
 
 @dataclass(frozen=True)
@@ -64,6 +69,12 @@ class Report:
     step_precision: float
     step_recall: float
     step_f1: float
+    duration_ratio_short: float | None
+    """Median played/written duration of the matched notes written shorter than 0.35 s (None: there are none)."""
+    duration_ratio_medium: float | None
+    """The same for notes of 0.35-0.7 s."""
+    duration_ratio_long: float | None
+    """The same for notes of 0.7 s or longer."""
     fingering_accuracy: float | None
     onset_tolerance: float
     rows: tuple[NoteRow, ...]
@@ -128,6 +139,21 @@ def key_press_f1(
     return float(precision.mean()), float(recall.mean()), float(f1.mean())
 
 
+def length_class(note: Note) -> str:
+    """The name of ``note``'s class in :data:`LENGTH_CLASSES` (by its written duration)."""
+    return next(name for name, low, high in LENGTH_CLASSES if low <= note.duration < high)
+
+
+def duration_ratios(rows: tuple[NoteRow, ...] | list[NoteRow]) -> dict[str, list[float]]:
+    """Played/written duration of every matched note, by the written note's length class (in
+    :data:`LENGTH_CLASSES` order): pool several pieces' rows to take one median over a set."""
+    out: dict[str, list[float]] = {name: [] for name, _, _ in LENGTH_CLASSES}
+    for row in rows:
+        if row.reference is not None and row.played is not None:
+            out[length_class(row.reference)].append(row.played.duration / row.reference.duration)
+    return out
+
+
 def compare(
     reference: Piece,
     played: Piece,
@@ -170,6 +196,7 @@ def compare(
     onset_errors = [abs(r.onset_error) for r in pairs_rows]
     fingered = [r for r in pairs_rows if r.reference.finger is not None and r.played.finger is not None]
     step_p, step_r, step_f1 = key_press_f1(reference, played, control_hz)
+    ratios = {name: float(np.median(r)) if r else None for name, r in duration_ratios(pairs_rows).items()}
     return Report(
         reference_notes=len(reference),
         played_notes=len(played),
@@ -186,6 +213,9 @@ def compare(
         step_precision=step_p,
         step_recall=step_r,
         step_f1=step_f1,
+        duration_ratio_short=ratios["short"],
+        duration_ratio_medium=ratios["medium"],
+        duration_ratio_long=ratios["long"],
         fingering_accuracy=(
             sum(r.reference.finger == r.played.finger for r in fingered) / len(fingered) if fingered else None
         ),
