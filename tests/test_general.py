@@ -65,7 +65,9 @@ def test_train_starts_each_phrase_from_the_general_policy_unless_told_not_to(mod
 
     scratch = run("train", EXAMPLES / "one-note.mid", *QUICK, "--models", models, "--no-from-general", "--force")
     assert scratch.exit_code == 0, scratch.output
-    assert "general policy" not in scratch.output
+    assert "starting every phrase" not in scratch.output
+    # from scratch, yet judged in the whole piece against the general policy play would use beside it
+    assert "playing one-note.mid whole from hand starts 0, 1, 2" in " ".join(scratch.output.split())
     manifest = manifest_of(Path(policy["folder"]))  # the same folder: where a run begins is not in its hash
     assert manifest["start"] is None and manifest["config"]["from_general"] is False
     assert all(e["step"] > 0 for e in manifest["evaluations"])
@@ -171,10 +173,19 @@ def test_a_phrase_the_start_policy_already_plays_costs_one_evaluation(tmp_path):
     assert replace(config, from_general=False).stop_f1 is None
 
 
+def own_policy(tmp_path: Path, models: Path) -> None:
+    """one-note.mid's phrase policy, trained before the general policy came into ``models`` (so
+    no whole-piece judgement set it aside: play uses it)."""
+    alone = tmp_path / "alone"
+    trained = run("train", EXAMPLES / "one-note.mid", *QUICK, "--models", alone)
+    assert trained.exit_code == 0 and "judge" not in trained.output, trained.output
+    for folder in alone.iterdir():
+        shutil.copytree(folder, models / folder.name)
+
+
 def test_play_uses_a_phrases_own_policy_then_the_general_policy_and_says_so(tmp_path, models):
     general = next(models.glob(f"{GENERAL_KEY}-*"))
-    trained = run("train", EXAMPLES / "one-note.mid", *QUICK, "--no-from-general", "--models", models)
-    assert trained.exit_code == 0, trained.output
+    own_policy(tmp_path, models)
     song = write_midi(Piece((Note(0.0, 64, 1.0, 80, 3), Note(3.0, 67, 4.0, 70, 4)), bpm=60), tmp_path / "song.mid")
     args = ("play", song, "-o", tmp_path / "out.mid", "--models", models, "--phrase-notes", "1")
     result = run(*args)  # phrase 0 is one-note.mid's note: its own policy; phrase 1 has none
@@ -219,8 +230,7 @@ def test_the_general_policy_plays_its_consecutive_phrases_as_one_section(tmp_pat
     from pianobot.perform.plan import assign
 
     general = next(models.glob(f"{GENERAL_KEY}-*"))
-    trained = run("train", EXAMPLES / "one-note.mid", *QUICK, "--no-from-general", "--models", models)
-    assert trained.exit_code == 0, trained.output
+    own_policy(tmp_path, models)
     notes = (
         Note(0.0, 60, 1.0, 80, 2),
         Note(2.5, 62, 2.8, 80, 3),

@@ -157,13 +157,19 @@ def _no_teacher(config: TrainConfig) -> TrainConfig:
 
 @dataclass(frozen=True)
 class Experiment:
+    """One of the paper's seven experiments: what it trains, its arms, and the budget each run gets."""
+
     number: int
+    """The paper's numbering (docs/paper/N-name.json keeps its records)."""
     name: str
     title: str
     tasks: tuple[str, ...]
+    """Task families (or ``compose``'s piece) each arm trains on."""
     variants: tuple[Variant, ...]
     steps: int
+    """Environment steps per run."""
     steps_source: str
+    """Where that budget comes from (the paper's figure, or why ours differs)."""
     adjust: Callable[[TrainConfig], TrainConfig] = _same
     """Applied to the ``ours`` setting before the variant (``control``: no teacher)."""
     baselines: tuple[str, ...] = ()

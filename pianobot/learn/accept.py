@@ -15,8 +15,9 @@ neighbours. :func:`settle_piece`:
 3. returns a :class:`Verdict`: note F1 before and after, and which policies play.
 
 So the piece's note F1 as ``play`` performs it from each of :data:`JUDGE_SEEDS` is never below
-what the general policy alone gives. Without a general policy nothing is judged: there is no
-other player to fall back on.
+what the general policy alone gives. The judge is the general policy ``play`` would use beside
+the piece's policies (:func:`judge_for`), whether or not training started from it. Without one
+nothing is judged: there is no other player to fall back on.
 """
 
 from __future__ import annotations
@@ -28,8 +29,10 @@ from typing import Callable
 import numpy as np
 
 from pianobot.agent import store
-from pianobot.agent.general import describe
+from pianobot.agent.general import describe, find_general
 from pianobot.agent.policy import policy_configs
+from pianobot.env.piano import EnvConfig
+from pianobot.errors import PianobotError
 from pianobot.music.phrases import Phrase
 from pianobot.music.piece import Piece
 from pianobot.perform.compose import find_policy
@@ -63,6 +66,18 @@ class Verdict:
             "dropped": {str(k): v for k, v in self.dropped.items()},
             "general_plays": list(self.general_plays),
         }
+
+
+def judge_for(models: Path, env: EnvConfig, start: Path | None) -> Path | None:
+    """The general policy a piece's phrase policies (trained in ``env``) are judged against: the
+    one training started from, else the one ``play`` would use beside them (the user's newest in
+    ``models`` that fits ``env``, then the packaged one). None when ``play`` would have none."""
+    if start is not None:
+        return start
+    try:
+        return find_general(models, env)
+    except PianobotError:  # the user's general policy does not fit these phrases: play says so, and uses none
+        return None
 
 
 def _f1s(plan: PerformancePlan, seeds: tuple[int, ...]) -> tuple[float, ...]:

@@ -69,10 +69,13 @@ class Note:
     """One note: MIDI pitch 0-127, onset < offset in seconds, velocity 1-127, finger 1-5 or None."""
 
     onset: float
+    """Seconds from the start of the piece."""
     pitch: int
     offset: float
+    """Seconds from the start of the piece; after the onset."""
     velocity: int = 80
     finger: int | None = None
+    """1 thumb to 5 little finger; None where the file says nothing."""
 
     def __post_init__(self) -> None:
         if not isinstance(self.pitch, int) or not 0 <= self.pitch <= 127:

@@ -161,6 +161,7 @@ def train(
     from pianobot.agent.general import find_general
     from pianobot.agent.sac import resolve_device
     from pianobot.cli import display
+    from pianobot.learn.accept import JUDGE_SEEDS, judge_for, settle_piece
     from pianobot.learn.jobs import general_start, phrase_jobs, plan_jobs, run_jobs, run_jobs_on_ray, task_job
     from pianobot.learn.log import LOG_FILE, PLOT_FILE
     from pianobot.learn.train import TASK_EVAL_EPISODES
@@ -316,9 +317,8 @@ def train(
     console.print(display.training_table(trained))
     console.print(f"learning curves: {LOG_FILE} and {PLOT_FILE} in each policy's folder")
     verdict = None
-    if task is None and start is not None:  # the whole piece, as play performs it: no phrase policy makes it worse
-        from pianobot.learn.accept import JUDGE_SEEDS, settle_piece
-
+    judge = judge_for(models, config.env, start) if task is None and todo else None
+    if judge is not None:  # the whole piece, as play performs it: no phrase policy trained now makes it worse
         started = {
             job.folder.name: m["evaluation"]["f1"] for job, m in trained if job in todo and m.get("kept") == "start"
         }
@@ -326,7 +326,7 @@ def train(
         console.print(
             f"playing {said(song.name)} whole from hand starts {seeds}, as `pianobot play` does, to judge its phrase policies"
         )
-        verdict = settle_piece(piece, phrases, models, start, started)
+        verdict = settle_piece(piece, phrases, models, judge, started)
         before, after = sum(verdict.before) / len(JUDGE_SEEDS), sum(verdict.after) / len(JUDGE_SEEDS)
         console.print(
             f"{said(song.name)}: note F1 {before:.3f} with the general policy alone, {after:.3f} as it plays now "
