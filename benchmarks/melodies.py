@@ -7,7 +7,9 @@ major and minor in turn), fingers each with the planner (a melody the planner sa
 cannot play at its tempo is drawn again, and counted), plays each with the scripted pianist
 from hand start ``index`` and prints a Markdown table per key: mean and lowest note F1,
 velocity MAE (MIDI units, matched notes), mean absolute onset error (ms), extra notes (played
-notes the score does not ask for); then the totals and every melody short of the targets
+notes the score does not ask for), mean note F1 with offsets and per-step key-press F1, and the
+median played/written duration of notes written < 0.35 s, 0.35-0.7 s and longer (articulation,
+docs/metrics.md); then the totals and every melody short of the targets
 (note F1 >= 0.95, velocity MAE <= 5, no extra notes).
 """
 
@@ -21,6 +23,7 @@ import numpy as np
 
 from pianobot.music.instrument import HandSpec, KeyboardSpec
 from pianobot.music.melodies import TONICS, describe, melody_set
+from pianobot.music.metrics import LENGTH_CLASSES, duration_ratios
 from pianobot.music.piece import Piece
 from pianobot.perform.perform import perform
 from pianobot.pianist.fingering import ensure_fingering
@@ -55,6 +58,9 @@ def play_set(per_key: int) -> tuple[list[dict], int]:
                 "seed": list(melody.seed),
                 "melody": describe(melody.piece),
                 "f1": report.f1,
+                "f1_offsets": report.f1_with_offsets,
+                "step_f1": report.step_f1,
+                "ratios": duration_ratios(report.rows),
                 "velocity_mae": report.velocity_mae if report.velocity_mae is not None else float("nan"),
                 "onset_ms": 1000 * float(np.mean(onset_errors)) if onset_errors else float("nan"),
                 "extra": sum(r.reference is None for r in report.rows),
@@ -69,10 +75,17 @@ def passes(r: dict) -> bool:
     return r["f1"] >= F1_TARGET and r["velocity_mae"] <= VELOCITY_TARGET and r["extra"] == 0
 
 
+def held_cells(results: list[dict]) -> str:
+    """The median played/written duration per note-length class, over every matched note of ``results``."""
+    pooled = [[x for r in results for x in r["ratios"][name]] for name, _, _ in LENGTH_CLASSES]
+    return ", ".join(f"{np.median(p):.2f}" if p else "n/a" for p in pooled)
+
+
 def table(results: list[dict], rejected: int) -> str:
     lines = [
-        "| key | melodies | notes | mean F1 | min F1 | velocity MAE (mean, max) | onset error (ms) | extra notes | pass |",
-        "| --- | ---: | ---: | ---: | ---: | --- | ---: | ---: | ---: |",
+        "| key | melodies | notes | mean F1 | min F1 | velocity MAE (mean, max) | onset error (ms) | extra notes | pass "
+        "| F1 with offsets | per-step F1 | held / written (short, medium, long) |",
+        "| --- | ---: | ---: | ---: | ---: | --- | ---: | ---: | ---: | ---: | ---: | --- |",
     ]
 
     def row(name: str, rs: list[dict]) -> str:
@@ -81,7 +94,9 @@ def table(results: list[dict], rejected: int) -> str:
         return (
             f"| {name} | {len(rs)} | {sum(r['notes'] for r in rs)} | {np.mean(f1):.3f} | {min(f1):.3f} | "
             f"{np.mean(vel):.1f}, {max(vel):.1f} | {np.mean([r['onset_ms'] for r in rs]):.0f} | "
-            f"{sum(r['extra'] for r in rs)} | {sum(passes(r) for r in rs)}/{len(rs)} |"
+            f"{sum(r['extra'] for r in rs)} | {sum(passes(r) for r in rs)}/{len(rs)} | "
+            f"{np.mean([r['f1_offsets'] for r in rs]):.3f} | {np.mean([r['step_f1'] for r in rs]):.3f} | "
+            f"{held_cells(rs)} |"
         )
 
     for tonic, name in enumerate(TONICS):

@@ -16,10 +16,13 @@ wrist guard, :mod:`pianobot.perform.guard`, with ``--wrist-guard``):
   generators seeded ``[--seed, index, draw]`` (no training run draws from these: the melody task
   family draws from the environment's generator, the melody benchmark from ``[tonic, index, draw]``),
   fingered by the planner; a melody it says this hand cannot play at its tempo is drawn again;
+- ``articulation``: as many random melodies drawn the same way with slurs (notes written to last
+  until the next one sounds; :data:`SLURS`), seeded ``[38, index, draw]``: how long notes are held;
 - ``tasks``: ``--per-task`` instances of each of the paper's task families (seeds 0, 1, ...).
 
-For each piece: note F1, velocity MAE (matched notes, MIDI units) and per-step key-press F1 (the
-paper's frame-level measure), for the general policy and for the scripted pianist on the same
+For each piece: note F1, velocity MAE (matched notes, MIDI units), per-step key-press F1 (the
+paper's frame-level measure), note F1 with offsets and the played/written duration ratio by note
+length (articulation; its median over every matched note of a set, docs/metrics.md), for the general policy and for the scripted pianist on the same
 piece (the ceiling); a Markdown table per set (means; the general policy's share of the scripted
 pianist's note F1), for the melodies the share of notes the general policy played by phrase and by
 onset within a phrase (where it loses notes), and, with ``--plot``, a figure of every piece's
@@ -43,7 +46,7 @@ from pianobot.agent.policy import policy_configs
 from pianobot.music.instrument import HandSpec, KeyboardSpec
 from pianobot.music.load import LoadOptions, load_piece
 from pianobot.music.melodies import describe, random_melody
-from pianobot.music.metrics import key_press_f1
+from pianobot.music.metrics import LENGTH_CLASSES, duration_ratios
 from pianobot.music.phrases import DEFAULT_MAX_NOTES, split_phrases
 from pianobot.music.piece import Piece
 from pianobot.music.tasks import TASKS, make_task
@@ -56,15 +59,21 @@ EXAMPLES = ("c-major-scale", "mary", "ode-to-joy", "twinkle", "one-note", "three
 """The one-hand example songs in examples/midi (the recordings and the five-finger piece need a
 hand part reduced or five fingers)."""
 MELODY_DRAWS = 50
-SETS = ("examples", "melodies", "tasks")
+SETS = ("examples", "melodies", "articulation", "tasks")
+ARTICULATION_SEED = 38
+"""The articulation set's first seed entry (issue 38), apart from the melodies' ``--seed``."""
+SLURS = 0.35
+"""The articulation set's chance that a note begins a slur (:func:`pianobot.music.melodies.random_melody`)."""
 
 
-def figures(reference: Piece, rollout) -> dict:
+def figures(rollout) -> dict:
     report = rollout.report()
     return {
         "f1": report.f1,
         "velocity_mae": report.velocity_mae,
-        "step_f1": key_press_f1(reference, rollout.played)[2],
+        "f1_offsets": report.f1_with_offsets,
+        "step_f1": report.step_f1,
+        "ratios": duration_ratios(report.rows),
     }
 
 
@@ -89,8 +98,8 @@ def play_both(piece: Piece, general: Path, empty: Path, guard: bool = False) -> 
     scripted = perform(piece, "scripted", PLAY_CONFIG)
     return {
         "notes": len(piece),
-        "general": {**figures(piece, policy), "hits": placed_hits(phrases, policy)},
-        "scripted": figures(piece, scripted),
+        "general": {**figures(policy), "hits": placed_hits(phrases, policy)},
+        "scripted": figures(scripted),
     }
 
 
@@ -117,12 +126,13 @@ def example_set(root: Path) -> list[tuple[str, Piece]]:
     return [(name, ensure_fingering(piece, KeyboardSpec(), HandSpec())[0]) for name, piece in pieces]
 
 
-def melody_set(count: int, seed: int) -> tuple[list[tuple[str, Piece]], int]:
-    """``count`` playable random melodies, and how many draws the planner turned down."""
+def melody_set(count: int, seed: int, slurs: float = 0.0) -> tuple[list[tuple[str, Piece]], int]:
+    """``count`` playable random melodies (``slurs``: their chance of a slur at each note), and how
+    many draws the planner turned down."""
     out, rejected = [], 0
     for index in range(count):
         for draw in range(MELODY_DRAWS):
-            piece = random_melody(np.random.default_rng([seed, index, draw]), KeyboardSpec())
+            piece = random_melody(np.random.default_rng([seed, index, draw]), KeyboardSpec(), slurs=slurs)
             fingered, plan = ensure_fingering(piece, KeyboardSpec(), HandSpec())
             if plan is None or not plan.problems:
                 out.append((describe(fingered), fingered))
@@ -152,6 +162,8 @@ def chosen_sets(
             sets[name] = example_set(examples)
         elif name == "melodies":
             sets[name], rejected = melody_set(melodies, seed)
+        elif name == "articulation":
+            sets[name], _ = melody_set(melodies, ARTICULATION_SEED, SLURS)
         else:
             sets[name] = task_set(per_task)
     return sets, rejected
@@ -162,7 +174,14 @@ def summary(rows: list[dict]) -> dict:
         values = [r[who][key] for r in rows if r[who][key] is not None]
         return float(np.mean(values)) if values else float("nan")
 
-    out = {who: {k: mean(who, k) for k in ("f1", "velocity_mae", "step_f1")} for who in ("general", "scripted")}
+    out = {
+        who: {k: mean(who, k) for k in ("f1", "velocity_mae", "f1_offsets", "step_f1")}
+        for who in ("general", "scripted")
+    }
+    for who in ("general", "scripted"):  # the median over every matched note of the set, by length class
+        for name, _, _ in LENGTH_CLASSES:
+            pooled = [x for r in rows for x in r[who]["ratios"][name]]
+            out[who][f"held_{name}"] = float(np.median(pooled)) if pooled else float("nan")
     out["pieces"], out["notes"] = len(rows), sum(r["notes"] for r in rows)
     out["share"] = out["general"]["f1"] / out["scripted"]["f1"]
     out["at_least_0.9"] = sum(r["general"]["f1"] >= 0.9 for r in rows)
@@ -172,16 +191,23 @@ def summary(rows: list[dict]) -> dict:
 def table(results: dict[str, list[dict]]) -> str:
     lines = [
         "| set | pieces | notes | note F1 general | note F1 scripted | general / scripted | pieces at F1 >= 0.9 "
-        "| velocity MAE general | velocity MAE scripted | per-step F1 general | per-step F1 scripted |",
-        "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |",
+        "| velocity MAE general | velocity MAE scripted | per-step F1 general | per-step F1 scripted "
+        "| F1 with offsets general | F1 with offsets scripted "
+        "| held / written general (short, medium, long) | held / written scripted (short, medium, long) |",
+        "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | --- | --- |",
     ]
+
+    def held(figures: dict) -> str:
+        return ", ".join(f"{figures[f'held_{name}']:.2f}" for name, _, _ in LENGTH_CLASSES)
+
     for name, rows in results.items():
         s = summary(rows)
         g, c = s["general"], s["scripted"]
         lines.append(
             f"| {name} | {s['pieces']} | {s['notes']} | {g['f1']:.3f} | {c['f1']:.3f} | {100 * s['share']:.0f} % | "
             f"{s['at_least_0.9']}/{s['pieces']} | {g['velocity_mae']:.1f} | {c['velocity_mae']:.1f} | "
-            f"{g['step_f1']:.3f} | {c['step_f1']:.3f} |"
+            f"{g['step_f1']:.3f} | {c['step_f1']:.3f} | {g['f1_offsets']:.3f} | {c['f1_offsets']:.3f} | "
+            f"{held(g)} | {held(c)} |"
         )
     return "\n".join(lines)
 

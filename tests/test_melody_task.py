@@ -126,3 +126,15 @@ def test_the_environment_imports_nothing_above_it():
     assert (
         subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.strip() == "[]"
     )
+
+
+def test_slurs_keep_every_seeds_melody_and_hold_notes_to_the_next():
+    plain = random_melody(np.random.default_rng(11))
+    slurred = random_melody(np.random.default_rng(11), slurs=1.0)
+    assert [(n.onset, n.pitch, n.velocity) for n in slurred] == [(n.onset, n.pitch, n.velocity) for n in plain]
+    pairs = list(zip(slurred.notes, slurred.notes[1:]))
+    legato = [a for a, b in pairs if a.pitch != b.pitch and a.offset == pytest.approx(b.onset, abs=1e-3)]
+    assert len(legato) >= len(pairs) / 2
+    # a repeated note leaves the key time to rise; no slurred note reaches past the next onset
+    assert all(a.offset <= b.onset + 1e-3 for a, b in pairs)
+    assert all(a.offset < b.onset - 1e-3 for a, b in pairs if a.pitch == b.pitch)

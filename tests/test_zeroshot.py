@@ -44,3 +44,23 @@ def test_sets_plays_only_the_sets_named_and_draws_no_others():
     assert len(sets["tasks"]) == len(zeroshot.TASKS)
     melodies, _ = zeroshot.chosen_sets(["melodies"], ROOT / "examples" / "midi", 2, 2026, 1)
     assert list(melodies) == ["melodies"] and len(melodies["melodies"]) == 2
+
+
+def test_held_duration_is_one_median_over_every_note_of_the_set():
+    """The table's held/written columns pool the notes of all pieces (not a mean of each piece's median)."""
+
+    def row(short: list[float]) -> dict:
+        figures = {"f1": 1.0, "velocity_mae": 0.0, "f1_offsets": 1.0, "step_f1": 1.0}
+        ratios = {"short": short, "medium": [], "long": [1.0]}
+        return {
+            "notes": len(short) + 1,
+            "general": {**figures, "ratios": ratios},
+            "scripted": {**figures, "ratios": ratios},
+        }
+
+    rows = [row([0.2]), row([0.5, 0.6, 0.9])]  # per-piece medians 0.2 and 0.6; pooled median 0.55
+    s = zeroshot.summary(rows)
+    assert s["scripted"]["held_short"] == 0.55 and s["general"]["held_long"] == 1.0
+    assert s["scripted"]["held_medium"] != s["scripted"]["held_medium"]  # no medium notes: nan
+    line = zeroshot.table({"melodies": rows}).splitlines()[-1]
+    assert line.split("|")[-2].strip() == "0.55, nan, 1.00"

@@ -9,8 +9,10 @@ level with accents and swells around it). Notes carry no fingering: finger them 
 :func:`pianobot.pianist.fingering.ensure_fingering`.
 
 Keyword options widen or narrow the draw: ``velocities`` (the dynamics' range), ``chords``
-(two-note chords) and ``max_notes`` (a bound on the notes in all); :func:`random_phrase` uses
-them to draw the phrases of the ``melody`` task family. Left at their defaults they draw
+(two-note chords), ``max_notes`` (a bound on the notes in all) and ``slurs`` (legato groups:
+notes written to last until the next one sounds); :func:`random_phrase` uses the first three to
+draw the phrases of the ``melody`` task family, :func:`articulation_set` the last for the test of
+how long the pianist holds its notes. Left at their defaults they draw
 exactly the melodies they always drew, so every seed keeps its melody.
 """
 
@@ -82,11 +84,13 @@ def random_melody(
     velocities: tuple[int, int] = VELOCITY_RANGE,
     chords: float = 0.0,
     max_notes: int | None = None,
+    slurs: float = 0.0,
 ) -> Piece:
     """One random melody (see the module docstring); ``key``, ``notes`` (onsets) and ``bpm`` are
     drawn when None. ``velocities``: the (lowest, highest) velocity of its dynamics. ``chords``:
     the chance that a note gets a second note with it (:data:`CHORD_INTERVALS`), a two-note chord,
-    while the melody holds fewer than ``max_notes`` notes in all (None: no bound on chords)."""
+    while the melody holds fewer than ``max_notes`` notes in all (None: no bound on chords).
+    ``slurs``: the chance that a note begins a slur (:func:`_slurred`)."""
     if key is None:
         key = MelodyKey(int(rng.integers(0, 12)), bool(rng.random() < 0.4))
     count = int(rng.integers(NOTE_RANGE[0], NOTE_RANGE[1] + 1)) if notes is None else notes
@@ -150,9 +154,38 @@ def random_melody(
         fraction = float(rng.choice([0.95, 0.8, 0.5], p=[0.4, 0.45, 0.15]))
         out.append(Note(time, pitch, time + max(duration * fraction, 0.06), velocity))
         time += duration + rest * beat
-    if chords > 0:  # drawn after everything else, so that chords=0 keeps every seed's melody
+    if slurs > 0:  # drawn after everything else, so that slurs=0 keeps every seed's melody
+        out = _slurred(rng, out, rests, slurs)
+    if chords > 0:  # the same
         out = _with_chords(rng, out, degrees, scale, chords, max_notes)
     return Piece(tuple(out), bpm=bpm)
+
+
+SLUR_NOTES = (2, 8)
+"""Fewest and most notes under one slur."""
+REPEAT_FRACTION = 0.9
+"""A repeated note under a slur lasts this fraction of the time to its repeat (the key must rise to sound again)."""
+
+
+def _slurred(rng: np.random.Generator, melody: list[Note], rests: list[float], chance: float) -> list[Note]:
+    """The melody with slurs: each note not yet under one begins a slur of :data:`SLUR_NOTES` notes
+    with probability ``chance``; a slurred note lasts until the next onset (a repeated one
+    :data:`REPEAT_FRACTION` of that); a rest (``rests``: beats after each note) ends the slur."""
+    out, left = list(melody), 0
+    for i, note in enumerate(melody[:-1]):
+        if left == 0 and rng.random() < chance:
+            left = int(rng.integers(SLUR_NOTES[0], SLUR_NOTES[1] + 1)) - 1
+        if left == 0:
+            continue
+        left -= 1
+        if rests[i] > 0:
+            left = 0
+            continue
+        following = melody[i + 1]
+        gap = following.onset - note.onset
+        length = gap * (REPEAT_FRACTION if following.pitch == note.pitch else 1.0)
+        out[i] = Note(note.onset, note.pitch, note.onset + length, note.velocity)
+    return out
 
 
 def _with_chords(
