@@ -62,3 +62,52 @@ def test_chords_and_polyphony():
     assert piece.max_polyphony() == (3, 1.5)
     # notes that touch (one ends where the next starts) do not overlap
     assert Piece((Note(0, 60, 1), Note(1, 62, 2))).max_polyphony()[0] == 1
+
+
+def test_a_note_has_a_hand_or_none():
+    assert Note(0, 60, 1).hand is None  # one-hand pieces and files are unchanged
+    assert Note(0, 60, 1, hand="left").hand == "left"
+    with pytest.raises(PianobotError, match="'right', 'left' or None"):
+        Note(0, 60, 1, hand="both")
+
+
+def test_parts_and_hands_of_a_piece():
+    piece = Piece((Note(0, 72, 1), Note(0, 48, 1), Note(1, 50, 2)), bpm=90).with_hands(["left", "right", "left"])
+    assert [n.hand for n in piece] == ["left", "right", "left"]  # in the piece's order: 48, 72, 50
+    assert piece.hands == ("right", "left")
+    assert [n.pitch for n in piece.part("left")] == [48, 50] and piece.part("left").bpm == 90
+    assert [n.pitch for n in piece.part("right")] == [72]
+    assert len(piece.part(None)) == 0 and piece.with_hands(None).hands == ()
+    assert piece.with_hands("right").hands == ("right",)
+    with pytest.raises(ValueError):
+        piece.with_hands(["left"])
+    # hands take part in equality: a piece given to other hands is another piece
+    assert piece != piece.with_hands(None)
+
+
+def test_the_mirror_keeps_every_key_colour_and_place():
+    from pianobot.music.instrument import KeyboardSpec
+    from pianobot.music.piece import mirror_pitch
+    from pianobot.sim.keyboard import KeyboardConfig, key_boxes
+
+    assert mirror_pitch(62) == 62 and mirror_pitch(60) == 64 and mirror_pitch(21) == 103
+    for pitch in range(0, 125):
+        assert KeyboardSpec.is_black(mirror_pitch(pitch)) == KeyboardSpec.is_black(pitch)
+        assert mirror_pitch(mirror_pitch(pitch)) == pitch
+    # on a keyboard laid out symmetrically about D4 (A0-G7), a key and its mirror image lie at
+    # the same distance from the middle: the left hand's geometry is the right hand's, reflected
+    boxes = key_boxes(KeyboardConfig(spec=KeyboardSpec(21, 83)))
+    x = {box.pitch: box.center[0] for box in boxes}
+    middle = x[62]
+    for pitch in range(21, 104):
+        assert x[mirror_pitch(pitch)] - middle == pytest.approx(middle - x[pitch], abs=1e-9)
+    with pytest.raises(PianobotError, match="no mirror image"):
+        mirror_pitch(126)
+
+
+def test_mirroring_a_left_hand_part_gives_a_right_hand_part():
+    left = Piece((Note(0, 48, 1, finger=1, hand="left"), Note(1, 43, 2, finger=5, hand="left")))
+    mirrored = left.mirror()
+    assert [(n.pitch, n.finger, n.hand) for n in mirrored] == [(76, 1, "right"), (81, 5, "right")]
+    assert mirrored.mirror() == left
+    assert Piece((Note(0, 60, 1),)).mirror().notes[0].hand is None

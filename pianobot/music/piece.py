@@ -1,7 +1,8 @@
 """Immutable notes and pieces.
 
 A :class:`Note` is a pitch sounding from ``onset`` to ``offset`` (seconds) at a MIDI velocity,
-optionally with the pianist's finger number (1 thumb ... 5 little finger). A :class:`Piece` is
+optionally with the pianist's finger number (1 thumb ... 5 little finger) and the hand that plays
+it ('right' or 'left'; None where nobody has said). A :class:`Piece` is
 a sorted tuple of notes. Both are frozen and validated on construction; every transform returns
 a new object and never touches the one it was called on.
 
@@ -21,6 +22,12 @@ from typing import Iterable, Sequence
 from pianobot.errors import PianobotError, SettingError, quote
 
 FINGER_NAMES = {1: "thumb", 2: "index", 3: "middle", 4: "ring", 5: "little"}
+HANDS = ("right", "left")
+"""The hands a note can be given to; a note's ``hand`` is one of these or None (unassigned)."""
+MIRROR_AXIS = 124
+"""The keyboard's black and white keys lie symmetrically about D (pitch 62, and every D):
+pitch ``p`` and ``MIRROR_AXIS - p`` are both white or both black, and their neighbours lie at the
+same distances. A left hand's part mirrored this way is a right hand's part (see :func:`mirror_pitch`)."""
 _NAMES = ("C", "C#", "D", "D#", "E", "F", "F#", "G", "G#", "A", "A#", "B")
 _LETTER = {"C": 0, "D": 2, "E": 4, "F": 5, "G": 7, "A": 9, "B": 11}
 TIME_RESOLUTION = 1e-3
@@ -60,13 +67,26 @@ def parse_pitch(name: str) -> int:
     return value
 
 
+def mirror_pitch(pitch: int) -> int:
+    """The key at the same place on the keyboard's mirror image about D4 (62 <-> 62, C4 60 <-> E4 64,
+    A0 21 <-> G7 103): a white key gives a white key and a black key a black key."""
+    mirrored = MIRROR_AXIS - pitch
+    if not 0 <= mirrored <= 127:
+        raise PianobotError(
+            f"{pitch_name(pitch)} has no mirror image in MIDI's range (pitches above {pitch_name(MIRROR_AXIS)} have none): "
+            "transpose the piece down with load.transpose"
+        )
+    return mirrored
+
+
 def _ms(seconds: float) -> float:
     return round(round(seconds / TIME_RESOLUTION) * TIME_RESOLUTION, 6)
 
 
 @dataclass(frozen=True)
 class Note:
-    """One note: MIDI pitch 0-127, onset < offset in seconds, velocity 1-127, finger 1-5 or None."""
+    """One note: MIDI pitch 0-127, onset < offset in seconds, velocity 1-127, finger 1-5 or None,
+    hand 'right', 'left' or None."""
 
     onset: float
     """Seconds from the start of the piece."""
@@ -76,6 +96,8 @@ class Note:
     velocity: int = 80
     finger: int | None = None
     """1 thumb to 5 little finger; None where the file says nothing."""
+    hand: str | None = None
+    """'right' or 'left': the hand that plays the note; None where nothing says (a one-hand piece)."""
 
     def __post_init__(self) -> None:
         if not isinstance(self.pitch, int) or not 0 <= self.pitch <= 127:
@@ -110,6 +132,11 @@ class Note:
                 f"note {pitch_name(self.pitch)} at {self.onset:.3f} s has finger {self.finger!r}: "
                 "fingers are numbered 1 (thumb) to 5 (little finger)"
             )
+        if self.hand is not None and self.hand not in HANDS:
+            raise PianobotError(
+                f"note {pitch_name(self.pitch)} at {self.onset:.3f} s has hand {self.hand!r}: "
+                "a note's hand is 'right', 'left' or None"
+            )
 
     @property
     def duration(self) -> float:
@@ -125,7 +152,7 @@ class Note:
 
 
 def _sort_key(n: Note) -> tuple:
-    return (n.onset, n.pitch, n.offset, n.velocity, n.finger or 0)
+    return (n.onset, n.pitch, n.offset, n.velocity, n.finger or 0, n.hand or "")
 
 
 @dataclass(frozen=True)
@@ -164,6 +191,18 @@ class Piece:
     def has_fingering(self) -> bool:
         """True when every note has a finger."""
         return bool(self.notes) and all(n.finger is not None for n in self.notes)
+
+    @property
+    def hands(self) -> tuple[str, ...]:
+        """The hands that have notes, right before left; () for a piece whose notes have no hand."""
+        present = {n.hand for n in self.notes}
+        return tuple(h for h in HANDS if h in present)
+
+    def part(self, hand: str | None) -> "Piece":
+        """The notes given to ``hand`` ('right', 'left', or None for the unassigned ones)."""
+        if hand is not None and hand not in HANDS:
+            raise PianobotError(f"hand {hand!r}: choose 'right', 'left' or None")
+        return Piece(tuple(n for n in self.notes if n.hand == hand), bpm=self.bpm)
 
     def chords(self) -> list[tuple[Note, ...]]:
         """Notes grouped by equal onset (a melody note is a chord of one), in time order."""
@@ -224,6 +263,23 @@ class Piece:
 
     def without_fingering(self) -> "Piece":
         return self.with_fingers([None] * len(self.notes))
+
+    def with_hands(self, hands: Sequence[str | None] | str | None) -> "Piece":
+        """The same notes with the given hands: one per note (in this piece's order), or one for all."""
+        if hands is None or isinstance(hands, str):
+            hands = [hands] * len(self.notes)
+        if len(hands) != len(self.notes):
+            raise ValueError(f"{len(hands)} hands for {len(self.notes)} notes")
+        return Piece(tuple(replace(n, hand=h) for n, h in zip(self.notes, hands)), bpm=self.bpm)
+
+    def mirror(self) -> "Piece":
+        """The piece on the keyboard's mirror image about D (:func:`mirror_pitch`): low becomes high,
+        every key keeps its colour, fingers stay, and the hands swap, so a left hand's part becomes a
+        part for a right hand (and back again: ``piece.mirror().mirror() == piece``)."""
+        swap = {"right": "left", "left": "right", None: None}
+        return Piece(
+            tuple(replace(n, pitch=mirror_pitch(n.pitch), hand=swap[n.hand]) for n in self.notes), bpm=self.bpm
+        )
 
     @staticmethod
     def of(notes: Iterable[Note], bpm: float = 120.0) -> "Piece":
