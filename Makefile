@@ -31,10 +31,12 @@ clean:
 	rm -rf $(VENV) *.egg-info
 
 # A piano sound for --wav and --video: the FluidSynth library and a small General MIDI soundfont
-# (Debian packages; needs root). Without them, pianobot synthesises sine waves.
+# (Debian packages; needs root); pyfluidsynth comes with the venv. Without them, pianobot
+# synthesises sine waves (pianobot/perform/audio.py's SOUND names these packages).
+SOUND_PACKAGES := libfluidsynth3 timgm6mb-soundfont
 sound:
 	@if command -v apt-get >/dev/null 2>&1 && [ "$$(id -u)" = 0 ]; then \
-		timeout 300 apt-get install -y -q libfluidsynth3 timgm6mb-soundfont >/dev/null 2>&1 || \
-		(timeout 300 apt-get update -q >/dev/null 2>&1 && timeout 300 apt-get install -y -q libfluidsynth3 timgm6mb-soundfont >/dev/null 2>&1) || \
+		timeout 300 apt-get install -y -q $(SOUND_PACKAGES) >/dev/null 2>&1 || \
+		(timeout 300 apt-get update -q >/dev/null 2>&1 && timeout 300 apt-get install -y -q $(SOUND_PACKAGES) >/dev/null 2>&1) || \
 		echo "could not install FluidSynth: --wav and --video use sine waves"; \
-	else echo "install libfluidsynth3 and a General MIDI soundfont (e.g. timgm6mb-soundfont) for a piano sound"; fi
+	else echo "install $(SOUND_PACKAGES) (Debian packages) for a piano sound"; fi

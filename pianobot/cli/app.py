@@ -14,7 +14,7 @@ import re
 import warnings
 
 import typer
-from typer.core import TyperGroup
+from typer.core import TyperCommand, TyperGroup
 
 from pianobot import __version__
 from pianobot.cli.commands.export import export
@@ -59,12 +59,30 @@ class OneLineUsageGroup(TyperGroup):
             return super().invoke(ctx)
 
 
+class PanelledCommand(TyperCommand):
+    """A command whose ``--help`` is click's plain text, wrapped to the terminal (at most 80
+    columns), each option with its full names (a flag as ``--thumb / --no-thumb``, no value), and
+    the options grouped under their panel's title (``rich_help_panel``: "Reading the piece")."""
+
+    def format_options(self, ctx, formatter) -> None:
+        sections: dict[str, list[tuple[str, str]]] = {}
+        for param in self.get_params(ctx):
+            record = param.get_help_record(ctx)
+            if record is not None:
+                title = "Arguments" if param.param_type_name == "argument" else param.rich_help_panel or "Options"
+                sections.setdefault(title, []).append(record)
+        for title, records in sections.items():
+            with formatter.section(title):
+                formatter.write_dl(records)
+
+
 app = typer.Typer(
     cls=OneLineUsageGroup,
     help="Teach a simulated robot hand with touch sensors to play the piano from MIDI files.",
     no_args_is_help=True,
     add_completion=True,
     pretty_exceptions_enable=False,
+    rich_markup_mode=None,  # (typer's panels squeeze the help into a narrow column at 80 columns)
 )
 
 
@@ -78,24 +96,20 @@ def friendly(command):
 
     @functools.wraps(command)
     def wrapper(*args, **kwargs):
+        error = None
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", PianobotWarning)
             try:
                 return command(*args, **kwargs)
             except PianobotError as e:
-                err.print(
-                    f"[red]error:[/red] {said(phrase(e))}", markup=True, highlight=False, emoji=False, soft_wrap=True
-                )
-                raise typer.Exit(EXIT_BAD_INPUT) from None
+                error, code = phrase(e), EXIT_BAD_INPUT
             except OSError as e:
-                where = f"{e.filename}: " if e.filename else ""
-                err.print(f"[red]error:[/red] {said(where + why(e))}", highlight=False, emoji=False, soft_wrap=True)
-                raise typer.Exit(EXIT_BAD_INPUT) from None
+                error, code = (f"{e.filename}: " if e.filename else "") + why(e), EXIT_BAD_INPUT
             except KeyboardInterrupt:
+                error, code = None, 130
                 err.print("[yellow]interrupted[/yellow]")
-                raise typer.Exit(130) from None
             finally:
-                for w in caught:
+                for w in caught:  # the warnings first: the error, last, is what stopped the command
                     if issubclass(w.category, PianobotWarning):
                         err.print(
                             f"[yellow]warning:[/yellow] {said(phrase(w.message))}",
@@ -103,12 +117,15 @@ def friendly(command):
                             emoji=False,
                             soft_wrap=True,
                         )
+        if error is not None:
+            err.print(f"[red]error:[/red] {said(error)}", highlight=False, emoji=False, soft_wrap=True)
+        raise typer.Exit(code) from None
 
     return wrapper
 
 
 for command in (inspect, finger, score, play, train, export):
-    app.command()(friendly(command))
+    app.command(cls=PanelledCommand)(friendly(command))
 
 
 def _version(value: bool):

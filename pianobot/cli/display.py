@@ -42,11 +42,11 @@ ROWS = 100
 """Rows a table shows by default: a long piece's tables would take longer to draw than to compute."""
 
 
-def _shown(table: Table, total: int, rows: int | None, what: str) -> int:
-    """How many of ``total`` rows to show; says in the caption when some are left out."""
+def _shown(table: Table, total: int, rows: int | None, what: str, more: str = "--all shows every one") -> int:
+    """How many of ``total`` rows to show; says in the caption when some are left out, and ``more``."""
     if rows is None or total <= rows:
         return total
-    table.caption = f"the first {rows} of {total} {what}; --all shows every one"
+    table.caption = f"the first {rows} of {total} {what}; {more}"
     return rows
 
 
@@ -92,64 +92,44 @@ def phrases_table(phrases: list[Phrase], trained: set[int] | None = None, rows: 
     return table
 
 
-def report_tables(report: Report) -> list[Table]:
-    summary = Table(title="performance against reference", show_header=False)
-    summary.add_column("figure")
-    summary.add_column("value", justify="right")
-    rows = [
-        (
-            "notes (reference / played / matched)",
-            f"{report.reference_notes} / {report.played_notes} / {report.matched_notes}",
-        ),
-        ("note precision", f"{report.precision:.3f}"),
-        ("note recall", f"{report.recall:.3f}"),
-        ("note F1", f"{report.f1:.3f}"),
-        ("note F1 with offsets", f"{report.f1_with_offsets:.3f}"),
-        ("velocity-aware note F1 (mir_eval)", f"{report.velocity_f1:.3f}"),
-        ("velocity mean abs. error (MIDI)", _opt(report.velocity_mae, ".2f")),
-        ("velocity max error (MIDI)", _opt(report.velocity_max_error, "d")),
-        (
-            "onset error mean (ms)",
-            _opt(None if report.onset_error_mean is None else report.onset_error_mean * 1000, ".1f"),
-        ),
-        (
-            "onset error max (ms)",
-            _opt(None if report.onset_error_max is None else report.onset_error_max * 1000, ".1f"),
-        ),
-        ("key-press F1 per step (RoboPianist)", f"{report.step_f1:.3f}"),
-        (
-            "held / written duration, median (< 0.35 s / 0.35-0.7 s / longer)",
-            " / ".join(
-                _opt(r, ".2f")
-                for r in (report.duration_ratio_short, report.duration_ratio_medium, report.duration_ratio_long)
-            ),
-        ),
-        ("fingering accuracy", _opt(report.fingering_accuracy, ".3f")),
-        ("onset tolerance (ms)", f"{report.onset_tolerance * 1000:.0f}"),
-    ]
-    for name, value in rows:
-        summary.add_row(name, value)
+def report_tables(report: Report, every: bool = False, notes: int | None = None) -> list[Table]:
+    """The figures, each with what it means: the first few (``every``: all of them); then the
+    per-note table, its first ``notes`` rows (None: every row; 0: no table)."""
+    from pianobot.perform.report import FIGURES
 
-    notes = Table(title="per note")
+    summary = Table(title="performance against reference")
+    for column in ("figure", "value", "what it means"):
+        summary.add_column(column, justify="right" if column == "value" else "left")
+    for figure in FIGURES:
+        if every or figure.first:
+            summary.add_row(figure.label, figure.value(report), f"[dim]{figure.meaning}[/dim]")
+    if not every:
+        summary.caption = "--all shows every figure; docs/metrics.md says how each is computed"
+    if notes == 0:
+        return [summary]
+    table = Table(title="per note")
     for column in (
         "pitch",
         "target onset",
         "played onset",
+        "onset error ms",
         "target vel",
         "played vel",
         "vel error",
         "finger",
         "status",
     ):
-        notes.add_column(column)
-    for row in report.rows:
+        table.add_column(column)
+    shown = _shown(table, len(report.rows), notes, "notes", "--notes N shows N")
+    for row in report.rows[:shown]:
         ref, out = row.reference, row.played
         status = "missed" if out is None else "extra" if ref is None else "ok"
         style = "red" if status != "ok" else None
-        notes.add_row(
+        table.add_row(
             (ref or out).name,
             _opt(ref and ref.onset, ".3f"),
             _opt(out and out.onset, ".3f"),
+            _opt(None if row.onset_error is None else row.onset_error * 1000, "+.0f"),
             _opt(ref and ref.velocity, "d"),
             _opt(out and out.velocity, "d"),
             _opt(row.velocity_error, "+d"),
@@ -157,7 +137,7 @@ def report_tables(report: Report) -> list[Table]:
             status,
             style=style,
         )
-    return [summary, notes]
+    return [summary, table]
 
 
 def print_all(console: Console, tables: list[Table]) -> None:

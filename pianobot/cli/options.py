@@ -77,6 +77,9 @@ PlayPhraseNotes = typer.Option(
     "--phrase-notes",
     help=f"Most notes in one phrase (default: the longest phrases, up to {DEFAULT_MAX_NOTES} notes, whose policies are all trained).",
 )
+AllFigures = typer.Option(
+    False, "--all", help="Print every figure, each with what it means (by default the few to read first)."
+)
 AllRows = typer.Option(False, "--all", help="List every note and phrase (by default the tables stop after 100 rows).")
 
 # -- reading a piece, once for every command that reads one ---------------------------------------
@@ -98,10 +101,10 @@ READING = {  # parameter name: (type, option); the commands' --help shows them i
     "hand_part": _reading(Optional[HandPart], None, "--hand", "Play one hand's part of a two-hand piece: right or left (tracks named for it, else split by pitch)."),
     "split": _reading(str, pitch_name(LoadOptions.split), "--split", "With --hand and no track named for it: lowest note of the right hand's part."),
     "quantize": _reading(Optional[str], None, "--quantize", "Move onsets and offsets to a grid, e.g. 1/16 (for recordings of human players)."),
-    "refinger": _reading(bool, LoadOptions.refinger, "--refinger", "Replace the file's fingering with the planner's (e.g. human fingering for five fingers)."),
+    "refinger": _reading(bool, LoadOptions.refinger, "--refinger/--no-refinger", "Replace the file's fingering with the planner's (e.g. human fingering for five fingers)."),
     "lowest_note": _reading(str, pitch_name(KeyboardSpec.lowest), "--lowest-note", "Lowest key of the keyboard (name like C4, or MIDI number).", INSTRUMENT),
     "keys": _reading(int, KeyboardSpec.count, "--keys", "Number of keys on the keyboard.", INSTRUMENT),
-    "thumb": _reading(bool, False, "--thumb", "Let the hand use its thumb (finger 1) too.", INSTRUMENT),
+    "thumb": _reading(bool, False, "--thumb/--no-thumb", "Let the hand use its thumb (finger 1) too.", INSTRUMENT),
 }
 # fmt: on
 

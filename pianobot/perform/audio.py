@@ -17,6 +17,8 @@ from pianobot.music.midi_io import midi_bytes
 from pianobot.music.piece import Piece
 
 SAMPLE_RATE = 22_050
+SOUND = "`make sound` installs the FluidSynth library and a soundfont (Debian's libfluidsynth3 and timgm6mb-soundfont)"
+"""What `make sound` installs (the Makefile's recipe names the same packages: a test checks)."""
 SOUNDFONTS = (
     Path("/usr/share/sounds/sf2/FluidR3_GM.sf2"),
     Path("/usr/share/sounds/sf2/default-GM.sf2"),
@@ -53,8 +55,7 @@ def check_soundfont(path: Path) -> Path:
         raise PianobotError(f"{path} is not a SoundFont 2 (.sf2) file")
     if not has_fluidsynth():
         raise PianobotError(
-            "a soundfont needs the FluidSynth library and pyfluidsynth: `make sound`, or "
-            "apt install libfluidsynth3 and pip install pyfluidsynth"
+            f"a soundfont needs the FluidSynth library and pyfluidsynth: {SOUND}; pip install 'pianobot[sound]'"
         )
     return path
 
@@ -69,9 +70,7 @@ def synthesize(
     font = font or soundfont()
     if font is not None:
         return midi.fluidsynth(fs=sample_rate, sf2_path=str(font)), f"FluidSynth with {font.name}"
-    return midi.synthesize(
-        fs=sample_rate
-    ), "sine waves (pretty_midi; install fluid-soundfont-gm and pyfluidsynth for a piano)"
+    return midi.synthesize(fs=sample_rate), f"sine waves; for a piano, {SOUND}, with pyfluidsynth (pianobot[sound])"
 
 
 def write_wav(

@@ -56,7 +56,7 @@ def inspect(
         pedal = sum(t.pedal for t in tracks)
         console.print(
             f"{len(with_notes)} track(s) with notes"
-            + (f"; named for hands: {', '.join(f'{i} {h}' for i, h in sorted(hands.items()))}" if hands else "")
+            + (f"; {_hand_parts(tracks)}" if hands else "")
             + (
                 f"; sustain pedal pressed {pedal} times (ignored: a note sounds while its key is down)"
                 if pedal
@@ -119,3 +119,17 @@ def inspect(
                 ],
             },
         )
+
+
+def _hand_parts(tracks) -> str:
+    """Which tracks each hand's name is on, in the words `--hand` warns with when none is."""
+    from pianobot.music.load import HANDS, hand_tracks
+
+    parts = []
+    for hand in HANDS:
+        named = hand_tracks(tracks, hand)
+        if named:
+            parts.append(f"track{'s' * (len(named) > 1)} {', '.join(map(str, named))} named for the {hand} hand")
+        else:
+            parts.append(f"no track is named for the {hand} hand")
+    return ", ".join(parts)

@@ -10,6 +10,7 @@ from typing import Optional
 import typer
 
 from pianobot.cli.options import (
+    AllFigures,
     Controller,
     Fallback,
     GeneralPolicy,
@@ -19,7 +20,7 @@ from pianobot.cli.options import (
     read_song,
     reads,
 )
-from pianobot.cli.terminal import err, out, said
+from pianobot.cli.terminal import err, out, said, write_json
 from pianobot.errors import PianobotError
 from pianobot.files import atomic_write, check_writable
 from pianobot.music.phrases import DEFAULT_MAX_NOTES
@@ -71,6 +72,18 @@ def play(
         "else sine waves).",
     ),
     gui: bool = typer.Option(False, "--gui", help="Show the simulation in a PyBullet window (needs a display)."),
+    json_path: Optional[Path] = typer.Option(
+        None,
+        "--json",
+        help="Also write the report (who played, every figure, every note) to this JSON file ('-': standard output).",
+    ),
+    notes: int = typer.Option(
+        0, "--notes", min=0, help="Print the per-note table's first N rows (the report file has every note)."
+    ),
+    every: bool = AllFigures,
+    quiet: bool = typer.Option(
+        False, "--quiet", "-q", help="Print only where the files went (and warnings and errors): no figures, no tables."
+    ),
     reading: Reading = None,
 ):
     """Perform a piece in the simulator; write the played notes (velocities, fingers) and a velocity-error report."""
@@ -85,7 +98,9 @@ def play(
 
     check_midi_output(output, song, "the performance")
     report_path = output.with_suffix(".report.json")
-    for target in (output, report_path, video, wav):
+    to_stdout = json_path is not None and str(json_path) == "-"
+    console = err if to_stdout else out  # standard output carries the JSON
+    for target in (output, report_path, video, wav, None if to_stdout else json_path):
         if target is not None:
             check_writable(target)
     if video is not None and video.suffix.lower() != ".mp4":
@@ -114,9 +129,14 @@ def play(
         wrist_guard=wrist_guard,
         gui=gui,
     )
-    if controller == "sac" and phrase_notes is None and list(plan.phrases) != split_phrases(piece, DEFAULT_MAX_NOTES):
+    if (
+        not quiet
+        and controller == "sac"
+        and phrase_notes is None
+        and list(plan.phrases) != split_phrases(piece, DEFAULT_MAX_NOTES)
+    ):
         most = max(len(p.notes) for p in plan.phrases)
-        out.print(
+        console.print(
             f"[dim]{len(plan.phrases)} phrases of at most {most} note{'s' * (most > 1)}: the split the policies in {said(models)} were trained for[/dim]"
         )
     with Progress(
@@ -137,24 +157,27 @@ def play(
     report = performance.report()
     write_midi(performance.played, output, name=f"pianobot ({plan.performer}): {song.stem}")
     atomic_write(report_path, json.dumps(performance.to_dict(), indent=2) + "\n")
-    if len(plan.players) > 1 or plan.players[0] is not Player.OWN:
+    if json_path is not None:
+        write_json(json_path, performance.to_dict())
+    if not quiet and (len(plan.players) > 1 or plan.players[0] is not Player.OWN):
         for player in plan.players:
             numbers = [p.index for s in plan.stretches if s.player is player for p in s.phrases]
             policy = next(s.policy for s in plan.stretches if s.player is player)
             which = f" {said(policy)}" if player is Player.GENERAL else ""
-            out.print(
+            console.print(
                 f"phrase{'s' * (len(numbers) > 1)} {', '.join(map(str, numbers))}: {player.value}{which}",
                 soft_wrap=True,
             )
-    display.print_all(out, display.report_tables(report))
-    out.print(f"performance written to {said(output)}, report to {said(report_path)}")
+    if not quiet:
+        display.print_all(console, display.report_tables(report, every, notes))
+    console.print(f"performance written to {said(output)}, report to {said(report_path)}")
     if video is not None:
         import tempfile
 
         with tempfile.TemporaryDirectory() as scratch:  # the sound, starting with the first frame
             method = write_wav(performance.played, Path(scratch) / "sound.wav", font=soundfont, delay=performance.start)
             write_video(performance.frames, video, fps=plan.config.world.control_hz, audio=Path(scratch) / "sound.wav")
-        out.print(f"video written to {said(video)}, with sound ({method})")
+        console.print(f"video written to {said(video)}, with sound ({method})")
     if wav is not None:
         method = write_wav(performance.played, wav, font=soundfont)
-        out.print(f"audio written to {said(wav)} ({method})")
+        console.print(f"audio written to {said(wav)} ({method})")

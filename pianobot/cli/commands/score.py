@@ -8,6 +8,7 @@ from typing import Optional
 import typer
 
 from pianobot.cli.options import (
+    AllFigures,
     Reading,
     reads,
 )
@@ -31,6 +32,7 @@ def score(
         None, "--plot", help="Draw both piano rolls with the errors marked to this PNG file."
     ),
     notes: bool = typer.Option(True, "--notes/--no-notes", help="Print the per-note table."),
+    every: bool = AllFigures,
     reading: Reading = None,
 ):
     """Compare a performance with its reference: note F1, velocity and timing errors, fingering.
@@ -56,8 +58,7 @@ def score(
     )  # with --hand, reduced as play reduces it
     played_piece = midi_io.read_midi(played)
     report = compare(reference_piece, played_piece, onset_tolerance=onset_tolerance)
-    tables = display.report_tables(report)
-    display.print_all(console, tables if notes else tables[:1])
+    display.print_all(console, display.report_tables(report, every, None if notes else 0))
     if json_path is not None:
         write_json(json_path, report.to_dict())
         if not to_stdout:

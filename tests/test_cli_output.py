@@ -1,0 +1,139 @@
+"""What the commands print, as a new user reads it: help at 80 columns, flags shown as flags,
+tables whole in files and pipes, warnings before the error that stopped a command, `play --json`,
+`--notes N` and `--quiet`, the first screen of figures, the sound notice (issue 36)."""
+
+import io
+import json
+import re
+from pathlib import Path
+
+import mido
+import pytest
+import typer.main
+from conftest import run
+from typer.testing import CliRunner
+
+from pianobot.cli.app import app
+from pianobot.music.midi_io import write_midi
+from pianobot.music.piece import Note, Piece
+
+EXAMPLES = Path(__file__).parent.parent / "examples" / "midi"
+ROOT = Path(__file__).parent.parent
+COMMANDS = sorted(typer.main.get_command(app).commands)
+
+
+@pytest.mark.parametrize("command", COMMANDS)
+def test_help_is_whole_at_80_columns(command):
+    """Every line fits, no description is cut ('…'), and each option's help is there word for word."""
+    result = CliRunner().invoke(app, [command, "--help"], env={"COLUMNS": "80"})
+    assert result.exit_code == 0, result.output
+    assert all(len(line) <= 80 for line in result.output.splitlines()), result.output
+    assert "…" not in result.output
+    words = " ".join(result.output.split())
+    for param in typer.main.get_command(app).commands[command].params:
+        if param.help:
+            assert " ".join(param.help.split()) in words.replace("- ", "-"), param.help
+
+
+def test_boolean_options_are_shown_and_parsed_as_flags(tmp_path):
+    help_text = CliRunner().invoke(app, ["play", "--help"], env={"COLUMNS": "80"}).output
+    assert "<bool>" not in help_text
+    assert "--thumb / --no-thumb" in help_text and "--refinger / --no-refinger" in help_text
+    assert "Reading the piece:" in help_text and "Keyboard and hand:" in help_text  # the panels, as sections
+    thumb = write_midi(Piece((Note(0, 60, 1, 80, 1),)), tmp_path / "thumb.mid")
+    assert run("inspect", thumb, "--thumb").exit_code == 0
+    assert run("inspect", thumb, "--thumb", "--no-thumb").exit_code == 2  # the last one given wins
+
+
+def test_tables_written_to_a_pipe_keep_their_words_whole(monkeypatch):
+    """Rich assumes 80 columns where the output is not a terminal, and breaks a table's words
+    ('genera/l'); pianobot's consoles there are as wide as what they print."""
+    from pianobot.cli import display
+    from pianobot.cli.terminal import Terminal
+
+    monkeypatch.delenv("COLUMNS", raising=False)
+
+    class Job:
+        key, phrases, folder = "0123456789abcdef", [0, 1, 2], Path("models") / ("0123456789abcdef-" + "f" * 16)
+
+    manifest = {"start": {"path": "x"}, "steps": 12000, "evaluation": {"step": 8000, "f1": 1.0, "velocity_mae": 2.5}}
+    console = Terminal(file=io.StringIO())
+    console.print(display.training_table([(Job, manifest)]))
+    text = console.file.getvalue()
+    assert "velocity MAE" in text and "general" in text and str(Job.folder) in text, text
+    result = run("score", EXAMPLES / "twinkle.mid", EXAMPLES / "twinkle.mid", "--all", "--no-notes")
+    assert "velocity-aware note F1 (mir_eval)" in result.output  # one line, not folded at 80 columns
+
+
+def test_warnings_come_before_the_error_that_stopped_the_command(tmp_path):
+    """A repaired overlap warns; a note below the keyboard stops the command: the error is the last line."""
+    midi = mido.MidiFile(type=1)
+    for start in (0, 240):  # the same key struck twice at once, in two tracks
+        midi.tracks.append(
+            mido.MidiTrack(
+                [mido.Message("note_on", note=60, velocity=80, time=start), mido.Message("note_off", note=60, time=480)]
+            )
+        )
+    midi.tracks.append(
+        mido.MidiTrack([mido.Message("note_on", note=30, velocity=80), mido.Message("note_off", note=30, time=480)])
+    )
+    midi.save(tmp_path / "low.mid")
+    result = run("inspect", tmp_path / "low.mid")
+    assert result.exit_code == 2
+    lines = result.stderr.strip().splitlines()
+    assert lines[-1].startswith("error: ") and "outside the keyboard" in lines[-1], lines
+    assert lines[:-1] and all(line.startswith("warning: ") for line in lines[:-1]), lines
+
+
+def test_inspect_names_each_hand_as_play_reads_it(tmp_path):
+    midi = mido.MidiFile(type=1)
+    for name, pitch in (("Soprano", 72), ("Left Hand", 50)):
+        midi.tracks.append(
+            mido.MidiTrack(
+                [
+                    mido.MetaMessage("track_name", name=name),
+                    mido.Message("note_on", note=pitch, velocity=80),
+                    mido.Message("note_off", note=pitch, time=480),
+                ]
+            )
+        )
+    midi.save(tmp_path / "two.mid")
+    output = " ".join(run("inspect", tmp_path / "two.mid").output.split())
+    assert "no track is named for the right hand" in output and "track 1 named for the left hand" in output
+
+
+def test_play_json_notes_and_quiet(tmp_path):
+    song = EXAMPLES / "three-note.mid"
+    args = ("play", song, "-o", tmp_path / "o.mid", "--controller", "scripted")
+    to_stdout = run(*args, "--json", "-", "--notes", "2")
+    assert to_stdout.exit_code == 0, to_stdout.output
+    report = json.loads(to_stdout.stdout)  # standard output is the JSON alone; the tables went to stderr
+    assert report == json.loads((tmp_path / "o.report.json").read_text())
+    assert report["performer"] == "scripted pianist" and len(report["notes"]) == 3
+    assert "the first 2 of 3 notes" in to_stdout.stderr and "note F1" in to_stdout.stderr
+
+    to_file = run(*args, "--json", tmp_path / "r.json")
+    assert json.loads((tmp_path / "r.json").read_text())["f1"] == report["f1"]
+    assert "per note" not in to_file.output  # no per-note table unless --notes asks for one
+    quiet = run(*args, "--quiet", "--notes", "3")
+    assert quiet.exit_code == 0 and quiet.output.strip().splitlines() == [
+        f"performance written to {tmp_path / 'o.mid'}, report to {tmp_path / 'o.report.json'}"
+    ]
+
+
+def test_the_first_screen_explains_a_few_figures_and_all_shows_the_rest(scale_file):
+    from pianobot.perform.report import FIGURES
+
+    first = run("score", scale_file, scale_file, "--no-notes")
+    every = run("score", scale_file, scale_file, "--no-notes", "--all")
+    for figure in FIGURES:
+        assert (f"│ {figure.label} " in first.output) == figure.first  # (in the figure column)
+        assert f"│ {figure.label} " in every.output and " ".join(figure.meaning.split()[:3]) in every.output
+    assert 3 <= sum(f.first for f in FIGURES) <= 6 and "--all shows every figure" in first.output
+
+
+def test_the_sound_notice_says_what_make_sound_installs():
+    from pianobot.perform.audio import SOUND
+
+    packages = re.search(r"^SOUND_PACKAGES := (.+)$", (ROOT / "Makefile").read_text(), re.M).group(1).split()
+    assert re.findall(r"[a-z0-9-]*(?:fluidsynth|soundfont)[a-z0-9-]*", SOUND.split("(")[1]) == packages
