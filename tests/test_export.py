@@ -77,3 +77,44 @@ def test_a_finger_shared_policy_exports_with_the_vector_alone(tmp_path):
         assert action.shape == (3, 13) and np.allclose(action[1], policy.act(observation), atol=1e-5)
         observation, *_ = env.step(action[0])
     env.close()
+
+
+@pytest.mark.parametrize("which", ["twinkle phrase (touch)", "general policy (vector alone)"])
+def test_the_model_pages_onnx_example_acts_as_pianobot_does(tmp_path, monkeypatch, which):
+    """docs/models.md's onnxruntime block, run as written beside an exported policy: the inputs it
+    names and the action it gives are pianobot's."""
+    import re
+
+    from pianobot.agent.export import export_onnx
+    from pianobot.agent.general import PACKAGED
+
+    piece = pianobot.load_piece(ROOT / "examples" / "midi" / "twinkle.mid")
+    phrase = pianobot.split_phrases(piece)[0]
+    folder = (
+        next((ROOT / "models").glob(f"{phrase.hash}-*")) if "touch" in which else next(PACKAGED.glob("task-melody-*"))
+    )
+    export_onnx(folder, tmp_path / "policy.onnx")
+    (block,) = [
+        b
+        for b in re.findall(r"```python\n(.*?)```", (ROOT / "docs" / "models.md").read_text(), re.S)
+        if "onnxruntime" in b
+    ]
+    monkeypatch.chdir(tmp_path)
+    namespace: dict = {}
+    exec(compile(block, "docs/models.md", "exec"), namespace)
+    env_config, _ = pianobot.policy_configs(folder)
+    env = pianobot.PianoEnv(piece=phrase.piece(), config=env_config)
+    policy = pianobot.load_policy(folder, env)
+    vector, tactile = policy.split(env.reset(seed=2)[0])
+    assert namespace["inputs"]["vector"] == ["batch", len(vector)]
+    if "touch" in which:
+        assert namespace["inputs"]["tactile"] == ["batch", *tactile.shape] == ["batch", 2, 3, 15, 20]
+        assert len(vector) == 1358  # the figure the page gives
+    else:
+        assert "tactile" not in namespace["inputs"]
+    observation, _ = env.reset(seed=2)
+    for _ in range(15):
+        action = namespace["act"](observation)
+        assert action.dtype == np.float32 and np.allclose(action, policy.act(observation), atol=1e-5)
+        observation, *_ = env.step(action)
+    env.close()
