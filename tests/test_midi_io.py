@@ -282,3 +282,52 @@ def test_long_or_multi_line_texts_are_quoted_short_on_one_line(tmp_path):
     with pytest.raises(PianobotError) as e:
         read_midi(tmp_path / "l.mid", track="x" * 10_000)
     assert len(str(e.value)) < 400
+
+
+def test_tracks_named_for_hands_give_each_note_its_hand(tmp_path):
+    path = midi_file(
+        tmp_path / "two.mid",
+        [
+            ("Piano RH", [(0, lyric("3")), (0, on(72)), (480, off(72))]),
+            ("L.H.", [(0, lyric("5 1")), (0, on(48)), (0, on(55)), (960, off(48)), (960, off(55))]),
+            ("Strings", [(480, on(60)), (960, off(60))]),
+        ],
+    )
+    piece = read_midi(path)
+    assert [(n.pitch, n.hand, n.finger) for n in piece] == [
+        (48, "left", 5),
+        (55, "left", 1),
+        (72, "right", 3),
+        (60, None, None),
+    ]
+    assert piece.hands == ("right", "left")
+
+
+def test_a_piece_with_hands_is_written_as_one_track_per_hand_and_read_back_exactly(tmp_path):
+    piece = Piece(
+        (
+            Note(0.0, 72, 0.5, 90, 3, "right"),
+            Note(0.0, 48, 1.0, 60, 5, "left"),
+            Note(0.0, 55, 1.0, 62, 1, "left"),
+            Note(0.5, 74, 1.0, 88, None, "right"),
+            Note(0.5, 60, 0.9, 70, 2, None),  # a note nobody has given to a hand
+            Note(1.0, 72, 1.5, 80, 4, "left"),  # the same key again, now the left hand's
+        ),
+        bpm=72,
+    )
+    path = write_midi(piece, tmp_path / "hands.mid")
+    midi = mido.MidiFile(path)
+    assert midi.type == 1
+    assert [t.name for t in midi.tracks] == ["Right Hand", "Left Hand", "Unassigned"]
+    assert read_midi(path) == piece
+    # a piece without hands is written as before: one track, type 0
+    plain = write_midi(piece.with_hands(None), tmp_path / "plain.mid")
+    assert mido.MidiFile(plain).type == 0 and read_midi(plain) == piece.with_hands(None)
+
+
+def test_a_one_track_files_name_is_its_title_not_a_hand(tmp_path):
+    # `pianobot finger` names its track after the song: 'left fingered by pianobot' is no hand
+    piece = Piece((Note(0, 60, 1, finger=2),))
+    assert read_midi(write_midi(piece, tmp_path / "left.mid", name="left fingered by pianobot")) == piece
+    only_right = piece.with_hands("right")  # one hand's notes with their hand: a type 1 file
+    assert read_midi(write_midi(only_right, tmp_path / "right.mid")) == only_right

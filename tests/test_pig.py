@@ -159,3 +159,20 @@ def test_sidecar_matching_takes_the_nearest_unused_note_quickly(tmp_path):
     near = Piece((Note(0.0, 60, 0.5, 80), Note(0.01, 60, 0.5, 80)))
     write_pig(Piece((Note(0.02, 60, 0.5, 80, 3), Note(0.0, 60, 0.5, 80, 2))), tmp_path / "near.txt")
     assert [n.finger for n in apply_fingering(near, tmp_path / "near.txt")] == [2, 3]
+
+
+def test_pig_with_both_hands_reads_and_writes_each_notes_hand(tmp_path):
+    path = tmp_path / "both.txt"
+    path.write_text(
+        "//Version: PianoFingering_v170101\n"
+        "0\t0.0\t0.5\tBb4\t64\t80\t0\t3_1\n"
+        "1\t0.0\t1.0\tC3\t64\t80\t1\t-5\n"
+        "2\t0.5\t1.0\tC#5\t64\t80\t0\t+4\n"
+    )
+    both = read_pig(path, hand=None)
+    assert [(n.pitch, n.finger, n.hand) for n in both] == [(48, 5, "left"), (70, 3, "right"), (73, 4, "right")]
+    written = write_pig(both, tmp_path / "again.txt")
+    columns = [line.split("\t") for line in written.read_text().splitlines()[1:]]
+    assert [(c[3], c[6], c[7]) for c in columns] == [("C3", "1", "-5"), ("A#4", "0", "3"), ("C#5", "0", "4")]
+    assert read_pig(written, hand=None) == both
+    assert read_pig(written, hand="left") == both.part("left").with_hands(None)  # one hand's part, as before

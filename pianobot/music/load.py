@@ -2,15 +2,14 @@
 
 from __future__ import annotations
 
-import re
 import warnings
 from dataclasses import dataclass, replace
 from pathlib import Path
 
 from pianobot.errors import PianobotError, PianobotWarning, SettingError, quote
 from pianobot.music import midi_io, pig
-from pianobot.music.instrument import HandSpec
-from pianobot.music.piece import Note, Piece, pitch_name
+from pianobot.music.instrument import HandSpec, KeyboardSpec
+from pianobot.music.piece import HANDS, Note, Piece, pitch_name
 
 
 @dataclass(frozen=True)
@@ -38,24 +37,9 @@ class LoadOptions:
     """Replace the file's fingering with the planner's (see pianobot.pianist.fingering)."""
 
 
-HANDS = ("right", "left")
-_HAND_NAMES = {
-    "right": re.compile(r"right|\brh\b|\br\.h\.|treble|upper|melody", re.IGNORECASE),
-    "left": re.compile(r"left|\blh\b|\bl\.h\.|bass|lower|accomp", re.IGNORECASE),
-}
-
-
 def hand_tracks(tracks: list[midi_io.TrackInfo], hand: str) -> list[int]:
     """Tracks with notes whose names say they hold ``hand``'s part ('Right Hand', 'RH', 'Treble'...)."""
-    return [
-        t.index
-        for t in tracks
-        if t.notes and _HAND_NAMES[hand].search(t.name) and not _HAND_NAMES[_other(hand)].search(t.name)
-    ]
-
-
-def _other(hand: str) -> str:
-    return "left" if hand == "right" else "right"
+    return [t.index for t in tracks if t.notes and midi_io.track_hand(t.name) == hand]
 
 
 CHORD_SPREAD = 0.06
@@ -111,6 +95,12 @@ def _read_midi(path: Path, options: LoadOptions, bpm: float | None = None) -> Pi
         raise SettingError(f"load.hand {quote(options.hand)}: choose right or left", "load.hand")
     if options.track is not None:
         raise SettingError("give load.track or load.hand, not both", "load.track", "load.hand")
+    return _read_hand(path, options, bpm, grid).with_hands(None)  # one hand's part, read as before hands
+
+
+def _read_hand(path: Path, options: LoadOptions, bpm: float | None, grid: float | None) -> Piece:
+    """``options.hand``'s part: the tracks named for it, else the higher or lower of two tracks, else
+    the notes on its side of ``options.split``."""
     tracks = midi_io.describe_tracks(path)
     named = hand_tracks(tracks, options.hand)
     if named:
@@ -195,3 +185,83 @@ def load_part(path: str | Path, options: LoadOptions, hand: HandSpec) -> Piece:
                 )
             )
     return piece
+
+
+PIANO = KeyboardSpec(21, 88)
+"""The piano's 88 keys, A0 to C8: what two hands may be asked to play."""
+
+
+def load_hands(path: str | Path, options: LoadOptions = LoadOptions()) -> Piece:
+    """A two-hand piece (a .mid file, or a PIG .txt file with both hands' notes), each note with
+    the hand its track's name (or PIG channel) says, None where nothing says (the fingering planner
+    then gives it one: :func:`pianobot.pianist.hands.load_two_hands`).
+
+    Bad input, in one line: notes beyond the piano's 88 keys and hands that cross are refused
+    (:class:`SettingError` naming the setting that helps); three or more tracks of notes that are
+    not all named for hands are read as one part whose notes the planner gives to the hands, said
+    in one warning."""
+    path = Path(path)
+    if options.hand is not None:
+        raise SettingError(
+            "load.hand takes one hand's part; a two-hand reading takes both: drop load.hand", "load.hand"
+        )
+    if path.suffix.lower() == ".txt":
+        if options.tempo is not None or options.fingering is not None or options.quantize is not None:
+            raise SettingError(
+                "a PIG file has times in seconds and its own fingering: drop load.tempo, load.fingering and load.quantize",
+                "load.tempo",
+                "load.fingering",
+                "load.quantize",
+            )
+        piece = pig.read_pig(path, hand=None).transpose(options.transpose)
+    else:
+        piece = load_piece(path, options)
+        tracks = [t for t in midi_io.describe_tracks(path) if t.notes]
+        unnamed = [t for t in tracks if midi_io.track_hand(t.name) is None]
+        if options.track is None and len(tracks) >= 3 and unnamed:
+            warnings.warn(
+                PianobotWarning(
+                    f"{path.name} has {len(tracks)} tracks of notes, {len(unnamed)} not named for a hand: "
+                    "their notes are given to the hands by the fingering planner"
+                )
+            )
+    _check_keys(piece, path)
+    _check_crossing(piece, path)
+    return piece
+
+
+def _check_keys(piece: Piece, path: Path) -> None:
+    """Refuse notes beyond the piano's 88 keys, suggesting the octave shift that fits them, if any."""
+    outside = [n for n in piece.notes if n.pitch not in PIANO]
+    if not outside:
+        return
+    names = ", ".join(n.describe() for n in outside[:3]) + (" ..." if len(outside) > 3 else "")
+    low, high = min(n.pitch for n in piece.notes), max(n.pitch for n in piece.notes)
+    shifts = [s for s in range(-120, 121, 12) if PIANO.lowest <= low + s and high + s <= PIANO.highest]
+    fix = f"use load.transpose {min(shifts, key=abs)}" if shifts else "the piece spans more than the piano: cut notes"
+    raise SettingError(
+        f"{path.name} has {len(outside)} note(s) beyond the piano's 88 keys {PIANO.describe()}: {names}; {fix}",
+        "load.transpose",
+    )
+
+
+def _check_crossing(piece: Piece, path: Path) -> None:
+    """Refuse a left-hand note that sounds above (or on) a right-hand note at the same time: the
+    robot's hands share one rail and cannot cross. Notes let go within :data:`LEGATO_OVERLAP` of
+    the other's onset do not count (a player's legato)."""
+    sounding: list[Note] = []
+    for note in piece.notes:
+        if note.hand is None:
+            continue
+        sounding = [n for n in sounding if n.offset > note.onset + LEGATO_OVERLAP]
+        other = [n for n in sounding if n.hand != note.hand]
+        crossed = [n for n in other if (n.pitch >= note.pitch if note.hand == "right" else n.pitch <= note.pitch)]
+        if crossed:
+            left, right = (crossed[0], note) if note.hand == "right" else (note, crossed[0])
+            raise SettingError(
+                f"{path.name}: the hands cross at {note.onset:.3f} s: the left hand's {left.name} sounds at or above "
+                f"the right hand's {right.name}, and the robot's two hands cannot cross: play one hand with "
+                "load.hand right or load.hand left",
+                "load.hand",
+            )
+        sounding.append(note)

@@ -6,6 +6,12 @@ first, separated by spaces or commas: ``"3"`` for a melody note, ``"2 4"`` for a
 A substitution written ``3_1`` counts as its first finger (the one that strikes); ``-`` marks
 a note without a finger. Texts that are not finger lists (ordinary lyrics) are ignored.
 
+Hands: in a type 1 file, a track whose name says it holds a hand's part ('Right Hand', 'RH',
+'Treble', 'Left Hand', 'Bass'...; :func:`track_hand`) gives its notes that hand; other tracks'
+notes have none, and so have a type 0 file's (its one track's name is the piece's title). A piece
+whose notes have hands is written as a type 1 file, one track per hand, named "Right Hand" and
+"Left Hand".
+
 Parsing uses mido; times come from the file's own tempo map unless ``bpm`` re-times the piece
 so that one beat lasts 60/bpm seconds.
 """
@@ -24,11 +30,26 @@ import mido
 
 from pianobot.errors import PianobotError, PianobotWarning, SettingError, quote
 from pianobot.files import atomic_write, read_input
-from pianobot.music.piece import MAX_SECONDS, Note, Piece, pitch_name
+from pianobot.music.piece import HANDS, MAX_SECONDS, Note, Piece, pitch_name
 
 _FINGER_TOKEN = r"(?:[0-9](?:_[0-9])?|-)"
 _FINGER_TEXT = re.compile(rf"^\s*{_FINGER_TOKEN}(?:[\s,]+{_FINGER_TOKEN})*\s*$")
 MAX_FILE_BYTES = 50_000_000
+HAND_NAMES = {
+    "right": re.compile(r"right|\brh\b|\br\.h\.|treble|upper|melody", re.IGNORECASE),
+    "left": re.compile(r"left|\blh\b|\bl\.h\.|bass|lower|accomp", re.IGNORECASE),
+}
+"""What a track's name says when it holds one hand's part."""
+TRACK_NAMES = {"right": "Right Hand", "left": "Left Hand"}
+"""The names pianobot gives the hands' tracks when it writes a piece with hands."""
+UNASSIGNED_TRACK = "Unassigned"
+"""The track for the notes without a hand, in a piece with hands."""
+
+
+def track_hand(name: str) -> str | None:
+    """The hand a track's name says it holds ('right' for 'Right Hand', 'RH', 'Treble'...), or None."""
+    said = [hand for hand in HANDS if HAND_NAMES[hand].search(name)]
+    return said[0] if len(said) == 1 else None
 
 
 @dataclass(frozen=True)
@@ -299,9 +320,12 @@ def read_midi(
         step = max(1, round(midi.ticks_per_beat * 4 * grid))
         snap = lambda tick: round(tick / step) * step  # noqa: E731
     notes: list[Note] = []
+    names = [info.name if midi.type == 1 else "" for info in list_tracks(midi)]  # type 0: a title
     for index, raw, fingering in _parts(
         midi, tracks if tracks is not None else _select_tracks(midi, track, path), seconds, path
     ):
+        hand = track_hand(names[index]) if index is not None else None
+        index = 0 if index is None else index  # (several tracks read as one: messages say track 0, as before)
         if grid is not None:
             raw = [(snap(on), max(snap(off), snap(on) + step), pitch, vel) for on, off, pitch, vel in raw]
             fingering = {snap(tick): fingers for tick, fingers in fingering.items()}
@@ -341,16 +365,17 @@ def read_midi(
             if round(offset, 3) <= round(onset, 3):
                 warnings.warn(PianobotWarning(f"{pitch_name(pitch)} at {onset:.3f} s lasts under 1 ms; dropped"))
                 continue
-            notes.append(Note(onset=onset, pitch=pitch, offset=offset, velocity=vel, finger=finger))
+            notes.append(Note(onset=onset, pitch=pitch, offset=offset, velocity=vel, finger=finger, hand=hand))
     return Piece(tuple(_resolve_overlaps(notes)), bpm=nominal)
 
 
-def _parts(midi: mido.MidiFile, chosen: list[int], seconds, path: Path) -> list[tuple[int, list, dict]]:
+def _parts(midi: mido.MidiFile, chosen: list[int], seconds, path: Path) -> list[tuple[int | None, list, dict]]:
     """(track index, notes, fingering by tick) of the chosen tracks.
 
     Fingering normally sits in the notes' own track. Some writers move every lyric to the first
     track, away from the notes (pretty_midi does): when lyric-only tracks hold fingering and no
-    chosen track has its own, the chosen tracks' notes are read as one part with that fingering."""
+    chosen track has its own, the chosen tracks' notes are read as one part with that fingering
+    (its index None where it merges several tracks: its notes have no hand)."""
     parts = [(index, *_track_notes(midi.tracks[index], index, seconds, path)) for index in chosen]
     if any(fingering for _, raw, fingering in parts if raw):
         return parts
@@ -363,7 +388,7 @@ def _parts(midi: mido.MidiFile, chosen: list[int], seconds, path: Path) -> list[
         return parts
     noted = [(index, raw) for index, raw, _ in parts if raw]
     merged = [item for _, raw in noted for item in raw]
-    return [(noted[0][0] if len(noted) == 1 else 0, merged, lyrics)] if noted else parts
+    return [(noted[0][0] if len(noted) == 1 else None, merged, lyrics)] if noted else parts
 
 
 def _resolve_overlaps(notes: list[Note]) -> list[Note]:
@@ -394,30 +419,45 @@ def _write_resolution(bpm: float) -> tuple[int, int]:
     return tempo, tempo // 1000
 
 
-def midi_bytes(piece: Piece, *, name: str = "pianobot") -> bytes:
-    """The piece as a type-0 MIDI file with 1 ms ticks and fingering lyrics."""
-    tempo, tpb = _write_resolution(piece.bpm)
+def _track(part: Piece, name: str, tempo: int | None) -> mido.MidiTrack:
+    """One track of ``part``'s notes with fingering lyrics, named ``name``, with the tempo if given."""
     events: list[tuple[int, int, mido.Message | mido.MetaMessage]] = []
-    for chord in piece.chords():
+    for chord in part.chords():
         tick = round(chord[0].onset * 1000)
         if any(n.finger is not None for n in chord):
             text = finger_text([n.finger for n in sorted(chord, key=lambda n: n.pitch)])
             events.append((tick, 1, mido.MetaMessage("lyrics", text=text)))
         for note in chord:
             events.append((tick, 2, mido.Message("note_on", note=note.pitch, velocity=note.velocity)))
-    for note in piece.notes:
+    for note in part.notes:
         events.append((round(note.offset * 1000), 0, mido.Message("note_off", note=note.pitch, velocity=0)))
     events.sort(key=lambda e: (e[0], e[1]))
     track = mido.MidiTrack()
     track.append(mido.MetaMessage("track_name", name=name))
-    track.append(mido.MetaMessage("set_tempo", tempo=tempo))
+    if tempo is not None:
+        track.append(mido.MetaMessage("set_tempo", tempo=tempo))
     last = 0
     for tick, _, msg in events:
         track.append(msg.copy(time=tick - last))
         last = tick
     track.append(mido.MetaMessage("end_of_track", time=0))
-    midi = mido.MidiFile(type=0, ticks_per_beat=tpb, charset="utf-8")  # any name: a file name may be '音.mid'
-    midi.tracks.append(track)
+    return track
+
+
+def midi_bytes(piece: Piece, *, name: str = "pianobot") -> bytes:
+    """The piece as a MIDI file with 1 ms ticks and fingering lyrics: type 0 (one track named
+    ``name``) when no note has a hand, else type 1 with one track per hand ("Right Hand", "Left
+    Hand", then "Unassigned" for notes without a hand), the first carrying the tempo."""
+    tempo, tpb = _write_resolution(piece.bpm)
+    if piece.hands:
+        parts = [(TRACK_NAMES[hand], piece.part(hand)) for hand in piece.hands]
+        parts += [(UNASSIGNED_TRACK, piece.part(None))] if any(n.hand is None for n in piece.notes) else []
+    else:
+        parts = [(name, piece)]
+    # any name: a file name may be '音.mid'
+    midi = mido.MidiFile(type=1 if piece.hands else 0, ticks_per_beat=tpb, charset="utf-8")
+    for i, (track_name, part) in enumerate(parts):
+        midi.tracks.append(_track(part, track_name, tempo if i == 0 else None))
     buffer = io.BytesIO()
     midi.save(file=buffer)
     return buffer.getvalue()

@@ -13,11 +13,12 @@ from __future__ import annotations
 
 import bisect
 from collections import defaultdict
+from dataclasses import replace
 from pathlib import Path
 
 from pianobot.errors import PianobotError, quote
 from pianobot.files import atomic_write, read_input
-from pianobot.music.piece import Note, Piece, parse_pitch, pitch_name
+from pianobot.music.piece import HANDS, Note, Piece, parse_pitch, pitch_name
 
 HEADER = "//Version: PianoFingering_v170101"
 SIDECAR_SUFFIX = "_fingering.txt"
@@ -84,21 +85,32 @@ def read_pig_rows(path: str | Path) -> list[tuple[Note, int]]:
     return rows
 
 
-def read_pig(path: str | Path, *, hand: str = "right") -> Piece:
-    """A PIG file's notes for one hand as a piece (fingers stored as 1-5)."""
-    channel = {"right": 0, "left": 1}[hand]
-    notes = [note for note, ch in read_pig_rows(path) if ch == channel]
+CHANNELS = {"right": 0, "left": 1}
+"""PIG's channel for each hand."""
+
+
+def read_pig(path: str | Path, *, hand: str | None = "right") -> Piece:
+    """A PIG file's notes for one hand as a piece (fingers stored as 1-5, no hand: a one-hand part),
+    or with ``hand=None`` both hands' notes, each with its hand (channel 0 right, 1 left)."""
+    rows = read_pig_rows(path)
+    if hand is None:
+        return Piece(tuple(replace(note, hand=HANDS[channel]) for note, channel in rows))
+    channel = CHANNELS[hand]
+    notes = [note for note, ch in rows if ch == channel]
     if not notes:
         raise PianobotError(f"{path} has no {hand}-hand notes (channel {channel}): choose the other hand")
     return Piece(tuple(notes))
 
 
 def pig_text(piece: Piece) -> str:
-    """The piece as PIG text (right hand, channel 0). Every note needs a finger."""
+    """The piece as PIG text. Every note needs a finger. A note of the left hand is written on
+    channel 1 with its finger negative; every other note (the right hand's, or one without a
+    hand) on channel 0 with its finger positive."""
     lines = [HEADER]
     for i, note in enumerate(piece.notes):
         if note.finger is None:
             raise PianobotError(f"{note.describe()} has no finger: a PIG file needs a finger for every note")
+        left = note.hand == "left"
         lines.append(
             "\t".join(
                 [
@@ -108,8 +120,8 @@ def pig_text(piece: Piece) -> str:
                     pitch_name(note.pitch),
                     str(note.velocity),
                     "80",
-                    "0",
-                    str(note.finger),
+                    str(CHANNELS["left" if left else "right"]),
+                    str(-note.finger if left else note.finger),
                 ]
             )
         )
