@@ -1,0 +1,73 @@
+"""Two-hand pieces at the reading level (pianobot.music.load.load_hands): hands from track names,
+bad input in one line."""
+
+import warnings
+
+import pytest
+from conftest import midi_file, off, on
+
+from pianobot.errors import PianobotWarning, SettingError
+from pianobot.music.load import LoadOptions, load_hands
+from pianobot.music.piece import Note, Piece
+from pianobot.music.pig import write_pig
+
+
+def _track(*notes):
+    """(tick, message) events of (pitch, start beat, end beat) notes, 480 ticks a beat."""
+    return [event for p, a, b in notes for event in ((round(a * 480), on(p)), (round(b * 480), off(p)))]
+
+
+def test_tracks_named_for_hands_give_a_two_hand_piece(tmp_path):
+    path = midi_file(
+        tmp_path / "hands.mid",
+        [("Right Hand", _track((72, 0, 1), (74, 1, 2))), ("Left Hand", _track((48, 0, 2)))],
+    )
+    piece = load_hands(path)
+    assert [(n.pitch, n.hand) for n in piece] == [(48, "left"), (72, "right"), (74, "right")]
+
+
+def test_notes_beyond_the_pianos_keys_are_refused_with_the_shift_that_fits(tmp_path):
+    path = midi_file(tmp_path / "high.mid", [("Right Hand", _track((110, 0, 1), (60, 1, 2)))])
+    with pytest.raises(SettingError, match=r"beyond the piano's 88 keys A0-C8.*D8.*load.transpose -12") as e:
+        load_hands(path)
+    assert e.value.field == "load.transpose"
+    assert [n.pitch for n in load_hands(path, LoadOptions(transpose=-12))] == [98, 48]
+
+
+def test_hands_that_cross_are_refused_in_one_line(tmp_path):
+    path = midi_file(
+        tmp_path / "cross.mid",
+        [("Right Hand", _track((60, 0, 2))), ("Left Hand", _track((48, 0, 1), (67, 1, 2)))],
+    )
+    with pytest.raises(SettingError, match=r"hands cross at 0.500 s: the left hand's G4 .* right hand's C4") as e:
+        load_hands(path)
+    assert e.value.field == "load.hand"
+    # a legato overlap (the left hand's note let go just after the right hand's starts) is no crossing
+    legato = midi_file(
+        tmp_path / "legato.mid",
+        [("Right Hand", _track((64, 2, 3))), ("Left Hand", _track((67, 0, 2.1)))],  # 2.1 beats: 50 ms late
+    )
+    assert load_hands(legato).hands == ("right", "left")
+
+
+def test_three_unnamed_staves_are_read_as_one_part_said_in_one_line(tmp_path):
+    path = midi_file(
+        tmp_path / "satb.mid",
+        [("Soprano", _track((72, 0, 1))), ("Alto", _track((67, 0, 1))), ("Tenor", _track((60, 0, 1)))],
+    )
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        piece = load_hands(path)
+    lines = [str(w.message) for w in caught if issubclass(w.category, PianobotWarning)]
+    assert lines == [
+        "satb.mid has 3 tracks of notes, 3 not named for a hand: their notes are given to the hands by the fingering planner"
+    ]
+    assert len(piece) == 3 and piece.hands == ()
+
+
+def test_one_hand_options_are_refused_and_a_two_hand_pig_file_is_read(tmp_path):
+    with pytest.raises(SettingError, match="drop load.hand"):
+        load_hands(tmp_path / "x.mid", LoadOptions(hand="right"))
+    piece = Piece((Note(0, 72, 1, finger=3, hand="right"), Note(0, 48, 1, finger=5, hand="left")))
+    path = write_pig(piece, tmp_path / "both.txt")
+    assert load_hands(path) == piece
