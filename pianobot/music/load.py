@@ -175,15 +175,20 @@ def load_part(path: str | Path, options: LoadOptions, hand: HandSpec) -> Piece:
     """:func:`load_piece`; with ``options.hand``, also thin chords to what ``hand`` can hold
     (:func:`pianobot.pianist.reduce.load_for_hand` goes on to what it can reach in time)."""
     piece = load_piece(path, options)
-    if options.hand is not None:
-        piece, dropped = thin_chords(piece, len(hand.fingers))
-        if dropped:
-            warnings.warn(
-                PianobotWarning(
-                    f"the {options.hand} hand's part has chords of more than {len(hand.fingers)} notes: "
-                    f"kept the highest {len(hand.fingers)}, dropped {dropped} note(s)"
-                )
+    return piece if options.hand is None else thin_hand(piece, options.hand, hand)
+
+
+def thin_hand(piece: Piece, name: str, hand: HandSpec, kept: str = "highest") -> Piece:
+    """:func:`thin_chords` to ``hand``'s fingers, said in one warning for the ``name`` hand's part
+    (whose kept notes are its ``kept`` ones: 'lowest' for a left hand's part thinned in its mirror image)."""
+    piece, dropped = thin_chords(piece, len(hand.fingers))
+    if dropped:
+        warnings.warn(
+            PianobotWarning(
+                f"the {name} hand's part has chords of more than {len(hand.fingers)} notes: "
+                f"kept the {kept} {len(hand.fingers)}, dropped {dropped} note(s)"
             )
+        )
     return piece
 
 

@@ -1,0 +1,314 @@
+"""Which hand plays each note of a two-hand piece, and each hand's fingering.
+
+A piece whose tracks are named for hands says which hand plays each note
+(:func:`pianobot.music.load.load_hands`). Where nothing says, :func:`assign_hands` decides by a
+small dynamic programme over the piece's chords (notes started within
+:data:`~pianobot.music.load.CHORD_SPREAD` of each other): a *state* is how many of a chord's
+notes, from the bottom, the left hand takes (the rest go to the right hand, so within a chord the
+hands never cross). The programme finds the states with the lowest total cost:
+
+- **travel**: each hand's position is the middle of the notes it plays (kept while it rests);
+  moving it costs the distance squared, in octaves, times :data:`TRAVEL_COST` (one long leap is
+  harder than several steps, so a leap is shared between the hands);
+- **switch**: :data:`SWITCH_COST` for a hand that plays a chord after the other played the one
+  before alone (a melody stays in one hand unless the other hand is much nearer);
+- **register**: :data:`HOME_COST` per semitone a note lies on the other hand's side of the
+  piece's middle (halfway between the median lowest and the median highest note of its chords of
+  two or more notes; no such cost in a piece without them), which settles what travel leaves open
+  (a melody note just above the bass while the left hand is free goes to the right hand);
+- **crossing**: the left hand's position stays below the right hand's; where a hand's notes
+  pass the resting hand, that hand is pushed aside and pays its travel; notes struck across the
+  other hand's held notes cost :data:`CROSS_COST` (the held note must be let go);
+- **what a hand cannot do**, read from the fingering planner (:class:`~pianobot.pianist.fingering.Planner`,
+  the one module that knows the hand's reach; the left hand is the right hand's mirror image,
+  asked through :meth:`~pianobot.music.piece.Piece.mirror`): more notes than the hand has
+  fingers, or a chord no hand position reaches, costs :data:`FORBIDDEN` (chosen only where no
+  split of the chord is playable); notes held under a new chord that leave too few fingers or lie
+  out of reach cost :data:`HELD_COST` each (the held note ends early when the hand's part is reduced).
+
+So notes one hand cannot take go to the other: a chord too wide for one hand is split between
+them, a melody that moves into the other hand's region passes to it. Notes that already have a
+hand keep it. Each hand's part is then reduced to what the hand can play and fingered by the
+planner (:func:`finger_hands`; the left hand's part mirrored, planned as a right hand's, and
+mirrored back).
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass
+from functools import lru_cache
+from pathlib import Path
+
+import numpy as np
+
+from pianobot.errors import PianobotWarning
+from pianobot.music.instrument import HandSpec, KeyboardSpec
+from pianobot.music.load import CHORD_SPREAD, LEGATO_OVERLAP, LoadOptions, load_hands, thin_hand
+from pianobot.music.piece import Note, Piece, mirror_pitch
+from pianobot.pianist.fingering import FingeringPlan, ensure_fingering
+from pianobot.pianist.reduce import reduce_part
+from pianobot.sim.hand import HandConfig
+from pianobot.sim.keyboard import KeyboardConfig
+
+TRAVEL_COST = 12.0
+"""Cost of a hand moving one octave (squared for longer moves)."""
+SWITCH_COST = 3.0
+"""Cost of a hand starting to play after the other hand played the chord before alone."""
+HOME_COST = 0.5
+"""Cost of each semitone a note lies on the other hand's side of the piece's middle."""
+CROSS_COST = 100.0
+"""Cost of a note struck across a note the other hand still holds."""
+HELD_COST = 10.0
+"""Cost of each note held under a new chord of the same hand that leaves it too few fingers or is out of reach."""
+FORBIDDEN = 1e4
+"""Cost of giving a hand more notes than its fingers, or a chord it cannot span."""
+_REACH_KEYS = KeyboardSpec(48, 48)
+"""The keyboard the reach is asked on (C3-B6): a chord is moved there by whole octaves, which keeps
+every key's place relative to the others."""
+
+
+@dataclass(frozen=True)
+class HandAssignment:
+    """The piece with every note's hand, and how far it is from what the hands can play."""
+
+    piece: Piece
+    cost: float
+    unplayable: int
+    """Chords no split between the hands makes playable for both (their parts are reduced later)."""
+
+
+@lru_cache(maxsize=4096)
+def _reaches(pitches: tuple[int, ...], fingers: tuple[int, ...]) -> bool:
+    """Whether a right hand with ``fingers`` can hold ``pitches`` (sorted) at one hand position."""
+    if len(pitches) > len(fingers):
+        return False
+    shift = _REACH_KEYS.lowest - pitches[0] // 12 * 12
+    if pitches[-1] + shift not in _REACH_KEYS:
+        return False
+    planner = _planner(fingers)
+    return planner.place([Note(0.0, p + shift, 1.0) for p in pitches]).possible
+
+
+@lru_cache(maxsize=8)
+def _planner(fingers: tuple[int, ...]):
+    from pianobot.pianist.fingering import Planner
+
+    return Planner(KeyboardConfig(spec=_REACH_KEYS), HandConfig(spec=HandSpec(fingers)))
+
+
+def reaches(pitches, hand: str, spec: HandSpec = HandSpec()) -> bool:
+    """Whether ``hand`` ('right' or 'left') can hold all of ``pitches`` at once, at one position:
+    no more notes than fingers, none beyond the planner's reach. The left hand is asked as the
+    right hand's mirror image."""
+    if not pitches:
+        return True
+    keys = [mirror_pitch(p) for p in pitches] if hand == "left" else list(pitches)
+    return _reaches(tuple(sorted(keys)), spec.fingers)
+
+
+def group_chords(piece: Piece, spread: float = CHORD_SPREAD) -> list[list[int]]:
+    """Indices into ``piece.notes`` grouped as :func:`~pianobot.music.load.gather_chords` groups notes
+    (each joins the chord started at most ``spread`` s before it), each chord by pitch."""
+    groups: list[list[int]] = []
+    notes = piece.notes
+    for i, note in enumerate(notes):
+        if groups and note.onset - notes[groups[-1][0]].onset <= spread:
+            if note.pitch not in {notes[j].pitch for j in groups[-1]}:
+                groups[-1].append(i)
+                continue
+        groups.append([i])
+    return [sorted(g, key=lambda j: notes[j].pitch) for g in groups]
+
+
+@dataclass(frozen=True)
+class _State:
+    """One way of playing up to a chord: its cost, the state before it, each hand's position
+    (None before it has played) and the notes each hand still holds."""
+
+    cost: float
+    back: int
+    left: float | None
+    right: float | None
+    held_left: tuple[Note, ...]
+    held_right: tuple[Note, ...]
+    played: tuple[bool, bool]
+    """Whether the left and the right hand played this chord."""
+
+
+def middle(piece: Piece, groups: list[list[int]]) -> float | None:
+    """Halfway between the median lowest and the median highest note of the chords of two or more
+    notes (``groups`` as :func:`group_chords` gives them); None where there are none."""
+    wide = [g for g in groups if len(g) > 1]
+    if not wide:
+        return None
+    low = float(np.median([piece.notes[g[0]].pitch for g in wide]))
+    high = float(np.median([piece.notes[g[-1]].pitch for g in wide]))
+    return (low + high) / 2
+
+
+def _local_cost(chord: list[Note], k: int, spec: HandSpec, middle: float | None) -> float:
+    """What the split itself costs: notes fixed to the other hand, more notes than fingers, a
+    chord too wide for the hand, notes on the other hand's side of the middle."""
+    left, right = chord[:k], chord[k:]
+    if any(n.hand == "right" for n in left) or any(n.hand == "left" for n in right):
+        return float("inf")
+    cost = 0.0
+    if middle is not None:
+        cost += HOME_COST * (
+            sum(max(0.0, n.pitch - middle) for n in left) + sum(max(0.0, middle - n.pitch) for n in right)
+        )
+    for part, hand in ((left, "left"), (right, "right")):
+        if part and not reaches([n.pitch for n in part], hand, spec):
+            cost += FORBIDDEN
+    return cost
+
+
+def _travel(before: float | None, after: float) -> float:
+    return 0.0 if before is None else TRAVEL_COST * ((after - before) / 12.0) ** 2
+
+
+def _step(state: _State, chord: list[Note], k: int, spec: HandSpec) -> tuple[float, tuple]:
+    """The cost of playing ``chord`` split at ``k`` after ``state``, and the new (left, right,
+    held left, held right, played) of the state it leads to."""
+    onset = chord[0].onset
+    left, right = chord[:k], chord[k:]
+    held_l = tuple(n for n in state.held_left if n.offset > onset + LEGATO_OVERLAP)
+    held_r = tuple(n for n in state.held_right if n.offset > onset + LEGATO_OVERLAP)
+    cost = 0.0
+    pos_l, pos_r = state.left, state.right
+    if left:
+        new = (left[0].pitch + left[-1].pitch) / 2
+        cost += _travel(pos_l, new) + (SWITCH_COST if state.played == (False, True) else 0.0)
+        pos_l = new
+    if right:
+        new = (right[0].pitch + right[-1].pitch) / 2
+        cost += _travel(pos_r, new) + (SWITCH_COST if state.played == (True, False) else 0.0)
+        pos_r = new
+    # the resting hand is pushed aside where the other passes it
+    if left and not right and pos_r is not None and pos_r <= left[-1].pitch:
+        cost += _travel(pos_r, left[-1].pitch + 1)
+        pos_r = left[-1].pitch + 1
+    if right and not left and pos_l is not None and pos_l >= right[0].pitch:
+        cost += _travel(pos_l, right[0].pitch - 1)
+        pos_l = right[0].pitch - 1
+    # notes struck across the other hand's held notes
+    if left and held_r:
+        cost += CROSS_COST * sum(1 for n in left if n.pitch >= min(h.pitch for h in held_r))
+    if right and held_l:
+        cost += CROSS_COST * sum(1 for n in right if n.pitch <= max(h.pitch for h in held_l))
+    # held notes of the same hand: fingers to spare and within reach
+    for held, part, hand in ((held_l, left, "left"), (held_r, right, "right")):
+        if held and part and not reaches([n.pitch for n in (*held, *part)], hand, spec):
+            cost += HELD_COST * len(held)
+    return cost, (pos_l, pos_r, held_l + tuple(left), held_r + tuple(right), (bool(left), bool(right)))
+
+
+def assign_hands(piece: Piece, spec: HandSpec = HandSpec()) -> HandAssignment:
+    """Every note of ``piece`` given to a hand by the dynamic programme in the module's notes;
+    notes that have a hand keep it. ``spec`` is each hand's fingers (the left hand mirrors the right)."""
+    notes = piece.notes
+    groups = group_chords(piece)
+    centre = middle(piece, groups)
+    layers: list[list[_State | None]] = []
+    previous = [_State(0.0, -1, None, None, (), (), (False, False))]
+    for group in groups:
+        chord = [notes[i] for i in group]
+        layer: list[_State | None] = []
+        for k in range(len(chord) + 1):
+            local = _local_cost(chord, k, spec, centre)
+            best = None
+            if local != float("inf"):
+                for b, state in enumerate(previous):
+                    if state is None:
+                        continue
+                    step, new = _step(state, chord, k, spec)
+                    total = state.cost + local + step
+                    if best is None or total < best.cost:
+                        best = _State(total, b, *new)
+            layer.append(best)
+        if all(s is None for s in layer):  # notes fixed to hands that cross inside one chord
+            raise ValueError(f"the notes at {chord[0].onset:.3f} s have hands that cross")
+        layers.append(layer)
+        previous = layer
+    if not layers:
+        return HandAssignment(piece, 0.0, 0)
+    k = min((s.cost, k) for k, s in enumerate(layers[-1]) if s is not None)[1]
+    hands: list[str | None] = [None] * len(notes)
+    unplayable = 0
+    for group, layer in zip(reversed(groups), reversed(layers)):
+        state = layer[k]
+        chord = [notes[i] for i in group]
+        unplayable += _local_cost(chord, k, spec, None) >= FORBIDDEN
+        for j, i in enumerate(group):
+            hands[i] = "left" if j < k else "right"
+        k = state.back
+    return HandAssignment(piece.with_hands(hands), min(s.cost for s in layers[-1] if s is not None), unplayable)
+
+
+def thin_for_hands(piece: Piece, spec: HandSpec = HandSpec()) -> tuple[Piece, int]:
+    """Chords of more notes than two hands have fingers keep their lowest and highest notes (the
+    bass and the melody), as many as each hand has fingers; returns the piece and how many were dropped."""
+    fingers = len(spec.fingers)
+    drop: set[int] = set()
+    for group in group_chords(piece):
+        if len(group) > 2 * fingers:
+            drop.update(group[fingers:-fingers])
+    if not drop:
+        return piece, 0
+    return Piece(tuple(n for i, n in enumerate(piece.notes) if i not in drop), bpm=piece.bpm), len(drop)
+
+
+def load_two_hands(path: str | Path, options: LoadOptions = LoadOptions(), spec: HandSpec = HandSpec()) -> Piece:
+    """A two-hand piece with every note's hand: :func:`~pianobot.music.load.load_hands` (hands
+    from track names, bad input refused in one line), chords of more notes than both hands' fingers
+    thinned (one warning), and the notes without a hand given one by :func:`assign_hands`."""
+    piece, dropped = thin_for_hands(load_hands(path, options), spec)
+    if dropped:
+        warnings.warn(
+            PianobotWarning(
+                f"{Path(path).name} has chords of more than {2 * len(spec.fingers)} notes, more than two hands of "
+                f"{len(spec.fingers)} fingers hold: kept their lowest and highest {len(spec.fingers)}, "
+                f"dropped {dropped} inner note(s)"
+            )
+        )
+    if all(n.hand is not None for n in piece.notes):
+        return piece
+    return assign_hands(piece, spec).piece
+
+
+def keyboard_for(piece: Piece) -> KeyboardSpec:
+    """The keys ``piece`` needs, rounded out to whole octaves (C to B), at most 88 and within MIDI."""
+    low = min(n.pitch for n in piece.notes) // 12 * 12
+    high = min(127, max(n.pitch for n in piece.notes) // 12 * 12 + 11)
+    return KeyboardSpec(low, min(88, high - low + 1))
+
+
+@dataclass(frozen=True)
+class HandsFingering:
+    """Both hands' parts, reduced to what each hand can play and fingered, as one piece, and each hand's plan."""
+
+    piece: Piece
+    plans: dict[str, FingeringPlan | None]
+
+
+def finger_hands(piece: Piece, spec: HandSpec = HandSpec(), refinger: bool = False) -> HandsFingering:
+    """Each hand's part of ``piece`` (every note has a hand) thinned and reduced to what the hand
+    can play (:func:`~pianobot.music.load.thin_hand`, :func:`~pianobot.pianist.reduce.reduce_part`,
+    one warning per kind of change and hand) and fingered by the planner. The left hand's part is
+    planned as its mirror image, a right hand's part, and mirrored back."""
+    if any(n.hand is None for n in piece.notes):
+        raise ValueError("finger_hands needs every note's hand: call assign_hands first")
+    notes: list[Note] = []
+    plans: dict[str, FingeringPlan | None] = {}
+    for hand in piece.hands:
+        part = piece.part(hand)
+        part = part.mirror() if hand == "left" else part  # now a right hand's part
+        thinned = thin_hand(part, hand, spec, "lowest" if hand == "left" else "highest")
+        keyboard = keyboard_for(thinned)
+        reduced = reduce_part(thinned.with_hands(None), keyboard, spec, f"the {hand} hand's part").piece
+        fingered, plan = ensure_fingering(reduced, keyboard, spec, refinger=refinger)
+        fingered = fingered.with_hands("right")
+        notes.extend((fingered.mirror() if hand == "left" else fingered).notes)
+        plans[hand] = plan
+    return HandsFingering(Piece(tuple(notes), bpm=piece.bpm), plans)

@@ -1,0 +1,92 @@
+"""Hand assignment by planning (pianobot.pianist.hands): small pieces with known answers."""
+
+import warnings
+
+import pytest
+
+from pianobot.errors import PianobotWarning
+from pianobot.music.instrument import HandSpec
+from pianobot.music.piece import Note, Piece, parse_pitch
+from pianobot.pianist.hands import assign_hands, finger_hands, reaches, thin_for_hands
+
+
+def notes(*items, hand=None):
+    """Notes from (pitch name, onset, offset) triples."""
+    return [Note(on, parse_pitch(name), off, hand=hand) for name, on, off in items]
+
+
+def hands_of(piece):
+    return {(n.name, n.onset): n.hand for n in piece}
+
+
+def test_reach_comes_from_the_planner_and_the_left_hand_is_its_mirror():
+    # the default three-finger hand spans up to a major seventh, not an octave; the thumb adds the octave
+    assert reaches([60, 71], "right") and not reaches([60, 72], "right")
+    assert reaches([60, 72], "right", HandSpec((1, 2, 3, 4)))
+    assert not reaches([60, 62, 64, 65], "right")  # four notes, three fingers
+    assert reaches([36, 47], "left") and not reaches([36, 48], "left")
+
+
+def test_a_bass_line_under_a_melody():
+    # bass on the beats, the melody between them: neither hand can take both lines
+    bass = [(name, float(i), i + 0.5) for i, name in enumerate(["C3", "G2", "A2", "F2", "C3", "G2"])]
+    melody = [(name, i + 0.5, i + 1.0) for i, name in enumerate(["E5", "D5", "C5", "A4", "G4", "B4"])]
+    piece = Piece.of(notes(*bass, *melody))
+    assigned = assign_hands(piece).piece
+    assert all(hands_of(assigned)[(n, on)] == "left" for n, on, _ in bass)
+    assert all(hands_of(assigned)[(n, on)] == "right" for n, on, _ in melody)
+
+
+def test_a_chord_too_wide_for_one_hand_is_split_between_them():
+    piece = Piece.of(notes(("C3", 0, 1), ("G3", 0, 1), ("E4", 0, 1), ("G4", 0, 1), ("C5", 0, 1)))
+    result = assign_hands(piece)
+    assert [n.hand for n in result.piece] == ["left", "left", "right", "right", "right"]
+    assert result.unplayable == 0
+
+
+def test_a_melody_that_moves_into_the_other_hands_region_passes_to_it():
+    chords = [((m, i, i + 1), (b, i, i + 1)) for i, (m, b) in enumerate([("E5", "C3"), ("D5", "G2"), ("C5", "C3")])]
+    scale = ["C5", "B4", "A4", "G4", "F4", "E4", "D4", "C4", "B3", "A3", "G3", "F3", "E3", "D3", "C3"]
+    run = [(name, 3 + i * 0.25, 3.25 + i * 0.25) for i, name in enumerate(scale)]
+    end = 3 + len(scale) * 0.25
+    tail = [("E5", end, end + 1), ("C3", end, end + 1)]
+    piece = Piece.of(notes(*[n for pair in chords for n in pair], *run, *tail))
+    assigned = hands_of(assign_hands(piece).piece)
+    run_hands = [assigned[(name, on)] for name, on, _ in run]
+    switch = run_hands.index("left")
+    assert run_hands == ["right"] * switch + ["left"] * (len(scale) - switch)  # one hand-over, downwards
+    assert 3 <= switch <= len(scale) - 4  # the run is shared, not played by one hand
+    assert assigned[("E5", end)] == "right" and assigned[("C3", end)] == "left"
+
+
+def test_crossing_the_other_hands_held_notes_is_refused_and_given_hands_are_kept():
+    held = notes(("E4", 0, 4), ("F4", 0, 4), ("G4", 0, 4), hand="right")  # every right-hand finger busy
+    above = Piece.of([*held, *notes(("B4", 1, 2))])
+    below = Piece.of([*held, *notes(("C4", 1, 2))])
+    # B4 goes to the right hand (a held note will end early) rather than the left hand crossing over
+    assert hands_of(assign_hands(above).piece)[("B4", 1)] == "right"
+    assert hands_of(assign_hands(below).piece)[("C4", 1)] == "left"
+    assert all(n.hand == "right" for n in assign_hands(below).piece if n.name in {"E4", "F4", "G4"})
+
+
+def test_chords_beyond_two_hands_keep_the_bass_and_the_melody():
+    piece = Piece.of(notes(*[(name, 0, 1) for name in ["C2", "G2", "C3", "E3", "G3", "C4", "E4", "G4"]]))
+    thinned, dropped = thin_for_hands(piece)
+    assert dropped == 2 and [n.name for n in thinned] == ["C2", "G2", "C3", "C4", "E4", "G4"]
+
+
+def test_each_hand_is_fingered_by_the_planner_the_left_through_the_mirror():
+    left = notes(("C3", 0, 0.5), ("D3", 0.5, 1), ("E3", 1, 1.5), hand="left")
+    right = notes(("C5", 0, 0.5), ("D5", 0.5, 1), ("E5", 1, 1.5), hand="right")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", PianobotWarning)  # a playable piece is not reduced
+        result = finger_hands(Piece.of([*left, *right]))
+    fingers = {n.hand: [m.finger for m in result.piece.part(n.hand)] for n in result.piece}
+    # a rising line: the right hand from its index finger up, the left hand from its ring finger down
+    assert fingers["right"] == [2, 3, 4] and fingers["left"] == [4, 3, 2]
+    assert result.piece.with_fingers([None] * 6) == Piece.of([*left, *right])
+
+
+def test_finger_hands_needs_every_notes_hand():
+    with pytest.raises(ValueError, match="assign_hands"):
+        finger_hands(Piece.of(notes(("C4", 0, 1))))
