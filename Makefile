@@ -3,7 +3,7 @@ PYTHON ?= python3
 VENV := .venv
 BIN := $(VENV)/bin
 
-.PHONY: demo test install examples clean sound
+.PHONY: demo test install examples clean sound browser
 
 $(BIN)/pianobot: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -16,8 +16,8 @@ install: $(BIN)/pianobot
 
 demo: install
 	mkdir -p out
-	$(BIN)/pianobot play examples/midi/twinkle.mid -o out/twinkle.mid --video out/twinkle.mp4  # the policies in models/
-	$(BIN)/pianobot score out/twinkle.mid examples/midi/twinkle.mid --no-notes --plot out/twinkle.png
+	$(BIN)/pianobot play examples/midi/twinkle.mid -o out/twinkle.mid --video out/twinkle.mp4 --html out/twinkle.html  # the policies in models/
+	@echo "open out/twinkle.html in a browser (it works offline): the video with its sound, the piano roll, every note"
 
 test: install
 	$(BIN)/ruff check .
@@ -40,3 +40,13 @@ sound:
 		(timeout 300 apt-get update -q >/dev/null 2>&1 && timeout 300 apt-get install -y -q $(SOUND_PACKAGES) >/dev/null 2>&1) || \
 		echo "could not install FluidSynth: --wav and --video use sine waves"; \
 	else echo "install $(SOUND_PACKAGES) (Debian packages) for a piano sound"; fi
+
+# A headless browser for the HTML report's test (tests/test_report.py): Debian's chromium (needs
+# root). Without it, that test is skipped and says so.
+browser:
+	@if command -v chromium >/dev/null 2>&1; then :; \
+	elif command -v apt-get >/dev/null 2>&1 && [ "$$(id -u)" = 0 ]; then \
+		timeout 600 apt-get install -y -q chromium >/dev/null 2>&1 || \
+		(timeout 300 apt-get update -q >/dev/null 2>&1 && timeout 600 apt-get install -y -q chromium >/dev/null 2>&1) || \
+		echo "could not install chromium: the HTML report's browser test is skipped"; \
+	else echo "install chromium (Debian package) for the HTML report's browser test"; fi

@@ -95,7 +95,7 @@ def phrases_table(phrases: list[Phrase], trained: set[int] | None = None, rows: 
 def report_tables(report: Report, every: bool = False, notes: int | None = None) -> list[Table]:
     """The figures, each with what it means: the first few (``every``: all of them); then the
     per-note table, its first ``notes`` rows (None: every row; 0: no table)."""
-    from pianobot.perform.report import FIGURES
+    from pianobot.perform.report import FIGURES, NOTE_COLUMNS, note_cells
 
     summary = Table(title="performance against reference")
     for column in ("figure", "value", "what it means"):
@@ -108,35 +108,12 @@ def report_tables(report: Report, every: bool = False, notes: int | None = None)
     if notes == 0:
         return [summary]
     table = Table(title="per note")
-    for column in (
-        "pitch",
-        "target onset",
-        "played onset",
-        "onset error ms",
-        "target vel",
-        "played vel",
-        "vel error",
-        "finger",
-        "status",
-    ):
+    for column in NOTE_COLUMNS:
         table.add_column(column)
     shown = _shown(table, len(report.rows), notes, "notes", "--notes N shows N")
     for row in report.rows[:shown]:
-        ref, out = row.reference, row.played
-        status = "missed" if out is None else "extra" if ref is None else "ok"
-        style = "red" if status != "ok" else None
-        table.add_row(
-            (ref or out).name,
-            _opt(ref and ref.onset, ".3f"),
-            _opt(out and out.onset, ".3f"),
-            _opt(None if row.onset_error is None else row.onset_error * 1000, "+.0f"),
-            _opt(ref and ref.velocity, "d"),
-            _opt(out and out.velocity, "d"),
-            _opt(row.velocity_error, "+d"),
-            f"{_opt(ref and ref.finger, 'd')} / {_opt(out and out.finger, 'd')}".replace("n/a", "-"),
-            status,
-            style=style,
-        )
+        cells = note_cells(row)
+        table.add_row(*cells, style="red" if cells[-1] != "matched" else None)
     return [summary, table]
 
 

@@ -77,6 +77,13 @@ PlayPhraseNotes = typer.Option(
     "--phrase-notes",
     help=f"Most notes in one phrase (default: the longest phrases, up to {DEFAULT_MAX_NOTES} notes, whose policies are all trained).",
 )
+HtmlReport = typer.Option(
+    None,
+    "--html",
+    help="Also write a report to open in a browser, offline: every figure with what it means, the piano roll of "
+    "score against performance (fingers coloured), each note's errors; from play, also who played each phrase, "
+    "and the video and sound made with --video, --wav.",
+)
 AllFigures = typer.Option(
     False, "--all", help="Print every figure, each with what it means (by default the few to read first)."
 )
@@ -171,6 +178,12 @@ def check_midi_output(output: Path, song: Path, what: str) -> None:
         raise PianobotError(f"-o {output}: {what} is a MIDI file, name it *.mid")
     if os.path.realpath(output) == os.path.realpath(song):  # (realpath: a symbolic-link loop is no crash)
         raise PianobotError(f"-o {output} would overwrite the input {song.name}: choose another file name")
+
+
+def check_html(path: Path | None) -> None:
+    """--html must name an .html file."""
+    if path is not None and path.suffix.lower() not in (".html", ".htm"):
+        raise PianobotError(f"--html {path}: the report is a web page, name it *.html")
 
 
 def read_song(song: Path, options: LoadOptions, keyboard: KeyboardSpec, hand: HandSpec) -> Piece:

@@ -14,8 +14,10 @@ from pianobot.cli.options import (
     Controller,
     Fallback,
     GeneralPolicy,
+    HtmlReport,
     PlayPhraseNotes,
     Reading,
+    check_html,
     check_midi_output,
     read_song,
     reads,
@@ -72,6 +74,7 @@ def play(
         "else sine waves).",
     ),
     gui: bool = typer.Option(False, "--gui", help="Show the simulation in a PyBullet window (needs a display)."),
+    html: Optional[Path] = HtmlReport,
     json_path: Optional[Path] = typer.Option(
         None,
         "--json",
@@ -100,9 +103,10 @@ def play(
     report_path = output.with_suffix(".report.json")
     to_stdout = json_path is not None and str(json_path) == "-"
     console = err if to_stdout else out  # standard output carries the JSON
-    for target in (output, report_path, video, wav, None if to_stdout else json_path):
+    for target in (output, report_path, video, wav, html, None if to_stdout else json_path):
         if target is not None:
             check_writable(target)
+    check_html(html)
     if video is not None and video.suffix.lower() != ".mp4":
         raise PianobotError(f"--video {video}: the video is an MP4 file, name it *.mp4")
     if wav is not None and wav.suffix.lower() != ".wav":
@@ -181,3 +185,9 @@ def play(
     if wav is not None:
         method = write_wav(performance.played, wav, font=soundfont)
         console.print(f"audio written to {said(wav)} ({method})")
+    if html is not None:
+        from pianobot.perform.report import write_html
+
+        title = f"{song.name}: {plan.performer}"
+        write_html(html, report, title, plan=plan, seed=seed, video=video, audio=wav)
+        console.print(f"report to open in a browser written to {said(html)}")

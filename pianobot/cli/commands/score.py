@@ -9,7 +9,9 @@ import typer
 
 from pianobot.cli.options import (
     AllFigures,
+    HtmlReport,
     Reading,
+    check_html,
     reads,
 )
 from pianobot.cli.terminal import err, out, said, write_json
@@ -31,6 +33,7 @@ def score(
     plot: Optional[Path] = typer.Option(
         None, "--plot", help="Draw both piano rolls with the errors marked to this PNG file."
     ),
+    html: Optional[Path] = HtmlReport,
     notes: bool = typer.Option(True, "--notes/--no-notes", help="Print the per-note table."),
     every: bool = AllFigures,
     reading: Reading = None,
@@ -49,7 +52,8 @@ def score(
     if plot is not None and plot.suffix.lower() != ".png":
         raise PianobotError(f"--plot {plot}: the plot is a PNG image, name the file *.png")
     to_stdout = json_path is not None and str(json_path) == "-"
-    for target in (None if to_stdout else json_path, plot):
+    check_html(html)
+    for target in (None if to_stdout else json_path, plot, html):
         if target is not None:
             check_writable(target)
     console = err if to_stdout else out  # standard output carries the JSON
@@ -66,3 +70,8 @@ def score(
     if plot is not None:
         plot_report(reference_piece, played_piece, report, plot)
         console.print(f"piano rolls drawn to {said(plot)}")
+    if html is not None:
+        from pianobot.perform.report import write_html
+
+        write_html(html, report, f"{played.name} against {reference.name}")
+        console.print(f"report to open in a browser written to {said(html)}")
