@@ -1,0 +1,83 @@
+"""Both hands of a piece played hand by hand (pianobot/perform/hands.py), and the random two-hand
+pieces they are measured on (pianobot/music/duets.py)."""
+
+import warnings
+
+import numpy as np
+import pytest
+
+from pianobot.errors import PianobotError, PianobotWarning
+from pianobot.music.duets import TEXTURES, duet_set, random_duet
+from pianobot.music.instrument import KeyboardSpec
+from pianobot.music.piece import Note, Piece
+from pianobot.perform.hands import Window, play_hands, window_for
+
+BLACK = {1, 3, 6, 8, 10}
+
+
+@pytest.mark.parametrize("hand", ["right", "left"])
+def test_a_window_maps_written_keys_onto_the_simulated_hand_and_back_keeping_their_colour(hand):
+    window = Window(hand, KeyboardSpec(), -2)
+    for pitch in range(21, 104):
+        inside = window.inward(pitch)
+        assert window.outward(inside) == pitch
+        assert (inside % 12 in BLACK) == (pitch % 12 in BLACK)
+    # the left hand's lowest note is the simulated right hand's highest: the mirror, not a shift
+    assert Window("left", KeyboardSpec(), 0).inward(36) > Window("left", KeyboardSpec(), 0).inward(48)
+
+
+def test_the_window_keeps_the_most_notes_on_the_keyboard_the_player_knows():
+    bass = Piece(tuple(Note(i, p, i + 0.9, hand="left") for i, p in enumerate([36, 40, 43, 48, 55])))
+    window = window_for(bass, "left", KeyboardSpec())  # mirrored: E6 C6 A5 E5 A4; C4-B5 is known
+
+    def kept(octaves: int) -> int:
+        return sum(Window("left", KeyboardSpec(), octaves).inward(n.pitch) in KeyboardSpec() for n in bass.notes)
+
+    assert kept(window.octaves) == 4 and all(kept(k) < 4 for k in range(-5, 6) if k != window.octaves)
+    wide = Piece(tuple(Note(i, p, i + 0.9, hand="right") for i, p in enumerate([48, 60, 72, 84])))
+    window = window_for(wide, "right", KeyboardSpec())
+    assert sum(window.inward(n.pitch) in KeyboardSpec() for n in wide.notes) == 2  # 36 keys span, 24 known
+    # the scripted pianist's window is the part's own range, rounded out to octaves
+    own = window_for(wide, "right", None)
+    assert (own.keyboard.lowest, own.keyboard.highest, own.octaves) == (48, 95, 0)
+
+
+def test_the_scripted_pianist_plays_both_hands_of_a_duet_at_the_written_pitches():
+    (name, piece), *_ = [d for d in duet_set(0, 8) if "broken" in d[0]]
+    performance = play_hands(piece, "scripted")
+    assert [h.hand for h in performance.hands] == ["right", "left"]
+    played = performance.played
+    assert {n.hand for n in played.notes} == {"right", "left"}
+    assert max(n.pitch for n in played.part("left").notes) < 60 <= min(n.pitch for n in played.part("right").notes)
+    assert performance.report("left").f1 == 1.0 and performance.report("right").f1 == 1.0, name
+    assert performance.report().reference_notes == len(piece)
+
+
+def test_notes_outside_the_window_are_said_and_count_as_missed():
+    notes = [Note(0.5 * i, p, 0.5 * i + 0.4, hand="right") for i, p in enumerate([36, 62, 64, 65, 67, 96])]
+    piece = Piece(tuple(notes))
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        performance = play_hands(piece, "sac")
+    said = [str(w.message) for w in caught if issubclass(w.category, PianobotWarning)]
+    assert any("left out 2 note(s)" in line for line in said), said
+    (right,) = performance.hands
+    assert right.left_out == 2 and len(right.part) == 4
+    report = performance.report()
+    assert report.reference_notes == 6 and report.recall <= 4 / 6
+
+
+def test_a_note_without_a_hand_is_refused():
+    with pytest.raises(PianobotError, match="every note needs a hand"):
+        play_hands(Piece((Note(0.0, 60, 1.0, hand="right"), Note(0.0, 48, 1.0))), "scripted")
+
+
+def test_random_duets_are_seeded_and_keep_the_hands_apart():
+    assert duet_set(3, 4) == duet_set(3, 4) and duet_set(3, 4) != duet_set(4, 4)
+    for texture in TEXTURES:
+        piece = random_duet(np.random.default_rng(1), texture)
+        left, right = piece.part("left"), piece.part("right")
+        assert len(left) + len(right) == len(piece) and left.notes and right.notes
+        assert max(n.pitch for n in left.notes) < min(n.pitch for n in right.notes)
+        chords = max(len(c) for c in left.chords())
+        assert chords == {"block": 3, "voices": 2}.get(texture, 1), texture
