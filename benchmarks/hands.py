@@ -1,0 +1,122 @@
+"""Two-hand pieces played hand by hand (pianobot/perform/hands.py): the general policy zero-shot,
+beside the scripted pianist, against the pieces as written.
+
+    python -m benchmarks.hands [--duets 50] [--seed 35] [--polyphonic 20] [--json out.json]
+
+Sets:
+
+- ``duets``: ``--duets`` random two-hand pieces (:func:`pianobot.music.duets.duet_set`, seed
+  ``--seed``: a melody over a bass line, broken chords, block chords or two voices, 60-120 bpm,
+  every key); no training run draws from them;
+- ``polyphonic``: the left hand's part alone of ``--polyphonic`` further duets with block chords
+  or two voices (seed ``--seed`` + 1): one hand's polyphonic part, chords and a held note under a
+  moving voice.
+
+Each piece is played once from hand start 0, each hand in a simulation of its own, by the general
+policy (the packaged one: the model store is an empty folder) and by the scripted pianist. Prints a
+Markdown table per set: note F1 (whole piece, right hand, left hand), per-step key-press F1, note
+F1 with offsets, notes left outside the general policy's 24 keys, and the general policy's share
+of the scripted pianist's note F1.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import tempfile
+import time
+import warnings
+
+import numpy as np
+import torch
+
+from pianobot.errors import PianobotWarning
+from pianobot.music.duets import duet_set, random_duet
+from pianobot.perform.hands import play_hands
+
+PLAYERS = ("sac", "scripted")
+NAMES = {"sac": "general", "scripted": "scripted"}
+
+
+def figures(piece, controller: str, models) -> dict:
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", PianobotWarning)  # the left-out counts are in the figures
+        performance = play_hands(piece, controller, models)
+    whole = performance.report()
+    out = {
+        "f1": whole.f1,
+        "step_f1": whole.step_f1,
+        "f1_offsets": whole.f1_with_offsets,
+        "left_out": sum(h.left_out for h in performance.hands),
+    }
+    for hand in piece.hands:
+        out[f"f1_{hand}"] = performance.report(hand).f1
+    return out
+
+
+def polyphonic_set(seed: int, count: int) -> list[tuple[str, object]]:
+    rng = np.random.default_rng(seed)
+    out = []
+    for i in range(count):
+        texture = ("block", "voices")[i % 2]
+        out.append((f"left hand {seed}-{i} ({texture})", random_duet(rng, texture).part("left")))
+    return out
+
+
+def table(name: str, rows: list[dict]) -> str:
+    def mean(player: str, key: str) -> str:
+        values = [r[player][key] for r in rows if key in r[player]]
+        return f"{np.mean(values):.3f}" if values else "–"
+
+    general = np.mean([r["sac"]["f1"] for r in rows])
+    scripted = np.mean([r["scripted"]["f1"] for r in rows])
+    lines = [
+        f"**{name}** ({len(rows)} pieces, {sum(r['notes'] for r in rows)} notes)",
+        "",
+        "| player | note F1 | right hand | left hand | per-step F1 | note F1 with offsets | notes left out | pieces at F1 ≥ 0.9 |",
+        "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |",
+    ]
+    for player in PLAYERS:
+        at = sum(r[player]["f1"] >= 0.9 for r in rows)
+        lines.append(
+            f"| {NAMES[player]} | {mean(player, 'f1')} | {mean(player, 'f1_right')} | {mean(player, 'f1_left')} | "
+            f"{mean(player, 'step_f1')} | {mean(player, 'f1_offsets')} | "
+            f"{sum(r[player]['left_out'] for r in rows)} | {at}/{len(rows)} |"
+        )
+    lines += ["", f"general / scripted: {general / scripted:.1%}", ""]
+    return "\n".join(lines)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--duets", type=int, default=50)
+    parser.add_argument("--polyphonic", type=int, default=20)
+    parser.add_argument("--seed", type=int, default=35)
+    parser.add_argument("--json", help="write every piece's figures here")
+    args = parser.parse_args()
+    torch.set_num_threads(1)
+    sets = {
+        "duets": duet_set(args.seed, args.duets),
+        "polyphonic": polyphonic_set(args.seed + 1, args.polyphonic),
+    }
+    results = {}
+    started = time.perf_counter()
+    with tempfile.TemporaryDirectory() as models:
+        for name, pieces in sets.items():
+            rows = []
+            for label, piece in pieces:
+                piece = piece if piece.hands else piece.with_hands("left")
+                row = {"piece": label, "notes": len(piece)}
+                row.update({player: figures(piece, player, models) for player in PLAYERS})
+                rows.append(row)
+                print(f"{label}: general {row['sac']['f1']:.3f}, scripted {row['scripted']['f1']:.3f}", flush=True)
+            results[name] = rows
+            print(table(name, rows), flush=True)
+    print(f"{time.perf_counter() - started:.0f} s")
+    if args.json:
+        with open(args.json, "w") as f:
+            json.dump(results, f, indent=1)
+
+
+if __name__ == "__main__":
+    main()
