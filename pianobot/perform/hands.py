@@ -23,7 +23,7 @@ figures are always against the piece as written, so what was left out counts as 
 from __future__ import annotations
 
 import warnings
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from pianobot.errors import PianobotError, PianobotWarning
@@ -104,10 +104,12 @@ class HandsPerformance:
     piece: Piece
     """The piece as written, every note with its hand: what the figures are against."""
     hands: tuple[HandPerformance, ...]
+    """Right hand first."""
+    played: Piece = field(init=False)
+    """What both keyboards sounded, as one piece at the written pitches, each note with its hand."""
 
-    @property
-    def played(self) -> Piece:
-        return Piece(tuple(n for h in self.hands for n in h.played.notes), bpm=self.piece.bpm)
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "played", Piece(tuple(n for h in self.hands for n in h.played.notes), self.piece.bpm))
 
     def report(self, hand: str | None = None) -> Report:
         """The figures for the whole piece, or for ``hand``'s part (against its written notes)."""
