@@ -162,10 +162,13 @@ class Experiment:
     number: int
     """The paper's numbering (docs/paper/N-name.json keeps its records)."""
     name: str
+    """What ``python -m benchmarks.paper`` calls it (``tasks``, ``rewards``, ...)."""
     title: str
+    """The section's title in docs/paper.md."""
     tasks: tuple[str, ...]
     """Task families (or ``compose``'s piece) each arm trains on."""
     variants: tuple[Variant, ...]
+    """The arms, each a change to a setting's configuration."""
     steps: int
     """Environment steps per run."""
     steps_source: str
