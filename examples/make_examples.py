@@ -221,6 +221,116 @@ NOCTURNE_LEFT = [
 ]
 
 
+# -- two-hand pieces with tracks named for the hands (issue 35) ---------------------------------
+# Old Hundredth (Louis Bourgeois, Genevan Psalter, 1551), harmonised here in four voices in G
+# major, one chord per melody note, as a church pianist plays it from a hymn book: soprano and
+# alto in the right hand, tenor and bass in the left, each hand within the reach of its fingers.
+# Rows are (beats, soprano, alto, tenor, bass); each line of the hymn opens with a half note and
+# closes on a held chord.
+CHORALE = [
+    *[
+        (2, "G4", "D4", "B3", "G3"),
+        (1, "G4", "E4", "B3", "E3"),
+        (1, "F#4", "D4", "A3", "D3"),
+        (1, "E4", "C4", "G3", "C3"),
+    ],
+    *[
+        (1, "D4", "C4", "A3", "D3"),
+        (1, "G4", "D4", "B3", "G3"),
+        (1, "A4", "E4", "A3", "C3"),
+        (4, "B4", "D4", "B3", "G3"),
+    ],
+    *[
+        (2, "B4", "D4", "B3", "G3"),
+        (1, "B4", "F#4", "B3", "D3"),
+        (1, "B4", "E4", "G3", "E3"),
+        (1, "A4", "D4", "F#3", "D3"),
+    ],
+    *[
+        (1, "G4", "D4", "B3", "G3"),
+        (1, "C5", "E4", "G3", "C3"),
+        (1, "B4", "D4", "G3", "D3"),
+        (4, "A4", "C4", "F#3", "D3"),
+    ],
+    *[
+        (2, "G4", "D4", "B3", "G3"),
+        (1, "A4", "D4", "F#3", "D3"),
+        (1, "B4", "D4", "G3", "B2"),
+        (1, "A4", "E4", "A3", "C3"),
+    ],
+    *[
+        (1, "G4", "D4", "B3", "D3"),
+        (1, "E4", "C4", "G3", "C3"),
+        (1, "F#4", "C4", "A3", "D3"),
+        (4, "G4", "D4", "B3", "G3"),
+    ],
+    *[
+        (2, "D5", "G4", "B3", "G3"),
+        (1, "B4", "E4", "G3", "E3"),
+        (1, "G4", "E4", "G3", "C3"),
+        (1, "A4", "F#4", "A3", "D3"),
+    ],
+    *[
+        (1, "C5", "E4", "A3", "C3"),
+        (1, "B4", "D4", "G3", "D3"),
+        (1, "A4", "C4", "F#3", "D3"),
+        (4, "G4", "D4", "B3", "G3"),
+    ],
+]
+CHORALE_RIGHT = [(" ".join(f"{alto}+{soprano}:{beats}" for beats, soprano, alto, _, _ in CHORALE), 68, 0.02)]
+CHORALE_LEFT = [(" ".join(f"{bass}+{tenor}:{beats}" for beats, _, _, tenor, bass in CHORALE), 56, 0.02)]
+
+# Ode to Joy (Beethoven, Symphony No. 9, 1824) as a first piano piece: the tune in the right
+# hand, a bass line of broken chords in quarter notes in the left.
+_ODE_A = "E5:1 E5:1 F5:1 G5:1 G5:1 F5:1 E5:1 D5:1 C5:1 C5:1 D5:1 E5:1 "
+ODE_RIGHT = [
+    (
+        _ODE_A
+        + "E5:3/2 D5:1/2 D5:2 "
+        + _ODE_A
+        + "D5:3/2 C5:1/2 C5:2 "
+        + "D5:1 D5:1 E5:1 C5:1 D5:1 E5:1/2 F5:1/2 E5:1 C5:1 D5:1 E5:1/2 F5:1/2 E5:1 D5:1 C5:1 D5:1 G4:2 "
+        + _ODE_A
+        + "D5:3/2 C5:1/2 C5:2",
+        70,
+        0.02,
+    )
+]
+_ODE_BASS = {"C": "C3:1 G3:1 E3:1 G3:1", "G": "B2:1 G3:1 D3:1 G3:1", "GC": "G2:2 C3:2", "CG": "C3:2 G2:2"}
+ODE_LEFT = [(" ".join(_ODE_BASS[h] for h in "C G C G C G C GC G C G CG C G C GC".split()), 52, -0.05)]
+
+# The opening of the Prelude in C (J. S. Bach, BWV 846, 1722), as it is often played: each bar's
+# chord broken into sixteenths, its two lowest notes held in the left hand, the figure above in
+# the right, the pedal changed with each bar, and a player's rubato.
+_PRELUDE_BARS = [
+    ("C4", "E4", "G4", "C5", "E5"),
+    ("C4", "D4", "A4", "D5", "F5"),
+    ("B3", "D4", "G4", "D5", "F5"),
+    ("C4", "E4", "G4", "C5", "E5"),
+    ("C4", "E4", "A4", "E5", "A5"),
+    ("C4", "D4", "F#4", "A4", "D5"),
+    ("B3", "D4", "G4", "D5", "G5"),
+    ("B3", "C4", "E4", "G4", "C5"),
+    ("A3", "C4", "E4", "G4", "C5"),
+    ("D3", "A3", "D4", "F#4", "C5"),
+    ("G3", "B3", "D4", "G4", "B4"),
+]
+PRELUDE_RIGHT = [
+    (
+        " ".join(
+            f"r:1/2 {c}:1/4 {d}:1/4 {e}:1/4 {c}:1/4 {d}:1/4 {e}:1/4" for *_, c, d, e in _PRELUDE_BARS for _ in "12"
+        )
+        + " r:1/2 C4+E4+G4:7/2",
+        66,
+        0.03,
+    )
+]
+PRELUDE_LEFT = [
+    (" ".join(f"{a}:2" for a, *_ in _PRELUDE_BARS for _ in "12") + " C3:4", 50, 0.05),
+    (" ".join(f"r:1/4 {b}:7/4" for _, b, *_ in _PRELUDE_BARS for _ in "12") + " r:1/4 G3:15/4", 44, 0.05),
+]
+
+
 def _events(voices, at, rng, lead: float) -> list[tuple[float, float, int, int]]:
     """(onset s, offset s, pitch, velocity) of every note of one hand, played the way a person
     plays: onsets scattered around the beat, chords spread, the melody (first voice) a little
@@ -269,13 +379,22 @@ def _clock(bpm: float, beats: float, phrase: float):
 
 
 def recording(
-    right, left, bpm: float, beats_per_bar: int, phrase_bars: int, *, one_track: bool, seed: int = 0
+    right,
+    left,
+    bpm: float,
+    beats_per_bar: int,
+    phrase_bars: int,
+    *,
+    one_track: bool,
+    seed: int = 0,
+    names: tuple[str, str] | None = None,
 ) -> mido.MidiFile:
     """A two-hand performance the way a digital piano records it: no track names, no fingering,
     one tempo (120 bpm, the recorder's) with the music's own rubato in the note times, velocity
     from the touch, note-offs as note-ons of velocity 0, and the sustain pedal changed (up, then
     down again) just after every change of harmony. ``one_track`` writes both hands in one track
-    (type 0), as most recorders do; else one track per hand after a conductor track."""
+    (type 0), as most recorders do; else one track per hand after a conductor track, named
+    ``names`` where given (as a notation program exports a piano score: "Right Hand", "Left Hand")."""
     rng = np.random.default_rng(seed)
     beats = sum(float(Fraction(t.split(":")[1])) for t in right[0][0].split() if not t.startswith("~"))
     at = _clock(bpm, beats, beats_per_bar * phrase_bars)
@@ -304,8 +423,9 @@ def recording(
     if not one_track:
         midi.tracks.append(_track(meta))
         meta = []
-    for messages in tracks:
-        midi.tracks.append(_track(meta + [(0, -1, mido.Message("program_change", program=0))] + messages))
+    for number, messages in enumerate(tracks):
+        named = [(0, -2, mido.MetaMessage("track_name", name=names[number]))] if names else []
+        midi.tracks.append(_track(named + meta + [(0, -1, mido.Message("program_change", program=0))] + messages))
         meta = []
     return midi
 
@@ -331,7 +451,17 @@ def main() -> None:
     recording(NOCTURNE_RIGHT, NOCTURNE_LEFT, bpm=54, beats_per_bar=3, phrase_bars=4, one_track=False).save(
         OUT / "nocturne-performed.mid"
     )
-    print(f"wrote {len(TASKS) + len(MELODIES) + 4} pieces to {OUT}")
+    hands = ("Right Hand", "Left Hand")
+    recording(
+        CHORALE_RIGHT, CHORALE_LEFT, bpm=72, beats_per_bar=4, phrase_bars=3, one_track=False, seed=3, names=hands
+    ).save(OUT / "chorale-performed.mid")
+    recording(ODE_RIGHT, ODE_LEFT, bpm=100, beats_per_bar=4, phrase_bars=4, one_track=False, seed=4, names=hands).save(
+        OUT / "ode-to-joy-performed.mid"
+    )
+    recording(
+        PRELUDE_RIGHT, PRELUDE_LEFT, bpm=60, beats_per_bar=4, phrase_bars=2, one_track=False, seed=5, names=hands
+    ).save(OUT / "prelude-performed.mid")
+    print(f"wrote {len(TASKS) + len(MELODIES) + 7} pieces to {OUT}")
 
 
 if __name__ == "__main__":

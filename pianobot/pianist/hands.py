@@ -7,15 +7,18 @@ small dynamic programme over the piece's chords (notes started within
 notes, from the bottom, the left hand takes (the rest go to the right hand, so within a chord the
 hands never cross). The programme finds the states with the lowest total cost:
 
-- **travel**: each hand's position is the middle of the notes it plays (kept while it rests);
-  moving it costs the distance squared, in octaves, times :data:`TRAVEL_COST` (one long leap is
-  harder than several steps, so a leap is shared between the hands);
+- **travel**: each hand covers the notes it has played, as far as it reaches from one position
+  (:func:`span`, the widest interval the planner lets it hold); a note within that reach costs
+  no travel, one beyond it the distance beyond, squared in octaves, times :data:`TRAVEL_COST`
+  (one long leap is harder than several steps, so a leap is shared between the hands);
 - **switch**: :data:`SWITCH_COST` for a hand that plays a chord after the other played the one
-  before alone (a melody stays in one hand unless the other hand is much nearer);
+  before alone (a melody stays in one hand unless the other hand is much nearer), and
+  :data:`HOLD_COST` for each note a hand holds while it strikes another (a free hand takes a
+  moving voice more easily);
 - **register**: :data:`HOME_COST` per semitone a note lies on the other hand's side of the
-  piece's middle (halfway between the median lowest and the median highest note of its chords of
-  two or more notes; no such cost in a piece without them), which settles what travel leaves open
-  (a melody note just above the bass while the left hand is free goes to the right hand);
+  piece's middle (halfway between the median lowest and the median highest note of its chords
+  wider than one hand reaches; no such cost in a piece without them), which settles what travel
+  leaves open;
 - **crossing**: the left hand's position stays below the right hand's; where a hand's notes
   pass the resting hand, that hand is pushed aside and pays its travel; notes struck across the
   other hand's held notes cost :data:`CROSS_COST` (the held note must be let go);
@@ -53,8 +56,10 @@ from pianobot.sim.keyboard import KeyboardConfig
 
 TRAVEL_COST = 12.0
 """Cost of a hand moving one octave (squared for longer moves)."""
-SWITCH_COST = 3.0
+SWITCH_COST = 1.5
 """Cost of a hand starting to play after the other hand played the chord before alone."""
+HOLD_COST = 1.0
+"""Cost of each note a hand holds while it strikes another (a free hand takes a moving voice more easily)."""
 HOME_COST = 0.5
 """Cost of each semitone a note lies on the other hand's side of the piece's middle."""
 CROSS_COST = 100.0
@@ -123,23 +128,24 @@ def group_chords(piece: Piece, spread: float = CHORD_SPREAD) -> list[list[int]]:
 
 @dataclass(frozen=True)
 class _State:
-    """One way of playing up to a chord: its cost, the state before it, each hand's position
+    """One way of playing up to a chord: its cost, the state before it, what each hand covers
     (None before it has played) and the notes each hand still holds."""
 
     cost: float
     back: int
-    left: float | None
-    right: float | None
+    left: Window | None
+    right: Window | None
     held_left: tuple[Note, ...]
     held_right: tuple[Note, ...]
     played: tuple[bool, bool]
     """Whether the left and the right hand played this chord."""
 
 
-def middle(piece: Piece, groups: list[list[int]]) -> float | None:
-    """Halfway between the median lowest and the median highest note of the chords of two or more
-    notes (``groups`` as :func:`group_chords` gives them); None where there are none."""
-    wide = [g for g in groups if len(g) > 1]
+def middle(piece: Piece, groups: list[list[int]], spec: HandSpec = HandSpec()) -> float | None:
+    """Halfway between the median lowest and the median highest note of the chords wider than one
+    hand reaches (``groups`` as :func:`group_chords` gives them); None where there are none (a piece
+    one hand could hold chord by chord has no register for each hand)."""
+    wide = [g for g in groups if piece.notes[g[-1]].pitch - piece.notes[g[0]].pitch > span(spec)]
     if not wide:
         return None
     low = float(np.median([piece.notes[g[0]].pitch for g in wide]))
@@ -164,8 +170,24 @@ def _local_cost(chord: list[Note], k: int, spec: HandSpec, middle: float | None)
     return cost
 
 
-def _travel(before: float | None, after: float) -> float:
-    return 0.0 if before is None else TRAVEL_COST * ((after - before) / 12.0) ** 2
+def span(spec: HandSpec) -> int:
+    """The widest interval (semitones) the planner lets one hand position hold with ``spec``'s fingers."""
+    return max(d for d in range(1, 25) if _reaches((60, 60 + d), spec.fingers)) if len(spec.fingers) > 1 else 0
+
+
+Window = tuple[int, int]
+"""The lowest and highest note a hand covers from where it is (at most :func:`span` apart)."""
+
+
+def _move(window: Window | None, low: int, high: int, reach: int) -> tuple[float, Window]:
+    """What moving a hand that covers ``window`` to notes ``low``-``high`` costs, and the window after:
+    nothing while the notes lie within its reach, else the distance beyond, squared in octaves."""
+    if window is None:
+        return 0.0, (low, high)
+    lo, hi = window
+    shift = max(0, high - (lo + reach)) + max(0, (hi - reach) - low)
+    new_lo = min(low, max(lo, high - reach))
+    return TRAVEL_COST * (shift / 12.0) ** 2, (new_lo, max(high, min(hi, new_lo + reach)))
 
 
 def _step(state: _State, chord: list[Note], k: int, spec: HandSpec) -> tuple[float, tuple]:
@@ -175,23 +197,22 @@ def _step(state: _State, chord: list[Note], k: int, spec: HandSpec) -> tuple[flo
     left, right = chord[:k], chord[k:]
     held_l = tuple(n for n in state.held_left if n.offset > onset + LEGATO_OVERLAP)
     held_r = tuple(n for n in state.held_right if n.offset > onset + LEGATO_OVERLAP)
+    reach = span(spec)
     cost = 0.0
-    pos_l, pos_r = state.left, state.right
+    win_l, win_r = state.left, state.right
     if left:
-        new = (left[0].pitch + left[-1].pitch) / 2
-        cost += _travel(pos_l, new) + (SWITCH_COST if state.played == (False, True) else 0.0)
-        pos_l = new
+        travel, win_l = _move(win_l, left[0].pitch, left[-1].pitch, reach)
+        cost += travel + (SWITCH_COST if state.played == (False, True) else 0.0) + HOLD_COST * len(held_l)
     if right:
-        new = (right[0].pitch + right[-1].pitch) / 2
-        cost += _travel(pos_r, new) + (SWITCH_COST if state.played == (True, False) else 0.0)
-        pos_r = new
+        travel, win_r = _move(win_r, right[0].pitch, right[-1].pitch, reach)
+        cost += travel + (SWITCH_COST if state.played == (True, False) else 0.0) + HOLD_COST * len(held_r)
     # the resting hand is pushed aside where the other passes it
-    if left and not right and pos_r is not None and pos_r <= left[-1].pitch:
-        cost += _travel(pos_r, left[-1].pitch + 1)
-        pos_r = left[-1].pitch + 1
-    if right and not left and pos_l is not None and pos_l >= right[0].pitch:
-        cost += _travel(pos_l, right[0].pitch - 1)
-        pos_l = right[0].pitch - 1
+    if left and not right and win_r is not None and win_r[0] <= left[-1].pitch:
+        travel, win_r = _move(win_r, left[-1].pitch + 1, max(win_r[1], left[-1].pitch + 1), reach)
+        cost += travel
+    if right and not left and win_l is not None and win_l[1] >= right[0].pitch:
+        travel, win_l = _move(win_l, min(win_l[0], right[0].pitch - 1), right[0].pitch - 1, reach)
+        cost += travel
     # notes struck across the other hand's held notes
     if left and held_r:
         cost += CROSS_COST * sum(1 for n in left if n.pitch >= min(h.pitch for h in held_r))
@@ -201,7 +222,7 @@ def _step(state: _State, chord: list[Note], k: int, spec: HandSpec) -> tuple[flo
     for held, part, hand in ((held_l, left, "left"), (held_r, right, "right")):
         if held and part and not reaches([n.pitch for n in (*held, *part)], hand, spec):
             cost += HELD_COST * len(held)
-    return cost, (pos_l, pos_r, held_l + tuple(left), held_r + tuple(right), (bool(left), bool(right)))
+    return cost, (win_l, win_r, held_l + tuple(left), held_r + tuple(right), (bool(left), bool(right)))
 
 
 def assign_hands(piece: Piece, spec: HandSpec = HandSpec()) -> HandAssignment:
@@ -209,7 +230,7 @@ def assign_hands(piece: Piece, spec: HandSpec = HandSpec()) -> HandAssignment:
     notes that have a hand keep it. ``spec`` is each hand's fingers (the left hand mirrors the right)."""
     notes = piece.notes
     groups = group_chords(piece)
-    centre = middle(piece, groups)
+    centre = middle(piece, groups, spec)
     layers: list[list[_State | None]] = []
     previous = [_State(0.0, -1, None, None, (), (), (False, False))]
     for group in groups:
