@@ -90,3 +90,29 @@ def test_each_hand_is_fingered_by_the_planner_the_left_through_the_mirror():
 def test_finger_hands_needs_every_notes_hand():
     with pytest.raises(ValueError, match="assign_hands"):
         finger_hands(Piece.of(notes(("C4", 0, 1))))
+
+
+def test_a_two_hand_file_without_named_tracks_is_read_with_every_notes_hand(tmp_path):
+    from pianobot.music.midi_io import write_midi
+    from pianobot.pianist.hands import load_two_hands
+
+    bass = notes(("C3", 0, 1), ("G2", 1, 2))
+    melody = notes(("E5", 0, 0.5), ("D5", 0.5, 1), ("C5", 1, 2))
+    big = notes(*[(name, 2, 3) for name in ["C2", "G2", "C3", "E3", "G3", "C4", "E4", "G4"]])
+    path = write_midi(Piece.of([*bass, *melody, *big]), tmp_path / "one-track.mid")  # no hands: one unnamed track
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        piece = load_two_hands(path)
+    lines = [str(w.message) for w in caught if issubclass(w.category, PianobotWarning)]
+    assert lines == [
+        "one-track.mid has chords of more than 6 notes, more than two hands of 3 fingers hold: "
+        "kept their lowest and highest 3, dropped 2 inner note(s)"
+    ]
+    assert {(n.name, n.hand) for n in piece if n.onset < 2} == {
+        ("C3", "left"),
+        ("G2", "left"),
+        ("E5", "right"),
+        ("D5", "right"),
+        ("C5", "right"),
+    }
+    assert [n.hand for n in piece if n.onset == 2] == ["left"] * 3 + ["right"] * 3
