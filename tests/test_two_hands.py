@@ -71,3 +71,14 @@ def test_one_hand_options_are_refused_and_a_two_hand_pig_file_is_read(tmp_path):
     piece = Piece((Note(0, 72, 1, finger=3, hand="right"), Note(0, 48, 1, finger=5, hand="left")))
     path = write_pig(piece, tmp_path / "both.txt")
     assert load_hands(path) == piece
+
+
+def test_a_pig_sidecar_with_both_hands_gives_the_notes_of_an_unnamed_file_their_hands(tmp_path):
+    from pianobot.music.midi_io import write_midi
+
+    written = Piece((Note(0, 72, 0.5, finger=3, hand="right"), Note(0, 48, 1, finger=5, hand="left")), bpm=120)
+    path = write_midi(written.with_hands(None).without_fingering(), tmp_path / "song.mid")  # one unnamed track
+    write_pig(written, tmp_path / "song_fingering.txt")
+    assert load_hands(path) == written
+    slow = load_hands(path, LoadOptions(tempo=60, transpose=2))  # re-timed and moved: the hands stay
+    assert [(n.pitch, n.offset, n.finger, n.hand) for n in slow] == [(50, 2.0, 5, "left"), (74, 1.0, 3, "right")]

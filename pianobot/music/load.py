@@ -198,8 +198,9 @@ PIANO = KeyboardSpec(21, 88)
 
 def load_hands(path: str | Path, options: LoadOptions = LoadOptions()) -> Piece:
     """A two-hand piece (a .mid file, or a PIG .txt file with both hands' notes), each note with
-    the hand its track's name (or PIG channel) says, None where nothing says (the fingering planner
-    then gives it one: :func:`pianobot.pianist.hands.load_two_hands`).
+    the hand its track's name says, else the channel of its note in the PIG fingering sidecar (or
+    the PIG file's), None where nothing says (the fingering planner then gives it one:
+    :func:`pianobot.pianist.hands.load_two_hands`).
 
     Bad input, in one line: notes beyond the piano's 88 keys and hands that cross are refused
     (:class:`SettingError` naming the setting that helps); three or more tracks of notes that are
@@ -221,9 +222,16 @@ def load_hands(path: str | Path, options: LoadOptions = LoadOptions()) -> Piece:
         piece = pig.read_pig(path, hand=None).transpose(options.transpose)
     else:
         piece = load_piece(path, options)
+        sidecar = options.fingering or pig.sidecar_for(path)
+        if any(n.hand is None for n in piece.notes) and (options.fingering is not None or sidecar.exists()):
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", PianobotWarning)  # said by the first read
+                # the notes as the sidecar lists them (the file's times, no shift), in the same order
+                written = pig.apply_fingering(_read_midi(path, replace(options, tempo=None)), sidecar, hands=True)
+            piece = piece.with_hands([n.hand or w.hand for n, w in zip(piece.notes, written.notes)])
         tracks = [t for t in midi_io.describe_tracks(path) if t.notes]
         unnamed = [t for t in tracks if midi_io.track_hand(t.name) is None]
-        if options.track is None and len(tracks) >= 3 and unnamed:
+        if options.track is None and len(tracks) >= 3 and unnamed and any(n.hand is None for n in piece.notes):
             warnings.warn(
                 PianobotWarning(
                     f"{path.name} has {len(tracks)} tracks of notes, {len(unnamed)} not named for a hand: "

@@ -138,25 +138,22 @@ def sidecar_for(midi_path: str | Path) -> Path:
     return midi_path.with_name(midi_path.stem + SIDECAR_SUFFIX)
 
 
-def apply_fingering(piece: Piece, pig_path: str | Path) -> Piece:
-    """Take each note's finger from the PIG note of the same pitch starting at the same time.
-
-    Every note of ``piece`` must find its PIG note (within :data:`MATCH_TOLERANCE`); PIG notes
-    left over (e.g. the other hand's) are ignored.
-    """
-    by_pitch: dict[int, list[Note]] = defaultdict(list)  # each pitch's PIG notes in onset order
-    for note, _ in sorted(read_pig_rows(pig_path), key=lambda r: (r[0].onset, r[0].pitch)):
-        by_pitch[note.pitch].append(note)
-    onsets = {pitch: [n.onset for n in notes] for pitch, notes in by_pitch.items()}
-    used = {pitch: [False] * len(notes) for pitch, notes in by_pitch.items()}
-    fingers = []
+def _matches(piece: Piece, pig_path: str | Path) -> list[tuple[Note, int]]:
+    """For each note of ``piece`` (in order) its PIG note and channel: the note of the same pitch
+    starting nearest, within :data:`MATCH_TOLERANCE`, each PIG note used once."""
+    by_pitch: dict[int, list[tuple[Note, int]]] = defaultdict(list)  # each pitch's PIG notes in onset order
+    for note, channel in sorted(read_pig_rows(pig_path), key=lambda r: (r[0].onset, r[0].pitch)):
+        by_pitch[note.pitch].append((note, channel))
+    onsets = {pitch: [n.onset for n, _ in rows] for pitch, rows in by_pitch.items()}
+    used = {pitch: [False] * len(rows) for pitch, rows in by_pitch.items()}
+    found = []
     for note in piece.notes:
         best = None
         candidates = by_pitch.get(note.pitch, [])
         first = bisect.bisect_left(onsets.get(note.pitch, []), note.onset - MATCH_TOLERANCE - 1e-9)
         for i in range(first, len(candidates)):
-            gap = abs(candidates[i].onset - note.onset)
-            if candidates[i].onset > note.onset + MATCH_TOLERANCE + 1e-9:
+            gap = abs(candidates[i][0].onset - note.onset)
+            if candidates[i][0].onset > note.onset + MATCH_TOLERANCE + 1e-9:
                 break
             if not used[note.pitch][i] and gap <= MATCH_TOLERANCE and (best is None or gap < best[0]):
                 best = (gap, i)
@@ -166,5 +163,19 @@ def apply_fingering(piece: Piece, pig_path: str | Path) -> Piece:
                 "the sidecar must list the same notes as the .mid file (same pitches and onsets)"
             )
         used[note.pitch][best[1]] = True
-        fingers.append(candidates[best[1]].finger)
-    return piece.with_fingers(fingers)
+        found.append(candidates[best[1]])
+    return found
+
+
+def apply_fingering(piece: Piece, pig_path: str | Path, *, hands: bool = False) -> Piece:
+    """Take each note's finger from the PIG note of the same pitch starting at the same time;
+    with ``hands``, also its hand from the PIG note's channel (0 right, 1 left).
+
+    Every note of ``piece`` must find its PIG note (within :data:`MATCH_TOLERANCE`); PIG notes
+    left over (e.g. the other hand's) are ignored.
+    """
+    notes = [
+        replace(note, finger=match.finger, hand=HANDS[channel] if hands else note.hand)
+        for note, (match, channel) in zip(piece.notes, _matches(piece, pig_path))
+    ]
+    return Piece(tuple(notes), bpm=piece.bpm)
