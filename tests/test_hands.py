@@ -116,3 +116,11 @@ def test_a_two_hand_file_without_named_tracks_is_read_with_every_notes_hand(tmp_
         ("C5", "right"),
     }
     assert [n.hand for n in piece if n.onset == 2] == ["left"] * 3 + ["right"] * 3
+
+
+def test_a_one_hand_melody_and_close_chords_stay_in_one_hand():
+    scale = ["C4", "D4", "E4", "F4", "G4", "A4", "B4", "C5", "B4", "A4", "G4", "F4", "E4", "D4", "C4"]
+    melody = Piece.of(notes(*[(name, i * 0.5, i * 0.5 + 0.5) for i, name in enumerate(scale)]))
+    assert assign_hands(melody).piece.hands == ("right",)
+    chords = Piece.of(notes(("C4", 0, 1), ("E4", 0, 1), ("D4", 1, 2), ("F4", 1, 2), ("E4", 2, 3), ("G4", 2, 3)))
+    assert assign_hands(chords).piece.hands == ("right",)
