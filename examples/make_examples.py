@@ -14,6 +14,15 @@ written as a digital piano records: one tempo, the player's rubato in the note t
 from the touch, the pedal changed with the harmony. Their right hands need `--hand right`,
 which reduces what the robot hand cannot play (docs/fingering.md).
 
+Three more are two-hand pieces with tracks named "Right Hand" and "Left Hand", written the same
+way (rubato in the note times, the pedal changed with each bar, velocity from the touch, no
+fingering), all public-domain music: `chorale-performed.mid` (Old Hundredth harmonised in four
+voices, soprano and alto in the right hand, tenor and bass in the left),
+`ode-to-joy-performed.mid` (the tune over a bass line of broken chords) and
+`prelude-performed.mid` (the opening of Bach's Prelude in C, BWV 846: each bar's chord broken
+into sixteenths). Each hand stays within the reach of its fingers chord by chord, and the right
+hands lie on the default keyboard.
+
 Fingerings were chosen by hand for a three-finger hand: within one hand position the index,
 middle and ring fingers lie over three neighbouring white keys, and the wrist moves between
 positions.
