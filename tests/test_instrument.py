@@ -61,3 +61,14 @@ def test_bad_keyboard_specs():
         KeyboardSpec(lowest=120, count=24)
     with pytest.raises(PianobotError):
         KeyboardSpec(count=0)
+
+
+def test_the_keyboard_a_piece_needs_is_its_range_rounded_out_to_octaves():
+    from pianobot.music.instrument import PIANO, keyboard_for
+    from pianobot.music.piece import Note, Piece
+
+    assert (PIANO.lowest, PIANO.highest, PIANO.count) == (21, 108, 88)  # A0-C8
+    piece = Piece((Note(0, 50, 1), Note(0, 73, 1)))  # D3 and C#5
+    assert (keyboard_for(piece).lowest, keyboard_for(piece).highest) == (48, 83)  # C3-B5
+    wide = Piece((Note(0, 21, 1), Note(0, 108, 1)))  # the whole piano: its 88 keys, not C0-B8
+    assert keyboard_for(wide) == PIANO

@@ -59,6 +59,20 @@ class KeyboardSpec:
         return f"{pitch_name(self.lowest)}-{pitch_name(self.highest)} ({self.count} keys)"
 
 
+PIANO = KeyboardSpec(21, 88)
+"""The piano's 88 keys, A0 to C8."""
+
+
+def keyboard_for(piece: Piece) -> KeyboardSpec:
+    """The keys ``piece`` needs, rounded out to whole octaves (C to B) within MIDI's range; where
+    that would pass 88 keys, just the piece's own range (at most 88 keys, from its lowest note)."""
+    lowest, highest = min(n.pitch for n in piece.notes), max(n.pitch for n in piece.notes)
+    low, high = lowest // 12 * 12, min(127, highest // 12 * 12 + 11)
+    if high - low + 1 > 88:
+        return KeyboardSpec(lowest, min(88, highest - lowest + 1))
+    return KeyboardSpec(low, high - low + 1)
+
+
 @dataclass(frozen=True)
 class HandSpec:
     """Which fingers the robot hand plays with, in pianists' numbering (1 thumb ... 5 little)."""

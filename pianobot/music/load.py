@@ -8,7 +8,7 @@ from pathlib import Path
 
 from pianobot.errors import PianobotError, PianobotWarning, SettingError, quote
 from pianobot.music import midi_io, pig
-from pianobot.music.instrument import HandSpec, KeyboardSpec
+from pianobot.music.instrument import PIANO, HandSpec
 from pianobot.music.piece import HANDS, Note, Piece, pitch_name
 
 
@@ -190,10 +190,6 @@ def thin_hand(piece: Piece, name: str, hand: HandSpec, kept: str = "highest") ->
             )
         )
     return piece
-
-
-PIANO = KeyboardSpec(21, 88)
-"""The piano's 88 keys, A0 to C8: what two hands may be asked to play."""
 
 
 def load_hands(path: str | Path, options: LoadOptions = LoadOptions()) -> Piece:

@@ -46,7 +46,7 @@ from pathlib import Path
 import numpy as np
 
 from pianobot.errors import PianobotWarning
-from pianobot.music.instrument import HandSpec, KeyboardSpec
+from pianobot.music.instrument import HandSpec, KeyboardSpec, keyboard_for
 from pianobot.music.load import CHORD_SPREAD, LEGATO_OVERLAP, LoadOptions, load_hands, thin_hand
 from pianobot.music.piece import Note, Piece, mirror_pitch
 from pianobot.pianist.fingering import FingeringPlan, ensure_fingering
@@ -296,13 +296,6 @@ def load_two_hands(path: str | Path, options: LoadOptions = LoadOptions(), spec:
     if all(n.hand is not None for n in piece.notes):
         return piece
     return assign_hands(piece, spec).piece
-
-
-def keyboard_for(piece: Piece) -> KeyboardSpec:
-    """The keys ``piece`` needs, rounded out to whole octaves (C to B), at most 88 and within MIDI."""
-    low = min(n.pitch for n in piece.notes) // 12 * 12
-    high = min(127, max(n.pitch for n in piece.notes) // 12 * 12 + 11)
-    return KeyboardSpec(low, min(88, high - low + 1))
 
 
 @dataclass(frozen=True)
