@@ -3,6 +3,7 @@
 import warnings
 
 import pytest
+from test_two_hands import warning_lines
 
 from pianobot.errors import PianobotWarning
 from pianobot.music.instrument import HandSpec
@@ -100,10 +101,7 @@ def test_a_two_hand_file_without_named_tracks_is_read_with_every_notes_hand(tmp_
     melody = notes(("E5", 0, 0.5), ("D5", 0.5, 1), ("C5", 1, 2))
     big = notes(*[(name, 2, 3) for name in ["C2", "G2", "C3", "E3", "G3", "C4", "E4", "G4"]])
     path = write_midi(Piece.of([*bass, *melody, *big]), tmp_path / "one-track.mid")  # no hands: one unnamed track
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        piece = load_two_hands(path)
-    lines = [str(w.message) for w in caught if issubclass(w.category, PianobotWarning)]
+    piece, lines = warning_lines(load_two_hands, path)
     assert lines == [
         "one-track.mid has chords of more than 6 notes, more than two hands of 3 fingers hold: "
         "kept their lowest and highest 3, dropped 2 inner note(s)"

@@ -12,6 +12,14 @@ from pianobot.music.piece import Note, Piece
 from pianobot.music.pig import write_pig
 
 
+def warning_lines(read, *args):
+    """``read(*args)`` and the PianobotWarning lines it gave."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        result = read(*args)
+    return result, [str(w.message) for w in caught if issubclass(w.category, PianobotWarning)]
+
+
 def _track(*notes):
     """(tick, message) events of (pitch, start beat, end beat) notes, 480 ticks a beat."""
     return [event for p, a, b in notes for event in ((round(a * 480), on(p)), (round(b * 480), off(p)))]
@@ -55,10 +63,7 @@ def test_three_unnamed_staves_are_read_as_one_part_said_in_one_line(tmp_path):
         tmp_path / "satb.mid",
         [("Soprano", _track((72, 0, 1))), ("Alto", _track((67, 0, 1))), ("Tenor", _track((60, 0, 1)))],
     )
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        piece = load_hands(path)
-    lines = [str(w.message) for w in caught if issubclass(w.category, PianobotWarning)]
+    piece, lines = warning_lines(load_hands, path)
     assert lines == [
         "satb.mid has 3 tracks of notes, 3 not named for a hand: their notes are given to the hands by the fingering planner"
     ]
