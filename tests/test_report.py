@@ -112,6 +112,7 @@ def test_a_headless_browser_renders_the_roll_and_plays_the_video(played):
             "--headless",
             "--no-sandbox",  # (as root, in CI)
             "--disable-gpu",
+            "--disable-dev-shm-usage",
             "--autoplay-policy=no-user-gesture-required",
             "--virtual-time-budget=5000",
             "--dump-dom",
