@@ -10,7 +10,12 @@ states with the lowest total cost:
   easier to play than many small ones);
 - **stretch**: each finger's sideways offset from straight over its key, squared, in units of
   its reach (a finger straight over its key strikes most reliably);
-- a **hop** cost when one finger plays two different keys in a row.
+- a **hop** cost when one finger plays two different keys in a row;
+- a **legato** cost (``PianistTuning.legato_cost``) for every note the scripted pianist would have to let go
+  before its written end: its finger plays the next chord too (a hop, or the same key again), another
+  finger plays its key next, or the wrist moves to where the key is out of the finger's reach, and
+  there is less time between its written end and the next onset than that takes. It grows with the
+  share of the note's written length lost, so where the planner has a choice, a note is held to its end.
 
 Hard constraints (what this hand cannot do): a finger reaches at most :data:`REACH_FRACTION` of
 what its abduction limit allows; simultaneous notes take distinct fingers in pitch order; a
@@ -188,10 +193,47 @@ class Planner:
         for a_p, f_p in enumerate(p_assign):
             for a, f in enumerate(assignments):
                 hop = slow if self._fast_hop(p_keys, f_p, keys, f, time, velocities) else 0.0
-                blocks[a_p, :, a, :] = self._transition(p_keys, keys, f_p, f, held, time) + too_fast + hop
+                legato = self._legato(prev_chord, onset, p_keys, f_p, keys, f, velocities)
+                blocks[a_p, :, a, :] = self._transition(p_keys, keys, f_p, f, held, time) + too_fast + hop + legato
         step = before.cost[:, None] + blocks.reshape(len(before.cost), -1)
         best = np.argmin(step, axis=0)
         return Reach(chord, step[best, np.arange(step.shape[1])] + local.ravel()), best
+
+    def _legato(
+        self,
+        prev_chord: Sequence[Note],
+        onset: float,
+        prev_keys: list[int],
+        fingers_prev: tuple,
+        keys: list[int],
+        fingers: tuple,
+        velocities: Sequence[int],
+    ) -> np.ndarray | float:
+        """Cost (W, by the next wrist position, or one number) of the previous chord's notes that the
+        scripted pianist must let go before their written end to play the next chord at ``onset`` with
+        ``fingers``: the share of each note's written length lost, times ``legato_cost``. A note is let
+        go :meth:`~pianobot.pianist.strikes.StrikePlanner.release_steps` before a strike of its own
+        finger or on its own key, and ``prepare_steps`` and the strike's lead before a strike from a wrist
+        position where its key is out of its finger's reach (the hand slides only once it has risen)."""
+        strikes, tuning = self.strikes, self.strikes.tuning
+        cost: np.ndarray | float = 0.0
+        for note, key_p, finger_p in zip(sorted(prev_chord, key=lambda n: n.pitch), prev_keys, fingers_prev):
+            slack = onset - note.offset  # time from its written end to the next onset (s)
+            if slack < -1e-6:
+                continue  # held over the onset: _transition keeps its finger and key
+            before = 0.0  # how long before the onset the note must be let go (s)
+            for key, finger, velocity in zip(keys, fingers, velocities):
+                if finger == finger_p or key == key_p:
+                    before = max(before, strikes.release_steps(key_p, key, velocity) * strikes.dt)
+            lost = float(np.clip((before - slack) / note.duration, 0.0, 1.0))
+            # out of reach from the next wrist position: let go before the slowest strike's lead and the slide
+            lead = max(strikes.ready(Run(key, 0, 1, v))[1] for key, v in zip(keys, velocities))
+            leap = (tuning.prepare_steps + lead) * strikes.dt
+            offset = np.abs(self.key_x[key_p] - self.grid - FINGER_BASE_X[finger_p]) / self.reach[key_p]
+            leap_lost = float(np.clip((leap - slack) / note.duration, 0.0, 1.0))
+            lost_by_wrist = np.where(offset <= 1.0, lost, max(lost, leap_lost))
+            cost = cost + tuning.legato_cost * lost_by_wrist[None, :]
+        return cost
 
     def _wrist_too_fast(self, move: np.ndarray | float, time: float, chord: Sequence[Note]) -> np.ndarray:
         """Whether the wrist cannot move ``move`` (m) in the ``time`` s before ``chord``'s onset:

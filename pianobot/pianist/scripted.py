@@ -55,6 +55,6 @@ class ScriptedPianist:
         joints = np.asarray(observation["joints"], dtype=float).reshape(len(self.fingers), 4)
         wrist = (float(observation["wrist"][0]) + 1) / 2 * self.layout.width
         tips = {finger: self.motion.tip(q) for finger, q in zip(self.fingers, joints)}
-        plans = self.strikes.plan(score, self.previous_row, tips)
+        plans = self.strikes.plan(score, self.previous_row, tips, wrist)
         self.previous_row = score[0].copy()
         return self.motion.command(plans, joints, wrist)[self.actuated]

@@ -11,7 +11,10 @@ Every control step the planner reads each finger's notes from the score window
 - ``hold``: keep a sounding key down, first going on down at the strike speed, so that a strike
   that lands a little late still sounds at the right velocity.
 
-A held key is let go early when the hand must get ready for what comes next (:meth:`StrikePlanner.plan`).
+A held key is held until its written end, and let go sooner only when the hand must get ready for
+what comes next (:meth:`StrikePlanner._let_go`): its own finger's next strike (a repeated key: just
+long enough for the key to rise), or a strike that needs the wrist where no abduction reaches the
+held key from.
 
 The planner knows no joints: it is given each fingertip's height, and
 :mod:`~pianobot.pianist.motion` turns its plans into joint speeds.
@@ -101,18 +104,21 @@ class StrikePlanner:
         self.curve = world.keyboard.curve
         self.max_wrist_speed = world.hand.max_wrist_speed
 
-    def plan(self, score: np.ndarray, previous_row: np.ndarray | None, tips: dict[int, Tip]) -> dict[int, Plan]:
+    def plan(
+        self, score: np.ndarray, previous_row: np.ndarray | None, tips: dict[int, Tip], wrist: float | None = None
+    ) -> dict[int, Plan]:
         """The plan of every finger that has something to do, by finger.
 
         ``previous_row`` is the score row of the previous step (None at the first step): it tells a
-        note that began earlier, to hold, from one to strike now. ``tips``: where each fingertip is, by finger.
+        note that began earlier, to hold, from one to strike now. ``tips``: where each fingertip is, by
+        finger; ``wrist``: where the wrist is (m; None: wherever a strike needs it).
         """
         plans: dict[int, Plan] = {}
         for slot, finger in enumerate(self.fingers):
             plan = self._plan_finger(score, slot, previous_row, tips[finger])
             if plan is not None:
                 plans[finger] = plan
-        self._let_go(plans, tips)
+        self._let_go(plans, tips, wrist)
         return plans
 
     # -- speed, depth and timing of one strike -----------------------------------------------------
@@ -173,13 +179,32 @@ class StrikePlanner:
         ``from_key`` sounds in its onset's step and is let go at the next, the fingertip goes from the
         pressed key to its ready height over ``to_key`` (:meth:`positioning_steps`, at least
         ``prepare_steps``), then strikes at ``velocity``. ``to_key`` may be ``from_key`` (a repeat)."""
-        layout = self.layout
-        pressed = Tip(
-            layout.key_top[from_key] - self.strike_depth(from_key) - self.tuning.hold_depth_margin,
-            layout.contact_y(from_key),
-        )
+        return 1 + self._lift_and_strike(from_key, to_key, velocity, self.tuning.prepare_steps)
+
+    def release_steps(self, from_key: int, to_key: int, velocity: float) -> int:
+        """Control steps before a strike on ``to_key`` at ``velocity`` that a finger holding ``from_key``
+        lets go, as :meth:`plan` does (:meth:`preparing_steps`, then the strike)."""
         height, lead = self.ready(Run(to_key, 0, 1, velocity))
-        return 1 + max(self.tuning.prepare_steps, self.positioning_steps(pressed, to_key, height)) + lead
+        return self.preparing_steps(self._pressed(from_key), from_key, to_key, height) + lead
+
+    def preparing_steps(self, tip: Tip, from_key: int, to_key: int, height: float) -> int:
+        """Control steps a finger holding ``from_key`` with its tip at ``tip`` needs from letting go to
+        the start of its strike on ``to_key`` from ``height``: :meth:`positioning_steps`, at least
+        ``prepare_steps``; on the same key, straight up and down again in front of it, no settling and
+        at least ``repeat_prepare_steps``."""
+        tuning = self.tuning
+        if to_key == from_key:
+            return max(tuning.repeat_prepare_steps, self.positioning_steps(tip, to_key, height) - tuning.settle_steps)
+        return max(tuning.prepare_steps, self.positioning_steps(tip, to_key, height))
+
+    def _pressed(self, key: int) -> Tip:
+        """Where a fingertip holding ``key`` down is."""
+        layout = self.layout
+        return Tip(layout.key_top[key] - self.strike_depth(key) - self.tuning.hold_depth_margin, layout.contact_y(key))
+
+    def _lift_and_strike(self, from_key: int, to_key: int, velocity: float, prepare: int) -> int:
+        height, lead = self.ready(Run(to_key, 0, 1, velocity))
+        return max(prepare, self.positioning_steps(self._pressed(from_key), to_key, height)) + lead
 
     # -- plans ----------------------------------------------------------------------------------
     def _plan_finger(self, score: np.ndarray, slot: int, previous_row: np.ndarray | None, tip: Tip) -> Plan | None:
@@ -201,7 +226,7 @@ class StrikePlanner:
         if upcoming is None:
             return Plan(key, "hold", goal=goal)
         height, lead = self.ready(upcoming)
-        next_lead = lead + max(self.tuning.prepare_steps, self.positioning_steps(tip, upcoming.key, height))
+        next_lead = lead + self.preparing_steps(tip, key, upcoming.key, height)
         return Plan(key, "hold", goal=goal, next_note=upcoming, next_lead=next_lead)
 
     def _approach(self, run: Run, tip: Tip) -> Plan:
@@ -223,12 +248,18 @@ class StrikePlanner:
         floor = -depth - self.tuning.hold_depth_margin
         return Plan(key, "strike", height=height, goal=float(np.clip(goal, floor, tip_height)), start=start, lead=steps)
 
-    def _let_go(self, plans: dict[int, Plan], tips: dict[int, Tip]) -> None:
+    def strike_reach(self, key: int) -> float:
+        """Farthest the wrist may be from straight over ``key`` for a finger to strike it (m)."""
+        return self.tuning.black_strike_reach if self.layout.black[key] else self.tuning.strike_reach
+
+    def _let_go(self, plans: dict[int, Plan], tips: dict[int, Tip], wrist: float | None) -> None:
         """Release held keys early when the hand must get ready for what comes next.
 
-        A holding finger lets go in time for its own next strike; every holding finger lets go
-        in time for a strike (its own or another finger's) that needs the wrist where a held
-        key is out of reach, counting the steps the wrist needs to get there.
+        A holding finger lets go in time for its own next strike, or another finger's on its key. Every holding finger lets go in
+        time for a strike (its own or another finger's) that no wrist position keeping the held keys
+        in reach (``hold_reach``) lets its finger reach (``strike_reach``), or not soon enough at the
+        speed the wrist slides while holding (``hold_slide``), counting the steps the wrist needs to
+        get where the finger is straight over its key.
         """
         tuning, layout = self.tuning, self.layout
 
@@ -242,23 +273,48 @@ class StrikePlanner:
         for finger, plan in list(plans.items()):
             if plan.phase == "hold" and plan.next_note is not None and plan.next_note.start - plan.next_lead <= 0:
                 release(finger)
+        for finger, plan in list(plans.items()):  # another finger strikes the held key: it must rise first
+            if plan.phase == "strike" or plan.phase == "ready":
+                for held, other in list(plans.items()):
+                    if other.phase == "hold" and other.key == plan.key and held != finger:
+                        if plan.start - plan.lead - tuning.repeat_prepare_steps <= 0:
+                            release(held)
         holds = {f: p for f, p in plans.items() if p.phase == "hold"}
         if not holds:
             return
         low = max(layout.wrist_for(f, p.key) for f, p in holds.items()) - tuning.hold_reach
         high = min(layout.wrist_for(f, p.key) for f, p in holds.items()) + tuning.hold_reach
-        # (finger, key, onset, lead): a holding finger's next_lead counts its path to the ready height and
-        # its strike; prepare_steps is added on top for every strike below, as the wrist does not slide
-        # until the fingers that let go have risen (tidying that overlap away cost a melody: measured)
-        strikes = [(f, p.key, p.start, p.lead) for f, p in plans.items() if p.phase != "hold"]
+        # (finger, key, onset, lead, extra): the wrist slides only once the fingers that let go have risen. A free
+        # finger's strike needs prepare_steps on top of its lead (it aims and settles once the wrist is there:
+        # tidying that overlap away cost a melody, measured); a holding finger's next_lead already counts its
+        # path to the ready height, so its own next strike needs only lift_steps more
+        strikes = [(f, p.key, p.start, p.lead, tuning.prepare_steps) for f, p in plans.items() if p.phase != "hold"]
         strikes += [
-            (f, p.next_note.key, p.next_note.start, p.next_lead) for f, p in holds.items() if p.next_note is not None
+            (f, p.next_note.key, p.next_note.start, p.next_lead, tuning.lift_steps)
+            for f, p in holds.items()
+            if p.next_note is not None
         ]
-        for finger, key, start, lead in strikes:
+        for finger, key, start, lead, extra in strikes:
             wanted = layout.wrist_for(finger, key)
+            if self._strike_while_holding(wanted, self.strike_reach(key), low, high, start - lead, wrist):
+                continue
             travel = max(0.0, low - wanted, wanted - high)
             shift_steps = math.ceil(travel / (self.max_wrist_speed * self.dt))
-            if travel > 0 and start - lead - tuning.prepare_steps - shift_steps <= 0:
+            if travel > 0 and start - lead - extra - shift_steps <= 0:
                 for held in holds:
                     release(held)
                 return
+
+    def _strike_while_holding(
+        self, wanted: float, reach: float, low: float, high: float, steps: int, wrist: float | None
+    ) -> bool:
+        """Whether a finger straight over its key with the wrist at ``wanted`` (m) can strike it from a
+        wrist position in the held keys' window [``low``, ``high``] (within ``reach`` of ``wanted``), the
+        wrist sliding there at ``hold_slide`` per step within ``steps`` (None ``wrist``: it is there)."""
+        near, far = max(low, wanted - reach), min(high, wanted + reach)
+        if near > far:
+            return False
+        if wrist is None:
+            return True
+        distance = max(0.0, near - wrist, wrist - far)
+        return math.ceil(distance / self.tuning.hold_slide - 1e-9) <= steps

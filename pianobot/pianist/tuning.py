@@ -37,6 +37,23 @@ class PianistTuning:
     (at ``max_move`` per step), this and the strike."""
     hold_reach: float = 0.030
     """Farthest the wrist may be from straight over a held key: the abduction makes up for it (m)."""
+    lift_steps: int = 1
+    """Time a finger that lets go of its key needs to rise clear of the keys before the wrist slides
+    (control steps): a holding finger lets go this much earlier for a strike of its own that needs
+    the wrist elsewhere."""
+    strike_reach: float = 0.030
+    """Farthest the wrist may be from straight over a white key that a finger strikes while other
+    fingers hold theirs: the abduction makes up for it, and the held keys are not let go (m)."""
+    black_strike_reach: float = 0.018
+    """The same for a black key: a slanted fingertip slips off its narrow top sooner (m)."""
+    repeat_prepare_steps: int = 1
+    """Least time a finger needs to let its key rise and be still over it again, before it strikes the
+    same key again from the ready height (control steps): no move across, so less than ``prepare_steps``."""
+
+    # -- fingering (pianobot/pianist/fingering.py) ---------------------------------------------------
+    legato_cost: float = 2.0
+    """The fingering planner's cost of a note let go before its written end, per share of its written
+    length lost (in white keys of wrist travel: a whole note lost costs as much as a move of this many)."""
 
     # -- motion (pianobot/pianist/motion.py) -----------------------------------------------------
     idle_height: float = 0.010
