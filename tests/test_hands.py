@@ -122,3 +122,12 @@ def test_a_one_hand_melody_and_close_chords_stay_in_one_hand():
     assert assign_hands(melody).piece.hands == ("right",)
     chords = Piece.of(notes(("C4", 0, 1), ("E4", 0, 1), ("D4", 1, 2), ("F4", 1, 2), ("E4", 2, 3), ("G4", 2, 3)))
     assert assign_hands(chords).piece.hands == ("right",)
+
+
+def test_a_left_hand_chord_too_wide_keeps_its_bass_and_says_so_for_the_left_hand():
+    piece = Piece.of([*notes(("C2", 0, 1), ("E3", 0, 1), hand="left"), *notes(("C5", 0, 1), hand="right")])
+    result, lines = warning_lines(finger_hands, piece)
+    assert [n.name for n in result.piece.part("left")] == ["C2"]  # the bass, not the upper note
+    assert lines == [
+        "the left hand's part has chords wider than this hand reaches: kept their lowest notes, dropped 1 upper note(s)"
+    ]

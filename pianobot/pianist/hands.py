@@ -306,6 +306,30 @@ class HandsFingering:
     plans: dict[str, FingeringPlan | None]
 
 
+MIRRORED_WORDS = (
+    ("kept their top notes", "kept their lowest notes"),
+    ("lower note(s)", "upper note(s)"),
+    ("lower notes of chords first", "upper notes of chords first"),
+)
+"""How :func:`~pianobot.pianist.reduce.reduce_part`'s lines read for a left hand's part, reduced
+as its mirror image (where its top notes are the written bass)."""
+
+
+def _reduce(part: Piece, keyboard: KeyboardSpec, spec: HandSpec, hand: str) -> Piece:
+    """:func:`~pianobot.pianist.reduce.reduce_part` of ``hand``'s part (the left hand's mirrored),
+    its warning lines worded for the written part."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", PianobotWarning)
+        reduced = reduce_part(part, keyboard, spec, f"the {hand} hand's part").piece
+    for warning in caught:
+        line = str(warning.message)
+        if hand == "left" and issubclass(warning.category, PianobotWarning):
+            for mirrored, written in MIRRORED_WORDS:
+                line = line.replace(mirrored, written)
+        warnings.warn(warning.category(line))
+    return reduced
+
+
 def finger_hands(piece: Piece, spec: HandSpec = HandSpec(), refinger: bool = False) -> HandsFingering:
     """Each hand's part of ``piece`` (every note has a hand) thinned and reduced to what the hand
     can play (:func:`~pianobot.music.load.thin_hand`, :func:`~pianobot.pianist.reduce.reduce_part`,
@@ -320,7 +344,7 @@ def finger_hands(piece: Piece, spec: HandSpec = HandSpec(), refinger: bool = Fal
         part = part.mirror() if hand == "left" else part  # now a right hand's part
         thinned = thin_hand(part, hand, spec, "lowest" if hand == "left" else "highest")
         keyboard = keyboard_for(thinned)
-        reduced = reduce_part(thinned.with_hands(None), keyboard, spec, f"the {hand} hand's part").piece
+        reduced = _reduce(thinned.with_hands(None), keyboard, spec, hand)
         fingered, plan = ensure_fingering(reduced, keyboard, spec, refinger=refinger)
         fingered = fingered.with_hands("right")
         notes.extend((fingered.mirror() if hand == "left" else fingered).notes)
