@@ -131,3 +131,11 @@ def test_a_left_hand_chord_too_wide_keeps_its_bass_and_says_so_for_the_left_hand
     assert lines == [
         "the left hand's part has chords wider than this hand reaches: kept their lowest notes, dropped 1 upper note(s)"
     ]
+
+
+def test_given_hands_that_cross_inside_a_chord_are_one_clear_error():
+    from pianobot.errors import PianobotError
+
+    crossed = Piece.of([*notes(("C5", 0, 1), hand="left"), *notes(("C4", 0, 1), hand="right")])
+    with pytest.raises(PianobotError, match="hands that cross"):
+        assign_hands(crossed)

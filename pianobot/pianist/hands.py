@@ -45,11 +45,11 @@ from pathlib import Path
 
 import numpy as np
 
-from pianobot.errors import PianobotWarning
+from pianobot.errors import PianobotError, PianobotWarning
 from pianobot.music.instrument import HandSpec, KeyboardSpec, keyboard_for
 from pianobot.music.load import CHORD_SPREAD, LEGATO_OVERLAP, LoadOptions, load_hands, thin_hand
 from pianobot.music.piece import Note, Piece, mirror_pitch
-from pianobot.pianist.fingering import FingeringPlan, ensure_fingering
+from pianobot.pianist.fingering import FingeringPlan, Planner, ensure_fingering
 from pianobot.pianist.reduce import reduce_part
 from pianobot.sim.hand import HandConfig
 from pianobot.sim.keyboard import KeyboardConfig
@@ -96,9 +96,7 @@ def _reaches(pitches: tuple[int, ...], fingers: tuple[int, ...]) -> bool:
 
 
 @lru_cache(maxsize=8)
-def _planner(fingers: tuple[int, ...]):
-    from pianobot.pianist.fingering import Planner
-
+def _planner(fingers: tuple[int, ...]) -> Planner:
     return Planner(KeyboardConfig(spec=_REACH_KEYS), HandConfig(spec=HandSpec(fingers)))
 
 
@@ -172,7 +170,12 @@ def _local_cost(chord: list[Note], k: int, spec: HandSpec, middle: float | None)
 
 def span(spec: HandSpec) -> int:
     """The widest interval (semitones) the planner lets one hand position hold with ``spec``'s fingers."""
-    return max(d for d in range(1, 25) if _reaches((60, 60 + d), spec.fingers)) if len(spec.fingers) > 1 else 0
+    return _span(spec.fingers)
+
+
+@lru_cache(maxsize=8)
+def _span(fingers: tuple[int, ...]) -> int:
+    return max((d for d in range(1, 25) if _reaches((60, 60 + d), fingers)), default=0)
 
 
 Window = tuple[int, int]
@@ -249,7 +252,10 @@ def assign_hands(piece: Piece, spec: HandSpec = HandSpec()) -> HandAssignment:
                         best = _State(total, b, *new)
             layer.append(best)
         if all(s is None for s in layer):  # notes fixed to hands that cross inside one chord
-            raise ValueError(f"the notes at {chord[0].onset:.3f} s have hands that cross")
+            raise PianobotError(
+                f"the notes at {chord[0].onset:.3f} s have hands that cross (a left-hand note at or above a "
+                "right-hand one): the robot's two hands cannot cross"
+            )
         layers.append(layer)
         previous = layer
     if not layers:
