@@ -10,7 +10,8 @@ from pianobot.errors import PianobotError, PianobotWarning
 from pianobot.music.duets import TEXTURES, duet_set, random_duet
 from pianobot.music.instrument import KeyboardSpec
 from pianobot.music.piece import Note, Piece
-from pianobot.perform.hands import Window, play_hands, window_for
+from pianobot.music.window import Window, window_for
+from pianobot.perform.hands import play_hands
 
 BLACK = {1, 3, 6, 8, 10}
 

@@ -30,47 +30,11 @@ from pianobot.errors import PianobotError, PianobotWarning
 from pianobot.music.instrument import HandSpec, KeyboardSpec
 from pianobot.music.load import thin_chords
 from pianobot.music.metrics import Report, compare
-from pianobot.music.piece import HANDS, Note, Piece, mirror_pitch
+from pianobot.music.piece import HANDS, Note, Piece
+from pianobot.music.window import Window, window_for
 from pianobot.perform.plan import Performance, play
 from pianobot.pianist.fingering import ensure_fingering
 from pianobot.pianist.reduce import reduce_part
-
-OCTAVE = 12
-
-
-@dataclass(frozen=True)
-class Window:
-    """Where a hand's part is played: ``hand``'s notes, mirrored for the left hand, moved by
-    ``octaves`` whole octaves onto ``keyboard``."""
-
-    hand: str
-    keyboard: KeyboardSpec
-    octaves: int
-
-    def inward(self, pitch: int) -> int:
-        """A written pitch of this hand -> the key the simulated (right) hand plays."""
-        return (mirror_pitch(pitch) if self.hand == "left" else pitch) + OCTAVE * self.octaves
-
-    def outward(self, pitch: int) -> int:
-        """A key the simulated hand played -> the written pitch it stands for."""
-        moved = pitch - OCTAVE * self.octaves
-        return mirror_pitch(moved) if self.hand == "left" else moved
-
-
-def window_for(part: Piece, hand: str, keyboard: KeyboardSpec | None) -> Window:
-    """The window for ``hand``'s ``part``: on ``keyboard`` (a policy's) the octave shift that keeps
-    the most notes on it (the lower shift on a tie); with ``keyboard`` None, the part's own range
-    rounded out to octaves (every note kept)."""
-    plain = Window(hand, KeyboardSpec(), 0)
-    pitches = [plain.inward(n.pitch) for n in part.notes]
-    if keyboard is None:
-        low = min(pitches) - min(pitches) % OCTAVE
-        high = max(pitches) + OCTAVE - 1 - max(pitches) % OCTAVE
-        return Window(hand, KeyboardSpec(low, min(88, high - low + 1)), 0)
-    spans = range(-10, 11)
-    kept = {k: sum(p + OCTAVE * k in keyboard for p in pitches) for k in spans}
-    best = max(spans, key=lambda k: (kept[k], -abs(k)))
-    return Window(hand, keyboard, best)
 
 
 @dataclass(frozen=True)
