@@ -82,3 +82,20 @@ def test_random_duets_are_seeded_and_keep_the_hands_apart():
         assert max(n.pitch for n in left.notes) < min(n.pitch for n in right.notes)
         chords = max(len(c) for c in left.chords())
         assert chords == {"block": 3, "voices": 2}.get(texture, 1), texture
+
+
+def test_the_parts_family_draws_fingered_hand_phrases_and_melodies_by_its_seed():
+    from pianobot.agent.tasks import task_sampler
+    from pianobot.env.piano import EnvConfig
+    from pianobot.music.tasks import FAMILIES, PARTS
+
+    assert PARTS in FAMILIES
+    draw = task_sampler(PARTS, EnvConfig())
+    pieces = [draw(np.random.default_rng(seed)) for seed in range(40)]
+    assert pieces == [draw(np.random.default_rng(seed)) for seed in range(40)]
+    keys = KeyboardSpec()
+    for piece in pieces:
+        assert piece.has_fingering and all(n.pitch in keys and n.finger in (2, 3, 4) for n in piece.notes)
+        assert len(piece) <= 6 and piece.notes[0].onset == 0.0
+    # held notes under a moving voice and three-note chords: what melodies alone seldom hold
+    assert sum(p.max_polyphony()[0] >= 2 for p in pieces) >= 8

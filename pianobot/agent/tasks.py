@@ -1,7 +1,8 @@
 """Task families by name, as the environment takes them: a sampler that draws a fingered piece.
 
 The paper's five families (:mod:`pianobot.music.tasks`) are fingered by construction. The
-``melody`` family draws a phrase with :func:`pianobot.music.melodies.random_phrase` and fingers it
+``parts`` family (:func:`draw_part`) draws a hand's phrase of a random two-hand piece, or a melody
+phrase. The ``melody`` family draws a phrase with :func:`pianobot.music.melodies.random_phrase` and fingers it
 with the fingering planner (:mod:`pianobot.pianist.fingering`); a phrase the planner says this
 hand cannot play (it reports problems, or raises an error) is drawn again, with the next draw of
 the same generator, so the environment's seed fixes every instance. The environment cannot do
@@ -18,10 +19,13 @@ import numpy as np
 
 from pianobot.env.piano import EnvConfig, PianoEnv, Sampler
 from pianobot.errors import PianobotError
+from pianobot.music.duets import random_duet
 from pianobot.music.instrument import check_playable
 from pianobot.music.melodies import MelodyKey, random_phrase
-from pianobot.music.piece import Piece
-from pianobot.music.tasks import FAMILIES, MELODY, TASKS, make_task
+from pianobot.music.phrases import DEFAULT_MAX_NOTES, split_phrases
+from pianobot.music.piece import HANDS, Note, Piece
+from pianobot.music.tasks import FAMILIES, MELODY, PARTS, TASKS, make_task
+from pianobot.music.window import window_for
 from pianobot.pianist.fingering import plan_fingering
 
 MAX_DRAWS = 1_000
@@ -48,11 +52,50 @@ def draw_melody(rng: np.random.Generator, config: EnvConfig = EnvConfig(), key: 
     )
 
 
+PART_SHARE = 0.5
+"""The share of the ``parts`` family's instances that are a phrase of a two-hand piece's hand; the
+rest are ``melody`` instances, so a policy trained on it keeps playing melodies."""
+
+
+def draw_part(rng: np.random.Generator, config: EnvConfig = EnvConfig()) -> Piece:
+    """One instance of the ``parts`` family (:data:`~pianobot.music.tasks.PARTS`): with chance
+    :data:`PART_SHARE` a phrase of one hand of a :func:`~pianobot.music.duets.random_duet`, given to
+    this hand through its window (:mod:`pianobot.music.window`: the left hand's part mirrored, both
+    moved by octaves onto the keyboard; notes that still lie off it are left out), the first one the
+    planner fingers without problems; else a ``melody`` instance."""
+    if rng.random() >= PART_SHARE:
+        return draw_melody(rng, config)
+    keyboard, hand = config.world.keyboard, config.world.hand
+    for _ in range(MAX_DRAWS):
+        side = HANDS[int(rng.integers(len(HANDS)))]
+        part = random_duet(rng).part(side)
+        window = window_for(part, side, keyboard.spec)
+        inside = [Note(n.onset, window.inward(n.pitch), n.offset, n.velocity) for n in part.notes]
+        inside = [n for n in inside if n.pitch in keyboard.spec]
+        if not inside:
+            continue
+        phrases = split_phrases(Piece(tuple(inside), bpm=part.bpm), DEFAULT_MAX_NOTES)
+        phrase = phrases[int(rng.integers(len(phrases)))].piece()
+        try:
+            check_playable(phrase, keyboard.spec, hand.spec)
+            plan = plan_fingering(phrase, keyboard, hand)
+        except PianobotError:  # a chord wider than the hand, notes it cannot get to
+            continue
+        if not plan.problems:
+            return plan.piece
+    raise PianobotError(
+        f"no hand part in {MAX_DRAWS} draws that this hand can play on {keyboard.spec.describe()}: "
+        "widen the keyboard or give the hand more fingers"
+    )
+
+
 def task_sampler(name: str, config: EnvConfig = EnvConfig()) -> Sampler:
     """The sampler of the task family ``name`` (one of :data:`~pianobot.music.tasks.FAMILIES`)
     in the environment ``config`` describes: a function from a generator to a fingered piece."""
     if name == MELODY:
         return partial(draw_melody, config=config)
+    if name == PARTS:
+        return partial(draw_part, config=config)
     if name in TASKS:
         return partial(make_task, name, keyboard=config.world.keyboard.spec)
     raise ValueError(f"unknown task {name!r}: choose one of {', '.join(FAMILIES)}")

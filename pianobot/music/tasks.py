@@ -12,8 +12,9 @@ the hand moves at most :data:`MAX_SHIFT` white keys from one position to the nex
 across the whole keyboard between two legato notes is beyond what a 0.5 s score lookahead
 lets a hand prepare). A task instance is drawn from a NumPy generator, so a seed fixes it.
 
-Our ``melody`` family (random one-hand phrases in every key, :data:`MELODY`) needs the fingering
-planner, so :mod:`pianobot.agent.tasks` draws it; this module only names it.
+Our ``melody`` family (random one-hand phrases in every key, :data:`MELODY`) and ``parts`` family
+(:data:`PARTS`) need the fingering planner, so :mod:`pianobot.agent.tasks` draws them; this module
+only names them.
 """
 
 from __future__ import annotations
@@ -29,7 +30,12 @@ MELODY = "melody"
 """Our family of realistic one-hand phrases (:func:`pianobot.music.melodies.random_phrase`). Its
 instances are fingered by the fingering planner, which lies above the environment, so they are
 drawn by :mod:`pianobot.agent.tasks` and handed to the environment as a sampler."""
-FAMILIES = TASKS + (MELODY,)
+PARTS = "parts"
+"""Our family of one hand's phrases as two-hand music gives them: a melody phrase, or a phrase of
+a random two-hand piece's right or left hand (:mod:`pianobot.music.duets`: chords, a held note
+under a moving voice), the left hand's mirrored onto the right's keys. Drawn, like ``melody``, by
+:mod:`pianobot.agent.tasks`."""
+FAMILIES = TASKS + (MELODY, PARTS)
 """Every task family ``pianobot train --task`` trains on."""
 BPM = 60.0
 FINGERS = (2, 3, 4)
