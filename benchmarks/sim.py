@@ -127,7 +127,7 @@ PHASES = {
     "physics (stepSimulation: contacts, solver)": [(world_module.p, "stepSimulation")],
     "finger motors": [(world_module.PianoWorld, "_apply_action"), (world_module.PianoWorld, "_drive_fingers")],
     "keys (springs, sensor, state reads)": [
-        (world_module.PianoWorld, "_apply_spring"),
+        (world_module.PianoWorld, "_update_keys"),
         (world_module.PianoWorld, "key_state"),
         (world_module.PianoWorld, "touching"),
         (world_module.PianoWorld, "_colour_keys"),

@@ -92,3 +92,38 @@ def test_finger_joints_stay_within_their_limits_at_full_command(control):
             angles = world.hand_state()[2]
             assert np.all(angles >= low - 0.15) and np.all(angles <= high + 0.15)
     world.close()
+
+
+def _press(keyboard: KeyboardSpec, pitch: int, speed: float) -> tuple[list[tuple[int, int]], np.ndarray, np.ndarray]:
+    """The middle finger, over ``pitch``, flexes its knuckle at ``speed`` until a key sounds: the
+    note-ons (pitch, velocity), and every key's angle and the angle of each key the world read."""
+    from pianobot.env.piano import idle_pose
+    from pianobot.sim.bullet import p
+    from pianobot.sim.world import PianoWorld, WorldConfig
+
+    world = PianoWorld(WorldConfig(keyboard=KeyboardConfig(spec=keyboard)))
+    world.reset(world.boxes[keyboard.index(pitch)].center[0], np.tile(idle_pose(world.config), 3))
+    action = np.zeros(13)
+    action[5] = speed
+    notes = []
+    for _ in range(20):
+        notes += [(e.pitch, e.velocity) for e in world.step(action).events if e.on]
+        if notes:
+            break
+    read, _ = world.key_state()
+    actual = np.array([p.getJointState(body, 0, physicsClientId=world.client)[0] for body in world.keys])
+    world.close()
+    return notes, read, actual
+
+
+def test_a_key_sounds_the_same_on_a_whole_piano_and_only_the_pressed_key_moves():
+    """Each key is a body of its own, asleep while at rest: the same press on E4 gives the same note
+    on the paper's 24 keys and on 88 (A0-C8), the keys beside it (the black keys overlap the white
+    ones' boxes) do not move, and the key states the world reports are the keys' own."""
+    paper, piano = KeyboardSpec(), KeyboardSpec(21, 88)
+    notes, read, actual = _press(paper, 64, 0.6)
+    assert len(notes) == 1 and notes[0][0] == 64
+    assert _press(piano, 64, 0.6)[0] == notes
+    assert np.allclose(read, actual, atol=1e-4)
+    others = np.delete(actual, paper.index(64))
+    assert np.abs(others).max() < 1e-4

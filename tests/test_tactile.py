@@ -64,7 +64,7 @@ def test_ray_cast_agrees_with_pybullet_ray_test(pressing):
     ours = renderer.distances(position, rotation, angles, max_range=reach).ravel()
     starts, direction = renderer.rays(position, rotation)
     results = p.rayTestBatch(starts.tolist(), (starts + direction * reach).tolist(), physicsClientId=env.world.client)
-    theirs = np.array([r[2] * reach if r[0] == env.world.keyboard else np.inf for r in results])
+    theirs = np.array([r[2] * reach if r[0] in env.world.keys else np.inf for r in results])
     on_gel = renderer.on_gel.ravel()
     # compare where both see a key and the ray does not start inside one (Bullet ignores those)
     both = on_gel & np.isfinite(ours) & np.isfinite(theirs) & (ours > 0)

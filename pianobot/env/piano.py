@@ -28,6 +28,14 @@ says how older records are read):
 - v0: the finger targets carry the next note's velocity (``target_velocity``) and point at
   note onsets, with the time left to hold a held key (``target_onsets``); both can be turned
   off to reproduce the observations of policies trained before them.
+- v0, physics of 2026-11-24 (issue 39): every key is a body of its own, asleep while at rest and
+  untouched, instead of one body for the whole keyboard (whose joints' constraints cost the
+  solver a time that grew with the square of the keys). The keys' geometry, mass, hinge, limits
+  and spring are unchanged, and no setting changed, so a stored policy's manifest reads as
+  before; the solver now orders its work differently, which moves the finger joints by 0.004 rad
+  on average over a performance (as running the old keyboard at 45 solver iterations instead of
+  50 does) and now and then a note by one physics step or one velocity unit
+  (docs/simulator.md#world).
 """
 
 from __future__ import annotations

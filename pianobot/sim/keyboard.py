@@ -220,38 +220,44 @@ def key_x(config: KeyboardConfig, pitch: int) -> float:
     return key_boxes(config)[config.spec.index(pitch)].center[0]
 
 
-def keyboard_urdf(config: KeyboardConfig) -> str:
-    """URDF text of the keyboard: a fixed frame with one hinged box per key (limits at rest and
-    fully pressed), one element per line."""
+def key_colour(black: bool, sounding: bool) -> list[float]:
+    """A key's RGBA colour in rendered frames: sounding keys turn blue."""
+    if sounding:
+        return [0.1, 0.3, 0.8, 1] if black else [0.45, 0.65, 1.0, 1]
+    return [0.08, 0.08, 0.08, 1] if black else [0.95, 0.95, 0.92, 1]
+
+
+def key_urdf(config: KeyboardConfig, box: KeyBox) -> str:
+    """URDF text of one key as a body of its own: a fixed frame and the key's box on a hinge at the
+    frame's origin (the simulator places the body at the key's x), limited to [0, full travel];
+    one element per line (PyBullet rejects a URDF written as one long line)."""
     g = config.geometry
-    parts = ['<?xml version="1.0"?>', '<robot name="keyboard">']
-    parts.append(
-        '<link name="frame"><inertial><mass value="0"/><inertia ixx="0" iyy="0" izz="0" ixy="0" ixz="0" iyz="0"/></inertial></link>'
+    name = f"key_{box.pitch}"
+    size = " ".join(f"{2 * h:.5f}" for h in box.half)
+    origin = f'<origin xyz="0 {box.center[1]:.5f} {box.center[2]:.5f}"/>'
+    colour = " ".join(str(c) for c in key_colour(box.black, False))
+    m = config.key_mass
+    hx, hy, hz = (2 * h for h in box.half)
+    inertia = (
+        f'<inertia ixx="{m * (hy * hy + hz * hz) / 12:.3e}" iyy="{m * (hx * hx + hz * hz) / 12:.3e}" '
+        f'izz="{m * (hx * hx + hy * hy) / 12:.3e}" ixy="0" ixz="0" iyz="0"/>'
     )
-    for box in key_boxes(config):
-        name = f"key_{box.pitch}"
-        size = " ".join(f"{2 * h:.5f}" for h in box.half)
-        origin = f'<origin xyz="0 {box.center[1]:.5f} {box.center[2]:.5f}"/>'
-        colour = "0.08 0.08 0.08 1" if box.black else "0.95 0.95 0.92 1"
-        m = config.key_mass
-        hx, hy, hz = (2 * h for h in box.half)
-        inertia = (
-            f'<inertia ixx="{m * (hy * hy + hz * hz) / 12:.3e}" iyy="{m * (hx * hx + hz * hz) / 12:.3e}" '
-            f'izz="{m * (hx * hx + hy * hy) / 12:.3e}" ixy="0" ixz="0" iyz="0"/>'
-        )
-        parts += [
-            f'<link name="{name}">',
-            f'<inertial>{origin}<mass value="{m}"/>{inertia}</inertial>',
-            f'<visual>{origin}<geometry><box size="{size}"/></geometry><material name="{"black" if box.black else "white"}"><color rgba="{colour}"/></material></visual>',
-            f'<collision>{origin}<geometry><box size="{size}"/></geometry></collision>',
-            "</link>",
-            f'<joint name="{name}" type="revolute">',
-            f'<parent link="frame"/><child link="{name}"/>',
-            f'<origin xyz="{box.center[0]:.5f} 0 0"/><axis xyz="-1 0 0"/>',
-            f'<limit lower="0" upper="{g.max_angle:.5f}" effort="100" velocity="100"/>',
-            "</joint>",
-        ]
-    parts.append("</robot>")
+    parts = [
+        '<?xml version="1.0"?>',
+        f'<robot name="{name}">',
+        '<link name="frame"><inertial><mass value="0"/><inertia ixx="0" iyy="0" izz="0" ixy="0" ixz="0" iyz="0"/></inertial></link>',
+        f'<link name="{name}">',
+        f'<inertial>{origin}<mass value="{m}"/>{inertia}</inertial>',
+        f'<visual>{origin}<geometry><box size="{size}"/></geometry><material name="{"black" if box.black else "white"}"><color rgba="{colour}"/></material></visual>',
+        f'<collision>{origin}<geometry><box size="{size}"/></geometry></collision>',
+        "</link>",
+        f'<joint name="{name}" type="revolute">',
+        f'<parent link="frame"/><child link="{name}"/>',
+        '<origin xyz="0 0 0"/><axis xyz="-1 0 0"/>',
+        f'<limit lower="0" upper="{g.max_angle:.5f}" effort="100" velocity="100"/>',
+        "</joint>",
+        "</robot>",
+    ]
     return "\n".join(parts) + "\n"
 
 

@@ -18,7 +18,15 @@ from pianobot.config import check_ranges
 from pianobot.music.tensor import ScoreSpec
 from pianobot.sim.bullet import p
 from pianobot.sim.hand import HandConfig, hand_urdf, joint_limits, joint_names
-from pianobot.sim.keyboard import KeyboardConfig, KeyEvent, KeySensor, key_boxes, keyboard_urdf, keyboard_width
+from pianobot.sim.keyboard import (
+    KeyboardConfig,
+    KeyEvent,
+    KeySensor,
+    key_boxes,
+    key_colour,
+    key_urdf,
+    keyboard_width,
+)
 
 CONTROL_MODES = ("velocity", "position", "torque")
 LIMIT_STOP_TORQUE = 5.0
@@ -70,8 +78,22 @@ class StepResult:
     """Their note-on velocity (int, 0 where not pressed)."""
 
 
+RAY_GROUP, HAND_GROUP, KEY_GROUP = 1, 2, 4
+"""Collision groups: a key collides with the hands only (the keys' boxes overlap where the black
+keys sit between the white ones), a hand with the keys and with other hands; ray tests (in
+PyBullet's default group) see both."""
+KEY_AT_REST = (1e-4, 1e-3)
+"""A key whose angle (rad) and angular speed (rad/s) are both below these, and that no fingertip
+touches, is at rest: it sleeps (PyBullet leaves it out of the physics until a finger touches it)
+and is not read."""
+
+
 class PianoWorld:
-    """One PyBullet client holding the keyboard and the hand."""
+    """One PyBullet client holding the keys (one body each) and the hand.
+
+    Cost: the physics of a key no finger touches is skipped (it sleeps at rest), and only the
+    keys that move or are touched are read at each physics step, so a step costs what the hand
+    does, whatever the keyboard's size."""
 
     def __init__(self, config: WorldConfig = WorldConfig()):
         self.config = config
@@ -79,7 +101,6 @@ class PianoWorld:
         self.dt = 1.0 / config.physics_hz
         self.boxes = key_boxes(config.keyboard)
         self.width = keyboard_width(config.keyboard)
-        self.key_joints = list(range(len(self.boxes)))
         self.sensor = KeySensor(config.keyboard)
         self.time = 0.0
         self._finger_command = np.zeros(4 * len(config.hand.spec.fingers))
@@ -89,7 +110,7 @@ class PianoWorld:
 
     # -- construction ------------------------------------------------------------------------
     def _build(self) -> None:
-        """(Re)create the physics world: settings, keyboard and hand."""
+        """(Re)create the physics world: settings, keys and hand, everything at rest."""
         c = self.client
         p.resetSimulation(physicsClientId=c)
         p.setTimeStep(self.dt, physicsClientId=c)
@@ -98,28 +119,63 @@ class PianoWorld:
         # finger links sag under their motors.)
         p.setGravity(0, 0, 0, physicsClientId=c)
         p.setPhysicsEngineParameter(numSolverIterations=self.config.solver_iterations, physicsClientId=c)
-        self.keyboard = self._build_keyboard()
+        self.keys = self._build_keys()
+        self._key_of = {body: k for k, body in enumerate(self.keys)}
         self.hand, self.wrist_joint, self.finger_joints, self.tip_links = self._build_hand()
-        self._apply_spring(np.zeros(len(self.boxes)))
+        n, kb = len(self.keys), self.config.keyboard
+        self.key_angles, self.key_speeds = np.zeros(n), np.zeros(n)
+        self._moving: set[int] = set()  # keys not at rest: read at every physics step
+        self._contacts: tuple = ()  # the hand's contacts at the last physics step
+        self._spring = np.full(n, kb.spring_torque)
+        for body in self.keys:
+            self._set_spring(body, kb.spring_torque)
+            p.changeDynamics(body, 0, activationState=p.ACTIVATION_STATE_SLEEP, physicsClientId=c)
 
-    def _load_urdf(self, text: str, position: list[float]) -> int:
+    def _load_urdf(self, path: str, position: list[float]) -> int:
+        return p.loadURDF(path, basePosition=position, useFixedBase=True, physicsClientId=self.client)
+
+    def _urdf_file(self, text: str) -> str:
         fd, path = tempfile.mkstemp(prefix="pianobot_", suffix=".urdf")
-        try:
-            with os.fdopen(fd, "w") as f:
-                f.write(text)
-            return p.loadURDF(path, basePosition=position, useFixedBase=True, physicsClientId=self.client)
-        finally:
-            os.unlink(path)
+        with os.fdopen(fd, "w") as f:
+            f.write(text)
+        return path
 
-    def _build_keyboard(self) -> int:
-        body = self._load_urdf(keyboard_urdf(self.config.keyboard), [0, 0, 0])
-        for j in range(len(self.boxes)):
-            p.changeDynamics(body, j, linearDamping=0, angularDamping=0, physicsClientId=self.client)
-        return body
+    def _build_keys(self) -> list[int]:
+        """One body per key, each hinged at its x: a key's joint then costs the physics what one
+        joint costs (the keys of one body shared every joint's constraints, a cost that grew with
+        the square of the keys), and a key at rest can sleep."""
+        c, kb = self.client, self.config.keyboard
+        files = {}
+        bodies = []
+        try:
+            for box in self.boxes:
+                shape = (box.black, box.center[1:], box.half)  # a white or a black key
+                if shape not in files:
+                    files[shape] = self._urdf_file(key_urdf(kb, box))
+                body = self._load_urdf(files[shape], [box.center[0], 0, 0])
+                p.changeDynamics(
+                    body,
+                    0,
+                    linearDamping=0,
+                    angularDamping=0,
+                    activationState=p.ACTIVATION_STATE_ENABLE_SLEEPING,
+                    physicsClientId=c,
+                )
+                for link in (-1, 0):
+                    p.setCollisionFilterGroupMask(body, link, KEY_GROUP, HAND_GROUP | RAY_GROUP, physicsClientId=c)
+                bodies.append(body)
+        finally:
+            for path in files.values():
+                os.unlink(path)
+        return bodies
 
     def _build_hand(self) -> tuple[int, int, list[int], dict[int, int]]:
         c, hand = self.client, self.config.hand
-        body = self._load_urdf(hand_urdf(hand, rail=(0.0, self.width)), [0, hand.palm_y, hand.palm_height])
+        path = self._urdf_file(hand_urdf(hand, rail=(0.0, self.width)))
+        try:
+            body = self._load_urdf(path, [0, hand.palm_y, hand.palm_height])
+        finally:
+            os.unlink(path)
         index = {
             p.getJointInfo(body, j, physicsClientId=c)[1].decode(): j
             for j in range(p.getNumJoints(body, physicsClientId=c))
@@ -131,14 +187,16 @@ class PianoWorld:
             p.changeDynamics(body, j, linearDamping=0, angularDamping=0, physicsClientId=c)
         for link in tips.values():
             p.changeDynamics(body, link, lateralFriction=0.8, physicsClientId=c)
+        for link in range(-1, p.getNumJoints(body, physicsClientId=c)):
+            p.setCollisionFilterGroupMask(body, link, HAND_GROUP, KEY_GROUP | HAND_GROUP | RAY_GROUP, physicsClientId=c)
         return body, index["wrist"], fingers, tips
 
     # -- state -------------------------------------------------------------------------------
     def reset(self, wrist: float, finger_angles: np.ndarray) -> None:
         """Put the hand at ``wrist`` (m along the keyboard) with the given joint angles, keys at rest."""
         c = self.client
-        # a fresh world (6 ms): no contact cache or solver warm start carries over, so an
-        # episode does not depend on the ones before it
+        # a fresh world: no contact cache or solver warm start carries over, so an episode does
+        # not depend on the ones before it (tested; PyBullet's saveState/restoreState left some)
         self._build()
         p.resetJointState(self.hand, self.wrist_joint, wrist, 0.0, physicsClientId=c)
         for j, angle in zip(self.finger_joints, finger_angles):
@@ -148,25 +206,13 @@ class PianoWorld:
         # no speed, no torque, or (position control) the angles it starts at
         position = self.config.control == "position"
         self._finger_command = np.array(finger_angles, dtype=float) if position else np.zeros(len(self.finger_joints))
-        self._hold(finger_angles, wrist)
-
-    def _hold(self, finger_angles: np.ndarray, wrist: float) -> None:
-        """Motors hold the current pose until the first action arrives."""
-        c, hand = self.client, self.config.hand
-        self._drive_wrist(p.POSITION_CONTROL, targetPosition=wrist)
-        p.setJointMotorControlArray(
-            self.hand,
-            self.finger_joints,
-            p.VELOCITY_CONTROL,
-            targetVelocities=[0.0] * len(self.finger_joints),
-            forces=[hand.joint_force] * len(self.finger_joints),
-            physicsClientId=c,
-        )
+        self._drive_wrist(p.POSITION_CONTROL, targetPosition=wrist)  # motors hold the pose until the first action
+        self._finger_motors(p.VELOCITY_CONTROL, targetVelocities=np.zeros(len(self.finger_joints)))
 
     def key_state(self) -> tuple[np.ndarray, np.ndarray]:
-        """Key angles (rad) and angular speeds (rad/s)."""
-        states = p.getJointStates(self.keyboard, self.key_joints, physicsClientId=self.client)
-        return np.array([s[0] for s in states]), np.array([s[1] for s in states])
+        """Key angles (rad) and angular speeds (rad/s), as of the last physics step (a key at rest
+        reads as it was when it came to rest)."""
+        return self.key_angles.copy(), self.key_speeds.copy()
 
     def hand_state(self) -> tuple[float, float, np.ndarray, np.ndarray]:
         """Wrist position (m) and speed (m/s), finger joint angles and speeds."""
@@ -175,14 +221,18 @@ class PianoWorld:
         states = p.getJointStates(self.hand, self.finger_joints, physicsClientId=c)
         return wrist[0], wrist[1], np.array([s[0] for s in states]), np.array([s[1] for s in states])
 
+    def _key_contacts(self) -> list[tuple[int, int, float]]:
+        """(key index, hand link, normal force) of every contact between the hand and a key now."""
+        key_of = self._key_of
+        return [(key_of[ct[2]], ct[3], ct[9]) for ct in self._contacts if ct[2] in key_of]
+
     def touching(self) -> dict[int, tuple[int, float]]:
         """Key index -> (finger, normal force) for every key a fingertip presses on now."""
         out: dict[int, tuple[int, float]] = {}
         finger_of = {link: f for f, link in self.tip_links.items()}
-        for contact in p.getContactPoints(self.hand, self.keyboard, physicsClientId=self.client):
-            finger = finger_of.get(contact[3])
-            key, force = contact[4], contact[9]
-            if finger is not None and key >= 0 and force > out.get(key, (0, 0.0))[1]:
+        for key, link, force in self._key_contacts():
+            finger = finger_of.get(link)
+            if finger is not None and force > out.get(key, (0, 0.0))[1]:
                 out[key] = (finger, force)
         return out
 
@@ -201,10 +251,10 @@ class PianoWorld:
         """Total normal force (N) on each fingertip from the keys."""
         forces = {f: 0.0 for f in self.tip_links}
         finger_of = {link: f for f, link in self.tip_links.items()}
-        for contact in p.getContactPoints(self.hand, self.keyboard, physicsClientId=self.client):
-            finger = finger_of.get(contact[3])
+        for _, link, force in self._key_contacts():
+            finger = finger_of.get(link)
             if finger is not None:
-                forces[finger] += contact[9]
+                forces[finger] += force
         return forces
 
     def link_pose(self, link: int) -> tuple[np.ndarray, np.ndarray]:
@@ -214,23 +264,48 @@ class PianoWorld:
         return np.array(state[4]), rotation
 
     # -- stepping ----------------------------------------------------------------------------
-    def _apply_spring(self, angles: np.ndarray) -> None:
-        """The keys' return spring: a motor driving back to rest whose torque limit grows with depth."""
+    def _set_spring(self, body: int, torque: float) -> None:
+        """A key's return spring: a motor driving back to rest with at most ``torque``."""
         kb = self.config.keyboard
-        depth = np.clip(angles / kb.geometry.max_angle, 0.0, 1.0)
-        torque = kb.spring_torque + (kb.spring_torque_pressed - kb.spring_torque) * depth**2
-        p.setJointMotorControlArray(
-            self.keyboard,
-            self.key_joints,
+        p.setJointMotorControl2(
+            body,
+            0,
             p.POSITION_CONTROL,
-            targetPositions=[0.0] * len(self.key_joints),
-            positionGains=[kb.spring_gain] * len(self.key_joints),
-            forces=torque.tolist(),
+            targetPosition=0.0,
+            positionGain=kb.spring_gain,
+            force=torque,
             physicsClientId=self.client,
         )
 
+    def _update_keys(self) -> list[int]:
+        """After a physics step: read the keys that move or are touched, retune their springs (the
+        torque limit grows with depth), put those back at rest to sleep. Returns the keys read."""
+        c, kb = self.client, self.config.keyboard
+        self._contacts = p.getContactPoints(bodyA=self.hand, physicsClientId=c)
+        touched = {key for key, _, _ in self._key_contacts()}
+        read = sorted(self._moving | touched)
+        if not read:
+            return read
+        for k in read:
+            self.key_angles[k], self.key_speeds[k] = p.getJointState(self.keys[k], 0, physicsClientId=c)[:2]
+        angles = self.key_angles[read]
+        depth = np.clip(angles / kb.geometry.max_angle, 0.0, 1.0)
+        torque = kb.spring_torque + (kb.spring_torque_pressed - kb.spring_torque) * depth**2
+        rest_angle, rest_speed = KEY_AT_REST
+        resting = (np.abs(angles) < rest_angle) & (np.abs(self.key_speeds[read]) < rest_speed)
+        for k, tau, still in zip(read, torque, resting):
+            if tau != self._spring[k]:
+                self._spring[k] = tau
+                self._set_spring(self.keys[k], tau)
+            if still and k not in touched:
+                self._moving.discard(k)
+                p.changeDynamics(self.keys[k], 0, activationState=p.ACTIVATION_STATE_SLEEP, physicsClientId=c)
+            else:
+                self._moving.add(k)
+        return read
+
     def _apply_action(self, action: np.ndarray) -> None:
-        cfg, hand, c = self.config, self.config.hand, self.client
+        cfg, hand = self.config, self.config.hand
         n = len(self.finger_joints)
         action = np.asarray(action, dtype=float)
         if action.shape != (n + 1,):
@@ -244,9 +319,7 @@ class PianoWorld:
             self._finger_command = low + (fingers + 1.0) / 2.0 * (high - low)
         else:
             self._finger_command = fingers * hand.max_joint_torque
-            p.setJointMotorControlArray(
-                self.hand, self.finger_joints, p.VELOCITY_CONTROL, forces=[0.0] * n, physicsClientId=c
-            )
+            self._finger_motors(p.VELOCITY_CONTROL, forces=np.zeros(n))
         if cfg.discrete_wrist:
             target = self.discrete_wrist_position(wrist)
             self._drive_wrist(p.POSITION_CONTROL, targetPosition=target, maxVelocity=hand.max_wrist_speed)
@@ -265,6 +338,14 @@ class PianoWorld:
             **target,
         )
 
+    def _finger_motors(self, mode: int, **arrays: np.ndarray) -> None:
+        """Every finger joint's motor in ``mode`` (velocity motors at most the hand's joint force,
+        unless ``forces`` says otherwise)."""
+        if mode == p.VELOCITY_CONTROL and "forces" not in arrays:
+            arrays["forces"] = np.full(len(self.finger_joints), self.config.hand.joint_force)
+        lists = {name: np.asarray(values, dtype=float).tolist() for name, values in arrays.items()}
+        p.setJointMotorControlArray(self.hand, self.finger_joints, mode, physicsClientId=self.client, **lists)
+
     def _drive_fingers(self, torque: bool, left: int) -> None:
         """Apply the finger command for one physics step, never driving a joint past its limit.
         ``left``: physics steps left in the control step, this one included.
@@ -277,8 +358,8 @@ class PianoWorld:
         links far past them (we saw the PIP joint at -1.5 rad against a limit of -0.17). So the
         commanded speed is clipped to what reaches the limit within one physics step, and a
         joint that would pass a limit under torque control is held at it by a motor."""
-        c, hand = self.client, self.config.hand
-        states = p.getJointStates(self.hand, self.finger_joints, physicsClientId=c)
+        hand = self.config.hand
+        states = p.getJointStates(self.hand, self.finger_joints, physicsClientId=self.client)
         q = np.array([s[0] for s in states])
         low, high = self.joint_limits
         # speeds that reach a limit within this physics step, and no further
@@ -287,36 +368,18 @@ class PianoWorld:
             command = self._finger_command
             if self.config.control == "position":  # at the speed that reaches the target at the control step's end
                 command = np.clip((command - q) / (left * self.dt), -hand.max_joint_speed, hand.max_joint_speed)
-            speed = np.clip(command, slowest, fastest)
-            p.setJointMotorControlArray(
-                self.hand,
-                self.finger_joints,
-                p.VELOCITY_CONTROL,
-                targetVelocities=speed.tolist(),
-                forces=[hand.joint_force] * len(q),
-                physicsClientId=c,
-            )
+            self._finger_motors(p.VELOCITY_CONTROL, targetVelocities=np.clip(command, slowest, fastest))
             return
         # torque control, except for joints that would pass a limit within this step: a motor holds those at it
         velocity = np.array([s[1] for s in states])
         tau = self._finger_command
         guard = (velocity > fastest) | (velocity < slowest) | ((q >= high) & (tau > 0)) | ((q <= low) & (tau < 0))
-        speed = np.clip(0.0, slowest, fastest)
-        p.setJointMotorControlArray(
-            self.hand,
-            self.finger_joints,
+        self._finger_motors(
             p.VELOCITY_CONTROL,
-            targetVelocities=speed.tolist(),
-            forces=np.where(guard, LIMIT_STOP_TORQUE, 0.0).tolist(),
-            physicsClientId=c,
+            targetVelocities=np.clip(0.0, slowest, fastest),
+            forces=np.where(guard, LIMIT_STOP_TORQUE, 0.0),
         )
-        p.setJointMotorControlArray(
-            self.hand,
-            self.finger_joints,
-            p.TORQUE_CONTROL,
-            forces=np.where(guard, 0.0, tau).tolist(),
-            physicsClientId=c,
-        )
+        self._finger_motors(p.TORQUE_CONTROL, forces=np.where(guard, 0.0, tau))
 
     def discrete_wrist_position(self, action: float) -> float:
         """The white-key position that a wrist action in [-1, 1] selects."""
@@ -332,25 +395,24 @@ class PianoWorld:
         pressed = self.sensor.sounding.copy()
         pressed_velocity = self.sensor.velocity.copy()
         torque = self.config.control == "torque"
+        lowest = self.config.keyboard.spec.lowest
         for substep in range(self.config.substeps):
             self._drive_fingers(torque, self.config.substeps - substep)
             p.stepSimulation(physicsClientId=self.client)
             self.time += self.dt
-            angles, speeds = self.key_state()
-            new = self.sensor.update(self.time, angles, speeds)
+            if not self._update_keys():
+                continue  # every key at rest: nothing can sound or release
+            new = self.sensor.update(self.time, self.key_angles, self.key_speeds)
             if new:
-                touch = None
+                touch = self.touching()
                 for event in new:
-                    if event.on:
-                        touch = touch if touch is not None else self.touching()
-                        key = event.pitch - self.config.keyboard.spec.lowest
-                        if key in touch:
-                            fingers[event.pitch] = touch[key][0]
+                    key = event.pitch - lowest
+                    if event.on and key in touch:
+                        fingers[event.pitch] = touch[key][0]
                 events += new
                 self._colour_keys(new)
-            pressed |= self.sensor.sounding
-            pressed_velocity = np.maximum(pressed_velocity, self.sensor.velocity)
-            self._apply_spring(angles)
+                pressed |= self.sensor.sounding
+                pressed_velocity = np.maximum(pressed_velocity, self.sensor.velocity)
         return StepResult(events, fingers, pressed, pressed_velocity)
 
     # -- images ------------------------------------------------------------------------------
@@ -358,12 +420,9 @@ class PianoWorld:
         """Sounding keys turn blue, so pressed keys show in frames and videos."""
         lowest = self.config.keyboard.spec.lowest
         for event in events:
-            box = self.boxes[event.pitch - lowest]
-            if event.on:
-                colour = [0.1, 0.3, 0.8, 1] if box.black else [0.45, 0.65, 1.0, 1]
-            else:
-                colour = [0.08, 0.08, 0.08, 1] if box.black else [0.95, 0.95, 0.92, 1]
-            p.changeVisualShape(self.keyboard, event.pitch - lowest, rgbaColor=colour, physicsClientId=self.client)
+            key = event.pitch - lowest
+            colour = key_colour(self.boxes[key].black, event.on)
+            p.changeVisualShape(self.keys[key], 0, rgbaColor=colour, physicsClientId=self.client)
 
     def render(self, width: int = 480, height: int = 320) -> np.ndarray:
         """An RGB frame (height, width, 3) from a camera above the pianist's side of the keyboard.
