@@ -8,7 +8,7 @@ import pytest
 
 from pianobot.errors import PianobotError, PianobotWarning
 from pianobot.music.duets import TEXTURES, duet_set, random_duet
-from pianobot.music.instrument import KeyboardSpec
+from pianobot.music.instrument import HandSpec, KeyboardSpec, check_playable
 from pianobot.music.piece import Note, Piece
 from pianobot.music.window import Window, window_for
 from pianobot.perform.hands import play_hands
@@ -97,5 +97,6 @@ def test_the_parts_family_draws_fingered_hand_phrases_and_melodies_by_its_seed()
     for piece in pieces:
         assert piece.has_fingering and all(n.pitch in keys and n.finger in (2, 3, 4) for n in piece.notes)
         assert len(piece) <= 6 and piece.notes[0].onset == 0.0
+        check_playable(piece, keys, HandSpec())  # no finger asked to play while it holds a note
     # held notes under a moving voice and three-note chords: what melodies alone seldom hold
     assert sum(p.max_polyphony()[0] >= 2 for p in pieces) >= 8

@@ -79,6 +79,7 @@ def draw_part(rng: np.random.Generator, config: EnvConfig = EnvConfig()) -> Piec
         try:
             check_playable(phrase, keyboard.spec, hand.spec)
             plan = plan_fingering(phrase, keyboard, hand)
+            check_playable(plan.piece, keyboard.spec, hand.spec)  # no finger asked for two notes at once
         except PianobotError:  # a chord wider than the hand, notes it cannot get to
             continue
         if not plan.problems:
