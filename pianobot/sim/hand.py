@@ -157,11 +157,31 @@ def _joint(name: str, kind: str, parent: str, child: str, xyz: tuple, axis: str,
     )
 
 
-def hand_urdf(config: HandConfig, rail: tuple[float, float]) -> str:
-    """URDF text of the rail, the sliding palm and the fingers (one element per line: PyBullet
-    rejects a URDF written as one long line)."""
+SIDES = ("right", "left")
+"""A hand's side. The left hand is the right hand's mirror image across the plane x = wrist: its
+fingers in the mirrored places (the thumb on the high side) and its abduction axes reversed, so
+the same joint angles put every link at the mirror image of the right hand's."""
+
+
+def finger_base_x(finger: int, side: str = "right") -> float:
+    """Where a finger's base sits across the palm (m, along the keyboard, from the wrist)."""
+    return FINGER_BASE_X[finger] if side == "right" else -FINGER_BASE_X[finger]
+
+
+def thumb_side_reach(config: HandConfig) -> float:
+    """How far (m) a hand's finger bases and links reach from its wrist towards its thumb's side
+    (down the keyboard for the right hand, up for the left), with no abduction."""
+    return -min(FINGER_BASE_X[f] for f in config.spec.fingers) + config.geometry.link_radius
+
+
+def hand_urdf(config: HandConfig, rail: tuple[float, float], side: str = "right") -> str:
+    """URDF text of the rail, the sliding palm and the fingers of a ``side`` hand (one element per
+    line: PyBullet rejects a URDF written as one long line)."""
+    if side not in SIDES:
+        raise ValueError(f"a hand's side is one of {', '.join(SIDES)}; got {side!r}")
     g = config.geometry
-    parts = ['<?xml version="1.0"?>', '<robot name="allegro_like_right_hand">']
+    mirror = -1 if side == "left" else 1
+    parts = ['<?xml version="1.0"?>', f'<robot name="allegro_like_{side}_hand">']
     parts.append(
         '<link name="rail"><inertial><mass value="0"/><inertia ixx="0" iyy="0" izz="0" ixy="0" ixz="0" iyz="0"/></inertial></link>'
     )
@@ -171,7 +191,7 @@ def hand_urdf(config: HandConfig, rail: tuple[float, float]) -> str:
             [
                 '<link name="palm">',
                 f'<inertial><origin xyz="0 0.045 0.01"/><mass value="0.4"/>{_box_inertia(0.4, palm_size)}</inertial>',
-                f'<visual><origin xyz="-0.015 0.03 0.015"/><geometry><box size="{palm_size[0]} {palm_size[1]} {palm_size[2]}"/></geometry>'
+                f'<visual><origin xyz="{-0.015 * mirror} 0.03 0.015"/><geometry><box size="{palm_size[0]} {palm_size[1]} {palm_size[2]}"/></geometry>'
                 '<material name="palm"><color rgba="0.3 0.3 0.35 1"/></material></visual>',
                 "</link>",
             ]
@@ -187,8 +207,8 @@ def hand_urdf(config: HandConfig, rail: tuple[float, float]) -> str:
                 "revolute",
                 "palm",
                 f"{prefix}_base",
-                (FINGER_BASE_X[f], FINGER_BASE_Y[f], 0.0),
-                "0 0 1",
+                (finger_base_x(f, side), FINGER_BASE_Y[f], 0.0),
+                f"0 0 {mirror}",
                 (-g.abduction_limit, g.abduction_limit),
             )
         )

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import os
 import tempfile
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -17,7 +18,7 @@ import numpy as np
 from pianobot.config import check_ranges
 from pianobot.music.tensor import ScoreSpec
 from pianobot.sim.bullet import p
-from pianobot.sim.hand import HandConfig, hand_urdf, joint_limits, joint_names
+from pianobot.sim.hand import SIDES, HandConfig, hand_urdf, joint_limits, joint_names, thumb_side_reach
 from pianobot.sim.keyboard import (
     KeyboardConfig,
     KeyEvent,
@@ -76,6 +77,23 @@ class StepResult:
     """Keys that sounded at any time during the step (bool, one per key)."""
     pressed_velocity: np.ndarray
     """Their note-on velocity (int, 0 where not pressed)."""
+    hands: dict[int, int] = field(default_factory=dict)
+    """For every note-on in ``fingers``: pitch -> the index (in ``PianoWorld.hands``) of the hand
+    whose finger it was."""
+
+
+@dataclass(frozen=True)
+class HandBody:
+    """One hand in the world: its side, body, and the joints and links the world drives and reads."""
+
+    side: str
+    body: int
+    wrist: int
+    """The wrist's (prismatic) joint."""
+    fingers: tuple[int, ...]
+    """The finger joints, in action order."""
+    tips: dict[int, int]
+    """Finger -> the link of its fingertip (the distal link)."""
 
 
 RAY_GROUP, HAND_GROUP, KEY_GROUP = 1, 2, 4
@@ -89,28 +107,59 @@ and is not read."""
 
 
 class PianoWorld:
-    """One PyBullet client holding the keys (one body each) and the hand.
+    """One PyBullet client holding the keys (one body each) and one hand, or two.
+
+    ``hands``: the sides of the hands, in the order their actions come: ("right",) (default), or
+    ("right", "left"), the left hand being the right's mirror image (:data:`~pianobot.sim.hand.SIDES`).
+    Each hand slides on its own rail along the whole keyboard; the two never cross: the world
+    keeps the right wrist at least :attr:`min_separation` above the left one (so their finger
+    bases never meet), and their links collide with each other's (so abducted fingers touch
+    rather than pass).
 
     Cost: the physics of a key no finger touches is skipped (it sleeps at rest), and only the
-    keys that move or are touched are read at each physics step, so a step costs what the hand
-    does, whatever the keyboard's size."""
+    keys that move or are touched are read at each physics step, so a step costs what the hands
+    do, whatever the keyboard's size."""
 
-    def __init__(self, config: WorldConfig = WorldConfig()):
+    def __init__(self, config: WorldConfig = WorldConfig(), hands: tuple[str, ...] = ("right",)):
+        if not 1 <= len(hands) <= 2 or len(set(hands)) != len(hands) or set(hands) - set(SIDES):
+            raise ValueError(f"hands must be one or two different sides of {', '.join(SIDES)}; got {hands}")
         self.config = config
+        self.sides = tuple(hands)
         self.client = p.connect(p.GUI if config.gui else p.DIRECT)
         self.dt = 1.0 / config.physics_hz
         self.boxes = key_boxes(config.keyboard)
         self.width = keyboard_width(config.keyboard)
         self.sensor = KeySensor(config.keyboard)
+        self.joint_limits = joint_limits(config.hand)
+        """(2, 4F): every finger joint's lower and upper limit (rad), for each hand alike."""
+        self.min_separation = 2 * thumb_side_reach(config.hand)
+        """Least distance (m) between two hands' wrists, the right one above."""
         self.time = 0.0
-        self._finger_command = np.zeros(4 * len(config.hand.spec.fingers))
+        self._finger_command = np.zeros((len(hands), 4 * len(config.hand.spec.fingers)))
         self._build()
         if config.gui:
             p.resetDebugVisualizerCamera(0.45, 180, -60, [self.width / 2, 0.11, 0], physicsClientId=self.client)
 
+    # the first hand's body and joints (all there is of a one-hand world)
+    @property
+    def hand(self) -> int:
+        return self.hands[0].body
+
+    @property
+    def wrist_joint(self) -> int:
+        return self.hands[0].wrist
+
+    @property
+    def finger_joints(self) -> list[int]:
+        return list(self.hands[0].fingers)
+
+    @property
+    def tip_links(self) -> dict[int, int]:
+        return self.hands[0].tips
+
     # -- construction ------------------------------------------------------------------------
     def _build(self) -> None:
-        """(Re)create the physics world: settings, keys and hand, everything at rest."""
+        """(Re)create the physics world: settings, keys and hands, everything at rest."""
         c = self.client
         p.resetSimulation(physicsClientId=c)
         p.setTimeStep(self.dt, physicsClientId=c)
@@ -121,11 +170,11 @@ class PianoWorld:
         p.setPhysicsEngineParameter(numSolverIterations=self.config.solver_iterations, physicsClientId=c)
         self.keys = self._build_keys()
         self._key_of = {body: k for k, body in enumerate(self.keys)}
-        self.hand, self.wrist_joint, self.finger_joints, self.tip_links = self._build_hand()
+        self.hands = [self._build_hand(side) for side in self.sides]
         n, kb = len(self.keys), self.config.keyboard
         self.key_angles, self.key_speeds = np.zeros(n), np.zeros(n)
         self._moving: set[int] = set()  # keys not at rest: read at every physics step
-        self._contacts: tuple = ()  # the hand's contacts at the last physics step
+        self._contacts: list[tuple[int, int, int, float]] = []  # (key, hand, link, force) at the last physics step
         self._spring = np.full(n, kb.spring_torque)
         for body in self.keys:
             self._set_spring(body, kb.spring_torque)
@@ -169,9 +218,9 @@ class PianoWorld:
                 os.unlink(path)
         return bodies
 
-    def _build_hand(self) -> tuple[int, int, list[int], dict[int, int]]:
+    def _build_hand(self, side: str) -> HandBody:
         c, hand = self.client, self.config.hand
-        path = self._urdf_file(hand_urdf(hand, rail=(0.0, self.width)))
+        path = self._urdf_file(hand_urdf(hand, rail=(0.0, self.width), side=side))
         try:
             body = self._load_urdf(path, [0, hand.palm_y, hand.palm_height])
         finally:
@@ -180,8 +229,7 @@ class PianoWorld:
             p.getJointInfo(body, j, physicsClientId=c)[1].decode(): j
             for j in range(p.getNumJoints(body, physicsClientId=c))
         }
-        fingers = [index[name] for name in joint_names(hand.spec)]
-        self.joint_limits = joint_limits(hand)
+        fingers = tuple(index[name] for name in joint_names(hand.spec))
         tips = {f: index[f"f{f}_dip"] for f in hand.spec.fingers}  # the DIP joint's child is the distal link
         for j in [index["wrist"], *fingers]:
             p.changeDynamics(body, j, linearDamping=0, angularDamping=0, physicsClientId=c)
@@ -189,77 +237,89 @@ class PianoWorld:
             p.changeDynamics(body, link, lateralFriction=0.8, physicsClientId=c)
         for link in range(-1, p.getNumJoints(body, physicsClientId=c)):
             p.setCollisionFilterGroupMask(body, link, HAND_GROUP, KEY_GROUP | HAND_GROUP | RAY_GROUP, physicsClientId=c)
-        return body, index["wrist"], fingers, tips
+        return HandBody(side, body, index["wrist"], fingers, tips)
 
     # -- state -------------------------------------------------------------------------------
-    def reset(self, wrist: float, finger_angles: np.ndarray) -> None:
-        """Put the hand at ``wrist`` (m along the keyboard) with the given joint angles, keys at rest."""
+    def reset(self, wrist: float | Sequence[float], finger_angles: np.ndarray) -> None:
+        """Put each hand at its ``wrist`` position (m along the keyboard; one number for one hand)
+        with the given joint angles (every hand's, one after the other: or one hand's, for all),
+        keys at rest."""
         c = self.client
+        wrists = np.atleast_1d(np.asarray(wrist, dtype=float))
+        angles = np.asarray(finger_angles, dtype=float).reshape(-1, self._finger_command.shape[1])
+        if len(wrists) != len(self.sides) or len(angles) not in (1, len(self.sides)):
+            raise ValueError(f"give a wrist position for each of the {len(self.sides)} hands, and their joint angles")
+        angles = np.broadcast_to(angles, self._finger_command.shape)
+        self._check_apart(wrists)
         # a fresh world: no contact cache or solver warm start carries over, so an episode does
         # not depend on the ones before it (tested; PyBullet's saveState/restoreState left some)
         self._build()
-        p.resetJointState(self.hand, self.wrist_joint, wrist, 0.0, physicsClientId=c)
-        for j, angle in zip(self.finger_joints, finger_angles):
-            p.resetJointState(self.hand, j, float(angle), 0.0, physicsClientId=c)
+        for hand, x, q in zip(self.hands, wrists, angles):
+            p.resetJointState(hand.body, hand.wrist, x, 0.0, physicsClientId=c)
+            for j, angle in zip(hand.fingers, q):
+                p.resetJointState(hand.body, j, float(angle), 0.0, physicsClientId=c)
+            self._drive_wrist(hand, p.POSITION_CONTROL, targetPosition=x)  # motors hold the pose until the first action
+            self._finger_motors(hand, p.VELOCITY_CONTROL, targetVelocities=np.zeros(len(hand.fingers)))
         self.sensor.reset()
         self.time = 0.0
         # no speed, no torque, or (position control) the angles it starts at
-        position = self.config.control == "position"
-        self._finger_command = np.array(finger_angles, dtype=float) if position else np.zeros(len(self.finger_joints))
-        self._drive_wrist(p.POSITION_CONTROL, targetPosition=wrist)  # motors hold the pose until the first action
-        self._finger_motors(p.VELOCITY_CONTROL, targetVelocities=np.zeros(len(self.finger_joints)))
+        self._finger_command = angles.copy() if self.config.control == "position" else np.zeros(angles.shape)
+
+    def _check_apart(self, wrists: np.ndarray) -> None:
+        if len(self.sides) == 2:
+            low, high = wrists[self.sides.index("left")], wrists[self.sides.index("right")]
+            if high - low < self.min_separation - 1e-9:
+                raise ValueError(
+                    f"the right wrist ({high:.3f} m) must be at least {self.min_separation:.3f} m above the left ({low:.3f} m)"
+                )
 
     def key_state(self) -> tuple[np.ndarray, np.ndarray]:
         """Key angles (rad) and angular speeds (rad/s), as of the last physics step (a key at rest
         reads as it was when it came to rest)."""
         return self.key_angles.copy(), self.key_speeds.copy()
 
-    def hand_state(self) -> tuple[float, float, np.ndarray, np.ndarray]:
-        """Wrist position (m) and speed (m/s), finger joint angles and speeds."""
-        c = self.client
-        wrist = p.getJointState(self.hand, self.wrist_joint, physicsClientId=c)
-        states = p.getJointStates(self.hand, self.finger_joints, physicsClientId=c)
+    def hand_state(self, hand: int = 0) -> tuple[float, float, np.ndarray, np.ndarray]:
+        """A hand's wrist position (m) and speed (m/s), finger joint angles and speeds."""
+        c, h = self.client, self.hands[hand]
+        wrist = p.getJointState(h.body, h.wrist, physicsClientId=c)
+        states = p.getJointStates(h.body, h.fingers, physicsClientId=c)
         return wrist[0], wrist[1], np.array([s[0] for s in states]), np.array([s[1] for s in states])
 
-    def _key_contacts(self) -> list[tuple[int, int, float]]:
-        """(key index, hand link, normal force) of every contact between the hand and a key now."""
-        key_of = self._key_of
-        return [(key_of[ct[2]], ct[3], ct[9]) for ct in self._contacts if ct[2] in key_of]
-
-    def touching(self) -> dict[int, tuple[int, float]]:
-        """Key index -> (finger, normal force) for every key a fingertip presses on now."""
+    def touching(self, hand: int = 0) -> dict[int, tuple[int, float]]:
+        """Key index -> (finger, normal force) for every key a fingertip of ``hand`` presses on now."""
         out: dict[int, tuple[int, float]] = {}
-        finger_of = {link: f for f, link in self.tip_links.items()}
-        for key, link, force in self._key_contacts():
-            finger = finger_of.get(link)
+        finger_of = {link: f for f, link in self.hands[hand].tips.items()}
+        for key, h, link, force in self._contacts:
+            finger = finger_of.get(link) if h == hand else None
             if finger is not None and force > out.get(key, (0, 0.0))[1]:
                 out[key] = (finger, force)
         return out
 
-    def tip_points(self) -> dict[int, np.ndarray]:
+    def tip_points(self, hand: int = 0) -> dict[int, np.ndarray]:
         """World position of each fingertip's lowest point (the bottom of its tip sphere)."""
         g = self.config.hand.geometry
         points = {}
-        for finger, link in self.tip_links.items():
-            position, rotation = self.link_pose(link)
+        for finger, link in self.hands[hand].tips.items():
+            position, rotation = self.link_pose(link, hand)
             points[finger] = (
                 position + rotation @ np.array([0.0, -(g.distal - g.tip_radius), 0.0]) - np.array([0, 0, g.tip_radius])
             )
         return points
 
-    def tip_forces(self) -> dict[int, float]:
-        """Total normal force (N) on each fingertip from the keys."""
-        forces = {f: 0.0 for f in self.tip_links}
-        finger_of = {link: f for f, link in self.tip_links.items()}
-        for _, link, force in self._key_contacts():
-            finger = finger_of.get(link)
-            if finger is not None:
-                forces[finger] += force
+    def tip_forces(self, hand: int = 0) -> dict[int, float]:
+        """Total normal force (N) on each fingertip of ``hand`` from the keys."""
+        tips = self.hands[hand].tips
+        forces = {f: 0.0 for f in tips}
+        finger_of = {link: f for f, link in tips.items()}
+        for _, h, link, force in self._contacts:
+            if h == hand and link in finger_of:
+                forces[finger_of[link]] += force
         return forces
 
-    def link_pose(self, link: int) -> tuple[np.ndarray, np.ndarray]:
+    def link_pose(self, link: int, hand: int = 0) -> tuple[np.ndarray, np.ndarray]:
         """World position and rotation matrix of a hand link's frame."""
-        state = p.getLinkState(self.hand, link, computeForwardKinematics=True, physicsClientId=self.client)
+        body = self.hands[hand].body
+        state = p.getLinkState(body, link, computeForwardKinematics=True, physicsClientId=self.client)
         rotation = np.array(p.getMatrixFromQuaternion(state[5], physicsClientId=self.client)).reshape(3, 3)
         return np.array(state[4]), rotation
 
@@ -280,9 +340,14 @@ class PianoWorld:
     def _update_keys(self) -> list[int]:
         """After a physics step: read the keys that move or are touched, retune their springs (the
         torque limit grows with depth), put those back at rest to sleep. Returns the keys read."""
-        c, kb = self.client, self.config.keyboard
-        self._contacts = p.getContactPoints(bodyA=self.hand, physicsClientId=c)
-        touched = {key for key, _, _ in self._key_contacts()}
+        c, kb, key_of = self.client, self.config.keyboard, self._key_of
+        self._contacts = [
+            (key_of[ct[2]], h, ct[3], ct[9])
+            for h, hand in enumerate(self.hands)
+            for ct in p.getContactPoints(bodyA=hand.body, physicsClientId=c)
+            if ct[2] in key_of
+        ]
+        touched = {key for key, *_ in self._contacts}
         read = sorted(self._moving | touched)
         if not read:
             return read
@@ -306,12 +371,15 @@ class PianoWorld:
 
     def _apply_action(self, action: np.ndarray) -> None:
         cfg, hand = self.config, self.config.hand
-        n = len(self.finger_joints)
+        h, n = self._finger_command.shape
         action = np.asarray(action, dtype=float)
-        if action.shape != (n + 1,):
-            raise ValueError(f"action must have shape ({n + 1},): {n} finger joints then the wrist; got {action.shape}")
-        action = np.clip(action, -1.0, 1.0)
-        fingers, wrist = action[:n], float(action[n])
+        if action.shape != (h * (n + 1),):
+            raise ValueError(
+                f"action must have shape ({h * (n + 1)},): for each of {h} hands, {n} finger joints then the wrist; "
+                f"got {action.shape}"
+            )
+        action = np.clip(action, -1.0, 1.0).reshape(h, n + 1)
+        fingers, wrists = action[:, :n], action[:, n]
         if cfg.control == "velocity":
             self._finger_command = fingers * hand.max_joint_speed
         elif cfg.control == "position":
@@ -319,36 +387,69 @@ class PianoWorld:
             self._finger_command = low + (fingers + 1.0) / 2.0 * (high - low)
         else:
             self._finger_command = fingers * hand.max_joint_torque
-            self._finger_motors(p.VELOCITY_CONTROL, forces=np.zeros(n))
+            for body in self.hands:
+                self._finger_motors(body, p.VELOCITY_CONTROL, forces=np.zeros(n))
         if cfg.discrete_wrist:
-            target = self.discrete_wrist_position(wrist)
-            self._drive_wrist(p.POSITION_CONTROL, targetPosition=target, maxVelocity=hand.max_wrist_speed)
+            targets = self._apart_targets(np.array([self.discrete_wrist_position(w) for w in wrists]))
+            for body, target in zip(self.hands, targets):
+                self._drive_wrist(body, p.POSITION_CONTROL, targetPosition=target, maxVelocity=hand.max_wrist_speed)
         else:
-            self._drive_wrist(p.VELOCITY_CONTROL, targetVelocity=wrist * hand.max_wrist_speed)
+            for body, speed in zip(self.hands, self._apart_speeds(wrists * hand.max_wrist_speed)):
+                self._drive_wrist(body, p.VELOCITY_CONTROL, targetVelocity=speed)
 
-    def _drive_wrist(self, mode: int, **target: float) -> None:
-        """The wrist's motor in ``mode`` towards ``target`` (pybullet's targetPosition, maxVelocity,
+    def _wrists(self) -> np.ndarray:
+        return np.array([p.getJointState(h.body, h.wrist, physicsClientId=self.client)[0] for h in self.hands])
+
+    def _apart_speeds(self, speeds: np.ndarray) -> np.ndarray:
+        """Wrist speeds with the hands' closing speed cut to what keeps them :attr:`min_separation`
+        apart at the end of the control step (one hand: as they are)."""
+        if len(self.hands) == 1:
+            return speeds
+        left, right = self.sides.index("left"), self.sides.index("right")
+        x = self._wrists()
+        room = max(x[right] - x[left] - self.min_separation, 0.0)
+        closing = np.array([max(speeds[left], 0.0), max(-speeds[right], 0.0)])
+        travel = closing.sum() * self.config.substeps * self.dt
+        if travel > room:
+            cut = closing * (1.0 - room / travel)
+            speeds = speeds.copy()
+            speeds[left] -= cut[0]
+            speeds[right] += cut[1]
+        return speeds
+
+    def _apart_targets(self, targets: np.ndarray) -> np.ndarray:
+        """Wrist targets at least :attr:`min_separation` apart (the left one gives way, then the right)."""
+        if len(self.hands) == 1:
+            return targets
+        left, right = self.sides.index("left"), self.sides.index("right")
+        targets = targets.copy()
+        targets[left] = max(min(targets[left], targets[right] - self.min_separation), 0.0)
+        targets[right] = max(targets[right], targets[left] + self.min_separation)
+        return targets
+
+    def _drive_wrist(self, hand: HandBody, mode: int, **target: float) -> None:
+        """A wrist's motor in ``mode`` towards ``target`` (pybullet's targetPosition, maxVelocity,
         targetVelocity), with at most the hand's wrist force."""
         p.setJointMotorControl2(
-            self.hand,
-            self.wrist_joint,
+            hand.body,
+            hand.wrist,
             mode,
             force=self.config.hand.wrist_force,
             physicsClientId=self.client,
             **target,
         )
 
-    def _finger_motors(self, mode: int, **arrays: np.ndarray) -> None:
-        """Every finger joint's motor in ``mode`` (velocity motors at most the hand's joint force,
-        unless ``forces`` says otherwise)."""
+    def _finger_motors(self, hand: HandBody, mode: int, **arrays: np.ndarray) -> None:
+        """Every finger joint's motor of ``hand`` in ``mode`` (velocity motors at most the hand's
+        joint force, unless ``forces`` says otherwise)."""
         if mode == p.VELOCITY_CONTROL and "forces" not in arrays:
-            arrays["forces"] = np.full(len(self.finger_joints), self.config.hand.joint_force)
+            arrays["forces"] = np.full(len(hand.fingers), self.config.hand.joint_force)
         lists = {name: np.asarray(values, dtype=float).tolist() for name, values in arrays.items()}
-        p.setJointMotorControlArray(self.hand, self.finger_joints, mode, physicsClientId=self.client, **lists)
+        p.setJointMotorControlArray(hand.body, hand.fingers, mode, physicsClientId=self.client, **lists)
 
-    def _drive_fingers(self, torque: bool, left: int) -> None:
-        """Apply the finger command for one physics step, never driving a joint past its limit.
-        ``left``: physics steps left in the control step, this one included.
+    def _drive_fingers(self, hand: int, torque: bool, left: int) -> None:
+        """Apply ``hand``'s finger command for one physics step, never driving a joint past its
+        limit. ``left``: physics steps left in the control step, this one included.
 
         Position control moves each joint at the constant speed that reaches its target when the
         control step ends (velocity control's path when the target is angle + speed x step), up
@@ -358,28 +459,30 @@ class PianoWorld:
         links far past them (we saw the PIP joint at -1.5 rad against a limit of -0.17). So the
         commanded speed is clipped to what reaches the limit within one physics step, and a
         joint that would pass a limit under torque control is held at it by a motor."""
-        hand = self.config.hand
-        states = p.getJointStates(self.hand, self.finger_joints, physicsClientId=self.client)
+        config, body = self.config.hand, self.hands[hand]
+        states = p.getJointStates(body.body, body.fingers, physicsClientId=self.client)
         q = np.array([s[0] for s in states])
         low, high = self.joint_limits
         # speeds that reach a limit within this physics step, and no further
         slowest, fastest = (low - q) / self.dt, (high - q) / self.dt
+        command = self._finger_command[hand]
         if not torque:
-            command = self._finger_command
             if self.config.control == "position":  # at the speed that reaches the target at the control step's end
-                command = np.clip((command - q) / (left * self.dt), -hand.max_joint_speed, hand.max_joint_speed)
-            self._finger_motors(p.VELOCITY_CONTROL, targetVelocities=np.clip(command, slowest, fastest))
+                command = np.clip((command - q) / (left * self.dt), -config.max_joint_speed, config.max_joint_speed)
+            self._finger_motors(body, p.VELOCITY_CONTROL, targetVelocities=np.clip(command, slowest, fastest))
             return
         # torque control, except for joints that would pass a limit within this step: a motor holds those at it
         velocity = np.array([s[1] for s in states])
-        tau = self._finger_command
-        guard = (velocity > fastest) | (velocity < slowest) | ((q >= high) & (tau > 0)) | ((q <= low) & (tau < 0))
+        guard = (
+            (velocity > fastest) | (velocity < slowest) | ((q >= high) & (command > 0)) | ((q <= low) & (command < 0))
+        )
         self._finger_motors(
+            body,
             p.VELOCITY_CONTROL,
             targetVelocities=np.clip(0.0, slowest, fastest),
             forces=np.where(guard, LIMIT_STOP_TORQUE, 0.0),
         )
-        self._finger_motors(p.TORQUE_CONTROL, forces=np.where(guard, 0.0, tau))
+        self._finger_motors(body, p.TORQUE_CONTROL, forces=np.where(guard, 0.0, command))
 
     def discrete_wrist_position(self, action: float) -> float:
         """The white-key position that a wrist action in [-1, 1] selects."""
@@ -388,32 +491,41 @@ class PianoWorld:
         return centres[index]
 
     def step(self, action: np.ndarray) -> StepResult:
-        """One control step: apply ``action`` (finger joints then wrist, each in [-1, 1]) and run the physics."""
+        """One control step: apply ``action`` (for each hand, its finger joints then its wrist, each
+        in [-1, 1]) and run the physics."""
         self._apply_action(action)
         events: list[KeyEvent] = []
         fingers: dict[int, int] = {}
+        hands: dict[int, int] = {}
         pressed = self.sensor.sounding.copy()
         pressed_velocity = self.sensor.velocity.copy()
         torque = self.config.control == "torque"
         lowest = self.config.keyboard.spec.lowest
         for substep in range(self.config.substeps):
-            self._drive_fingers(torque, self.config.substeps - substep)
+            for hand in range(len(self.hands)):
+                self._drive_fingers(hand, torque, self.config.substeps - substep)
             p.stepSimulation(physicsClientId=self.client)
             self.time += self.dt
             if not self._update_keys():
                 continue  # every key at rest: nothing can sound or release
             new = self.sensor.update(self.time, self.key_angles, self.key_speeds)
             if new:
-                touch = self.touching()
+                touch: dict[
+                    int, tuple[int, int, float]
+                ] = {}  # key -> the hand, finger and force of its strongest touch
+                for h in range(len(self.hands)):
+                    for key, (finger, force) in self.touching(h).items():
+                        if force > touch.get(key, (0, 0, 0.0))[2]:
+                            touch[key] = (h, finger, force)
                 for event in new:
                     key = event.pitch - lowest
                     if event.on and key in touch:
-                        fingers[event.pitch] = touch[key][0]
+                        hands[event.pitch], fingers[event.pitch], _ = touch[key]
                 events += new
                 self._colour_keys(new)
                 pressed |= self.sensor.sounding
                 pressed_velocity = np.maximum(pressed_velocity, self.sensor.velocity)
-        return StepResult(events, fingers, pressed, pressed_velocity)
+        return StepResult(events, fingers, pressed, pressed_velocity, hands)
 
     # -- images ------------------------------------------------------------------------------
     def _colour_keys(self, events: list[KeyEvent]) -> None:
