@@ -128,3 +128,46 @@ def test_train_with_the_dagger_learner_in_rounds_of_round_steps(tmp_path):
         result = run("train", song, *QUICK, *args, "--models", tmp_path / "bad")
         assert result.exit_code == 2 and len(result.stderr.strip().splitlines()) == 1, result.output
         assert all(word in result.stderr for word in words), result.stderr
+
+
+def test_a_ray_worker_killed_mid_phrase_is_run_again_from_its_checkpoint(tmp_path):
+    """Issue 36, item 6: the worker training a phrase dies after its first checkpoint; Ray runs the
+    task again, which resumes from that checkpoint, and the phrase ends trained to its last step."""
+    pytest.importorskip("ray")
+    import os
+    import signal
+    import subprocess
+
+    from pianobot.agent import store
+    from pianobot.agent.config import SACConfig
+    from pianobot.env.piano import EnvConfig
+    from pianobot.learn.config import TrainConfig
+    from pianobot.learn.jobs import phrase_jobs, run_jobs_on_ray
+    from pianobot.music.load import load_piece
+    from pianobot.music.phrases import split_phrases
+
+    config = TrainConfig(
+        steps=150,
+        eval_every=50,
+        checkpoint_every=50,
+        eval_episodes=1,
+        from_general=False,
+        sac=SACConfig(exploration_steps=30),
+        env=EnvConfig(tactile=False),
+    )
+    (job,) = phrase_jobs(split_phrases(load_piece(EXAMPLES / "one-note.mid")), config, tmp_path)
+    killed, resumed = [], []
+
+    def on_progress(key, progress):
+        resumed.extend([progress.step] if progress.resumed else [])
+        if not killed and store.checkpoint_state(job.folder) is not None:
+            found = subprocess.run(["pgrep", "-f", "ray::_run_job"], capture_output=True, text=True).stdout.split()
+            for pid in found:
+                os.kill(int(pid), signal.SIGKILL)
+            killed.extend(found)
+
+    results = run_jobs_on_ray([job], config, on_progress)
+    assert killed, "no worker was found to kill"
+    assert resumed and resumed[0] >= 50  # the second run began at the checkpoint, not at step 0
+    manifest = results[job.key]
+    assert manifest["steps"] >= 150 and (job.folder / store.POLICY_FILE).exists()

@@ -186,6 +186,11 @@ def run_jobs(
     return results
 
 
+RAY_RETRIES = 3
+"""Times Ray runs a phrase again when its worker dies (a process killed, a node lost): each run
+resumes from the phrase's last checkpoint, so what was trained before it is kept."""
+
+
 def run_jobs_on_ray(
     jobs: list[PhraseJob],
     config: TrainConfig,
@@ -196,7 +201,8 @@ def run_jobs_on_ray(
     """Train every job as a Ray task: on the cluster ``RAY_ADDRESS`` names (Ray's own convention),
     or on a local Ray runtime when it is unset. Each task asks for ``threads`` CPUs (or
     ``config.envs``, when more: its environment workers) and trains with ``threads`` torch threads; progress comes back through a Ray queue. Every node must see the model
-    folders at the same path (a shared file system): checkpoints are written and resumed there."""
+    folders at the same path (a shared file system): checkpoints are written and resumed there.
+    A task whose worker dies is run again (:data:`RAY_RETRIES`) from its phrase's last checkpoint."""
     try:
         import ray
         from ray.util.queue import Queue
@@ -207,7 +213,7 @@ def run_jobs_on_ray(
         ray.init(include_dashboard=False, log_to_driver=False, configure_logging=False)
     try:
         queue = Queue()
-        task = ray.remote(num_cpus=max(threads, config.envs), max_retries=0)(_run_job)
+        task = ray.remote(num_cpus=max(threads, config.envs), max_retries=RAY_RETRIES)(_run_job)
         refs = {task.remote(job, config, queue, threads, start): job for job in jobs}
         pending, results = list(refs), {}
 
