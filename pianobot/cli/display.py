@@ -117,6 +117,50 @@ def report_tables(report: Report, every: bool = False, notes: int | None = None)
     return [summary, table]
 
 
+def _figures(report: Report) -> list[str]:
+    """A part's first figures, for the tables of hands: notes played, note F1, key-press F1 per step."""
+    extra = report.played_notes - report.matched_notes
+    return [
+        f"{report.matched_notes} of {report.reference_notes}, {extra} extra",
+        f"{report.f1:.3f}",
+        f"{report.step_f1:.3f}",
+    ]
+
+
+def hands_table(performance) -> Table:
+    """A two-hand performance (:class:`~pianobot.perform.hands.HandsPerformance`): the whole piece
+    and each hand, who played it and where, and its first figures."""
+    from pianobot.perform.hands import APART
+
+    table = Table(title=f"both hands, {APART}")
+    columns = ("part", "played by", "played as", "notes given", "notes played", "note F1", "key-press F1 per step")
+    for column in columns:
+        table.add_column(column, justify="right" if column in ("note F1", "key-press F1 per step") else "left")
+
+    whole = performance.report()
+    given = sum(len(h.part) for h in performance.hands)
+    table.add_row("whole piece", performance.performer, "", f"{given} of {len(performance.piece)}", *_figures(whole))
+    for h in performance.hands:
+        written = len(performance.piece.part(h.hand))
+        row = [f"{h.hand} hand", h.performer, h.describe(), f"{len(h.part)} of {written}"]
+        table.add_row(*row, *_figures(performance.report(h.hand)))
+    table.caption = (
+        "notes given: what each simulated hand was given of the notes written (the rest left out or reduced)"
+    )
+    return table
+
+
+def hands_scores_table(scores) -> Table:
+    """A two-hand performance scored (:class:`~pianobot.music.hand_scores.HandsReport`): the whole
+    piece and each hand of the reference."""
+    table = Table(title="the whole piece and each hand")
+    for column in ("part", "notes played", "note F1", "key-press F1 per step", "fingering"):
+        table.add_column(column, justify="left" if column in ("part", "notes played") else "right")
+    for name, report in (("whole piece", scores.whole), *((f"{h} hand", r) for h, r in scores.hands.items())):
+        table.add_row(name, *_figures(report), _opt(report.fingering_accuracy, ".3f"))
+    return table
+
+
 def print_all(console: Console, tables: list[Table]) -> None:
     for table in tables:
         console.print(table)

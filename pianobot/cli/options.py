@@ -208,6 +208,21 @@ def read_song(song: Path, options: LoadOptions, keyboard: KeyboardSpec, hand: Ha
     return piece
 
 
+def read_for_play(song: Path, reading: Reading, keep_warnings: bool = True):
+    """The piece as `play` reads it: a :class:`~pianobot.perform.hands.HandsReading` when the file
+    plays both hands, else the one-hand piece of :func:`read_song` (``keep_warnings`` False: that
+    reading's warnings are dropped, for a command that only asks which it is)."""
+    from pianobot.perform.hands import read_one_or_two
+
+    return read_one_or_two(
+        song,
+        reading.options,
+        reading.hand,
+        lambda: read_song(song, reading.options, reading.keyboard, reading.hand),
+        keep_warnings,
+    )
+
+
 def refuse_training_into(start: Path | None, jobs) -> None:
     """One line, before any work, when the policy to start from is a folder this run trains into
     (the same options, so the same hash): ``--force`` would delete it before it is read."""

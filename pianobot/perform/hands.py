@@ -18,6 +18,11 @@ colour and every distance between keys:
 Notes outside the window are left out, and the part is then reduced to what the hand can play
 (:func:`~pianobot.pianist.reduce.reduce_part`), each kind of change said in one warning line; the
 figures are always against the piece as written, so what was left out counts as missed.
+
+Reading: :func:`read_one_or_two` decides, as ``pianobot play`` does, whether a file plays both
+hands (tracks named for the hands, or notes one hand cannot play that the fingering planner gives
+to both) or one, as before two hands; :func:`play` (``pianobot.play``) plays a piece with both
+hands hand by hand and any other piece as one hand.
 """
 
 from __future__ import annotations
@@ -25,16 +30,119 @@ from __future__ import annotations
 import warnings
 from dataclasses import dataclass, field, replace
 from pathlib import Path
+from typing import Callable
 
 from pianobot.errors import PianobotError, PianobotWarning
+from pianobot.music import midi_io
+from pianobot.music.hand_scores import HandsReport, compare_hands
 from pianobot.music.instrument import HandSpec, KeyboardSpec
-from pianobot.music.load import thin_chords
-from pianobot.music.metrics import Report, compare
-from pianobot.music.piece import HANDS, Note, Piece
+from pianobot.music.load import LoadOptions, load_hands, thin_hand
+from pianobot.music.metrics import Report
+from pianobot.music.piece import HANDS, Note, Piece, pitch_name
 from pianobot.music.window import Window, window_for
-from pianobot.perform.plan import Performance, play
+from pianobot.perform import plan
+from pianobot.perform.plan import Performance
 from pianobot.pianist.fingering import ensure_fingering
-from pianobot.pianist.reduce import reduce_part
+from pianobot.pianist.hands import _reduce, load_two_hands
+
+APART = "each hand in a simulation of its own"
+"""How both hands play until the simulator holds two: said wherever a two-hand performance is reported."""
+AGAINST = "figures against the piece as written (notes left out or reduced count as missed)"
+"""What a two-hand performance's figures are measured against."""
+
+
+@dataclass(frozen=True)
+class HandsReading:
+    """A two-hand file as read for both hands: every note with its hand, and how many of each
+    hand's notes the file named (its tracks' names, or a PIG file's channels) rather than the
+    fingering planner (:func:`~pianobot.pianist.hands.assign_hands`)."""
+
+    piece: Piece
+    named: dict[str, int]
+    source: str = "its track"
+    """What named a note's hand in the file: 'its track', 'the PIG channel'."""
+
+    def describe(self, hand: str) -> str:
+        """One line on ``hand``'s part: 'right hand: 64 notes, C4-D5, named by its track'."""
+        part = self.piece.part(hand)
+        low, high = min(n.pitch for n in part.notes), max(n.pitch for n in part.notes)
+        named = min(self.named.get(hand, 0), len(part))
+        if named == len(part):
+            who = f"named by {self.source}"
+        elif named == 0:
+            who = "assigned by the fingering planner"
+        else:
+            who = f"{named} named by {self.source}, {len(part) - named} assigned by the fingering planner"
+        return f"{hand} hand: {len(part)} notes, {pitch_name(low)}-{pitch_name(high)}, {who}"
+
+    def to_dict(self, hand: str) -> dict:
+        part = self.piece.part(hand)
+        named = min(self.named.get(hand, 0), len(part))
+        return {
+            "notes": len(part),
+            "range": [pitch_name(min(n.pitch for n in part.notes)), pitch_name(max(n.pitch for n in part.notes))],
+            "named_by_file": named,
+            "assigned_by_planner": len(part) - named,
+        }
+
+
+def read_hands(path: str | Path, options: LoadOptions = LoadOptions(), spec: HandSpec = HandSpec()) -> HandsReading:
+    """Both hands of the file at ``path``: :func:`~pianobot.pianist.hands.load_two_hands` (its
+    warnings and its one-line refusals), with what the file named."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", PianobotWarning)  # said by load_two_hands
+        given = load_hands(path, options)
+    piece = load_two_hands(path, options, spec)
+    named = {hand: sum(n.hand == hand for n in given.notes) for hand in HANDS}
+    return HandsReading(piece, named, "the PIG channel" if Path(path).suffix.lower() == ".txt" else "its track")
+
+
+def names_hands(path: str | Path) -> bool:
+    """Whether the file says which hand plays its notes: a track named for a hand, or a PIG file."""
+    path = Path(path)
+    if path.suffix.lower() == ".txt":
+        return True
+    return any(t.notes and midi_io.track_hand(t.name) for t in midi_io.describe_tracks(path))
+
+
+def read_one_or_two(
+    path: str | Path,
+    options: LoadOptions,
+    spec: HandSpec,
+    one_hand: Callable[[], Piece],
+    keep_warnings: bool = True,
+) -> Piece | HandsReading:
+    """The file at ``path`` as ``pianobot play`` reads it: both hands (a :class:`HandsReading`) when
+    it is a two-hand file, else ``one_hand()`` (the one-hand reading, as before two hands).
+
+    A two-hand file: without ``options.hand`` and ``options.track``, a file whose tracks are
+    named for both hands (or a PIG file with both hands' channels), or one whose notes cannot be
+    one hand's (``one_hand()`` refuses them) and that the fingering planner gives to both hands.
+    Where the planner gives them all to one hand, ``one_hand()``'s refusal stands. ``keep_warnings``
+    False drops the warnings of a one-hand reading made only to decide."""
+    if options.hand is not None or options.track is not None:
+        return one_hand()
+    if names_hands(path):
+        if Path(path).suffix.lower() == ".txt" and (options.tempo or options.fingering or options.quantize):
+            return one_hand()  # (refused there in its own words)
+        hands = read_hands(path, options, spec)
+        return hands if len(hands.piece.hands) == 2 else one_hand()
+    refused = None
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            piece = one_hand()
+        except PianobotError as error:
+            refused = error
+    if refused is not None:
+        hands = read_hands(path, options, spec)
+        if len(hands.piece.hands) == 2:
+            return hands
+    for warning in caught if keep_warnings else ():
+        warnings.warn(warning.message)
+    if refused is not None:
+        raise refused
+    return piece
 
 
 @dataclass(frozen=True)
@@ -50,6 +158,8 @@ class HandPerformance:
     left_out: int
     """Written notes outside the window."""
     performance: Performance
+    changes: tuple[str, ...] = ()
+    """What was left out or reduced to make the part playable: one line per kind."""
 
     @property
     def played(self) -> Piece:
@@ -60,6 +170,21 @@ class HandPerformance:
         ]
         return Piece(tuple(notes), bpm=self.part.bpm)
 
+    @property
+    def performer(self) -> str:
+        """Who played this hand, in words ('general policy', 'scripted pianist', ...)."""
+        return self.performance.plan.performer
+
+    def describe(self) -> str:
+        """Where the simulated hand played the part: 'mirrored, moved up 1 octave onto C4-B5 (24 keys)'."""
+        moves = []
+        if self.hand == "left":
+            moves.append("mirrored about D")
+        if self.window.octaves:
+            octaves = abs(self.window.octaves)
+            moves.append(f"moved {'up' if self.window.octaves > 0 else 'down'} {octaves} octave{'s' * (octaves > 1)}")
+        return ", ".join(moves + [f"on {self.window.keyboard.describe()}"])
+
 
 @dataclass(frozen=True)
 class HandsPerformance:
@@ -69,24 +194,56 @@ class HandsPerformance:
     """The piece as written, every note with its hand: what the figures are against."""
     hands: tuple[HandPerformance, ...]
     """Right hand first."""
+    seed: int = 0
     played: Piece = field(init=False)
     """What both keyboards sounded, as one piece at the written pitches, each note with its hand."""
+    scores: HandsReport = field(init=False, repr=False, compare=False)
+    """The figures for the whole piece and each hand (:func:`~pianobot.music.hand_scores.compare_hands`)."""
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "played", Piece(tuple(n for h in self.hands for n in h.played.notes), self.piece.bpm))
+        played = Piece(tuple(n for h in self.hands for n in h.played.notes), self.piece.bpm)
+        object.__setattr__(self, "played", played)
+        object.__setattr__(self, "scores", compare_hands(self.piece, played))
 
     def report(self, hand: str | None = None) -> Report:
-        """The figures for the whole piece, or for ``hand``'s part (against its written notes)."""
-        if hand is None:
-            return compare(self.piece, self.played)
-        return compare(self.piece.part(hand), self.played.part(hand))
+        """The figures for the whole piece, or for ``hand``'s part (against its written notes),
+        as ``pianobot score`` computes them from the written file."""
+        return self.scores.whole if hand is None else self.scores.hands[hand]
+
+    @property
+    def performer(self) -> str:
+        """Who played, in words: 'scripted pianist (each hand in a simulation of its own)'."""
+        names = dict.fromkeys(h.performer for h in self.hands)
+        return f"{' and '.join(names)} ({APART})"
+
+    def to_dict(self, reading: HandsReading | None = None) -> dict:
+        """The report's JSON: who played each hand, where, what was left out or reduced, and the
+        figures for the whole piece and each hand (``reading``: what the file named)."""
+        hands = {}
+        for h in self.hands:
+            hands[h.hand] = {
+                "performer": h.performer,
+                **(reading.to_dict(h.hand) if reading is not None else {}),
+                "played_as": h.describe(),
+                "given_to_the_hand": len(h.part),
+                "left_out_or_reduced": list(h.changes),
+                "plan": h.performance.plan.to_dict(),
+                **self.report(h.hand).summary(),
+            }
+        return {
+            "seed": self.seed,
+            "performer": self.performer,
+            "hands_simulated": f"apart: {APART}, the two merged; {AGAINST}",
+            "hands": hands,
+            **self.report().to_dict(),
+        }
 
 
 def prepare_part(
     piece: Piece, hand: str, keyboard: KeyboardSpec | None, fingers: HandSpec
 ) -> tuple[Window, Piece, float, int]:
     """``hand``'s part of ``piece`` as the simulated hand is given it: (window, part, start, notes
-    left out). Each kind of change is one :class:`PianobotWarning`."""
+    left out). Each kind of change is one :class:`PianobotWarning`, worded for the written part."""
     part = piece.part(hand)
     window = window_for(part, hand, keyboard)
     inside = [n for n in part.notes if window.inward(n.pitch) in window.keyboard]
@@ -102,15 +259,9 @@ def prepare_part(
         raise PianobotError(f"none of the {hand} hand's notes fits the keyboard its player knows")
     moved = Piece(tuple(Note(n.onset, window.inward(n.pitch), n.offset, n.velocity) for n in inside), bpm=piece.bpm)
     start = moved.notes[0].onset
-    moved, dropped = thin_chords(moved.shift(-start), len(fingers.fingers))
-    if dropped:
-        warnings.warn(
-            PianobotWarning(
-                f"the {hand} hand's part has chords of more than {len(fingers.fingers)} notes: "
-                f"kept the highest {len(fingers.fingers)}, dropped {dropped} note(s)"
-            )
-        )
-    reduced = reduce_part(moved, window.keyboard, fingers, f"the {hand} hand's part").piece
+    # (the simulated hand is a right hand: its top notes are a left hand's lowest)
+    thinned = thin_hand(moved.shift(-start), hand, fingers, "lowest" if hand == "left" else "highest")
+    reduced = _reduce(thinned, window.keyboard, fingers, hand)
     fingered, _ = ensure_fingering(reduced, window.keyboard, fingers, refinger=True)
     return window, fingered, start, left_out
 
@@ -121,19 +272,44 @@ def play_hands(
     models: Path | str | None = None,
     seed: int = 0,
     hand: HandSpec | None = None,
+    keyboard: KeyboardSpec | None = None,
+    **options,
 ) -> HandsPerformance:
     """Perform ``piece``, every note of which has a hand, hand by hand (the module's notes):
     ``controller`` 'sac' (the general policy, or policies trained for the part) or 'scripted',
-    ``models`` the model store, ``seed`` the hand start of every simulation."""
+    ``models`` the model store, ``seed`` the hand start of every simulation, ``hand`` each hand's
+    fingers; ``keyboard`` the keys every part is moved onto (default: the general policy's 24 keys
+    for 'sac', each part's own range for 'scripted'); ``options`` go to
+    :func:`~pianobot.perform.plan.plan_performance` (``general``, ``fallback``, ...)."""
     if any(n.hand is None for n in piece.notes):
         raise PianobotError("every note needs a hand to play both hands: give the piece's notes a hand first")
     if controller not in ("sac", "scripted"):
         raise PianobotError(f"controller {controller!r}: both hands are played by 'sac' or 'scripted'")
     fingers = hand or HandSpec()
-    keyboard = KeyboardSpec() if controller == "sac" else None
+    keyboard = keyboard or (KeyboardSpec() if controller == "sac" else None)
     done = []
     for name in (h for h in HANDS if h in piece.hands):
-        window, part, start, left_out = prepare_part(piece, name, keyboard, fingers)
-        performance = play(part, controller, models, seed=seed, keyboard=window.keyboard, hand=fingers)
-        done.append(HandPerformance(name, window, part, start, left_out, performance))
-    return HandsPerformance(piece, tuple(done))
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", PianobotWarning)
+            window, part, start, left_out = prepare_part(piece, name, keyboard, fingers)
+        changes = tuple(str(w.message) for w in caught if issubclass(w.category, PianobotWarning))
+        for warning in caught:
+            warnings.warn(warning.message)
+        performance = plan.play(part, controller, models, seed=seed, keyboard=window.keyboard, hand=fingers, **options)
+        done.append(HandPerformance(name, window, part, start, left_out, performance, changes))
+    return HandsPerformance(piece, tuple(done), seed)
+
+
+def play(
+    piece: Piece, controller: str = "sac", models: Path | str | None = None, seed: int = 0, **options
+) -> Performance | HandsPerformance:
+    """``pianobot.play``: a piece with both hands (every note with its hand, both hands with notes)
+    plays both, :func:`play_hands` (each hand in a simulation of its own; ``options`` as there);
+    any other piece plays as one hand, :func:`pianobot.perform.plan.play` (``options`` as there:
+    ``video``, ``on_step``, ``keyboard``, ``hand``, ``general``, ...)."""
+    if len(piece.hands) < 2:
+        return plan.play(piece, controller, models, seed, **options)
+    if options.pop("video", False):
+        raise PianobotError(f"a video shows one simulation, and both hands play {APART}: play one hand for a video")
+    options.pop("on_step", None)
+    return play_hands(piece, controller, models, seed, **options)

@@ -336,6 +336,43 @@ def _phrases_table(stretches: list[Section]) -> str:
     )
 
 
+def _hands_section(performance, reading) -> str:
+    """Each hand of a two-hand performance (:class:`~pianobot.perform.hands.HandsPerformance`):
+    who played it, where, what it was given, its figures, what was left out or reduced."""
+    from html import escape
+
+    from pianobot.perform.hands import AGAINST, APART
+
+    head = "".join(
+        f"<th>{h}</th>"
+        for h in ("hand", "written", "played by", "played as", "notes given", "note F1", "key-press F1 per step")
+    )
+    rows = []
+    for h in performance.hands:
+        report = performance.report(h.hand)
+        written = reading.describe(h.hand) if reading is not None else f"{len(performance.piece.part(h.hand))} notes"
+        cells = (
+            f"{h.hand} hand",
+            written,
+            h.performer,
+            h.describe(),
+            f"{len(h.part)} of {len(performance.piece.part(h.hand))}",
+            f"{report.f1:.3f}",
+            f"{report.step_f1:.3f}",
+        )
+        rows.append("<tr>" + "".join(f"<td>{escape(c)}</td>" for c in cells) + "</tr>")
+    changes = [line for h in performance.hands for line in h.changes]
+    listed = "".join(f"<li>{escape(line)}</li>" for line in changes) or "<li>nothing: every note was given</li>"
+    return (
+        "<section id='hands'><h2>Each hand</h2>"
+        f"<p class='what'>Both hands played, {escape(APART)} (the simulator holds one hand so far): each hand's "
+        "part given to the one simulated hand (the left hand's mirrored about D), what the two sounded merged; "
+        f"{escape(AGAINST)}. In the piano roll the left hand's notes are hatched.</p>"
+        f"<table class='hands'><tr>{head}</tr>{''.join(rows)}</table>"
+        f"<h3>Left out or reduced</h3><ul class='changes'>{listed}</ul></section>"
+    )
+
+
 def _media(path: Path | None, kind: str, mime: str) -> str:
     import base64
 
@@ -353,11 +390,15 @@ def html_report(
     seed: int | None = None,
     video: Path | None = None,
     audio: Path | None = None,
+    hands=None,
+    reading=None,
 ) -> str:
     """One self-contained HTML page (no file or network needed beside it): the figures with what
     they mean, the video (with its sound) and the audio when given, the piano roll of the score
     against what was played, each note's velocity and timing errors, who played each phrase
-    (``plan``: a :class:`~pianobot.perform.plan.PerformancePlan`) and every note."""
+    (``plan``: a :class:`~pianobot.perform.plan.PerformancePlan`) and every note; for a two-hand
+    performance (``hands``: a :class:`~pianobot.perform.hands.HandsPerformance`, ``reading``
+    what the file named), each hand."""
     from html import escape
 
     stretches = sections(plan) if plan is not None else []
@@ -370,9 +411,10 @@ def html_report(
             for i, row in enumerate(report.rows)
             if row.reference is not None and (row.reference.onset, row.reference.pitch) in by_note
         }
+    performer = plan.performer if plan is not None else hands.performer if hands is not None else None
     who = (
-        f"Played by: {escape(plan.performer)}" + (f", from hand start {seed}" if seed is not None else "")
-        if plan
+        f"Played by: {escape(performer)}" + (f", from hand start {seed}" if seed is not None else "")
+        if performer
         else ""
     )
     parts = [
@@ -384,6 +426,8 @@ def html_report(
         _figures_table(report, first=True),
         f"<details><summary>every figure</summary>{_figures_table(report, first=False)}</details></section>",
     ]
+    if hands is not None:
+        parts.append(_hands_section(hands, reading))
     if video is not None or audio is not None:
         parts += [
             "<section id='media'><h2>Watch and listen</h2>",

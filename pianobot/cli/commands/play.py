@@ -19,13 +19,14 @@ from pianobot.cli.options import (
     Reading,
     check_html,
     check_midi_output,
-    read_song,
+    read_for_play,
     reads,
 )
 from pianobot.cli.terminal import err, out, said, write_json
 from pianobot.errors import PianobotError
 from pianobot.files import atomic_write, check_writable
 from pianobot.music.phrases import DEFAULT_MAX_NOTES
+from pianobot.music.piece import Piece
 from pianobot.perform.controllers import CONTROLLERS
 
 
@@ -119,7 +120,33 @@ def play(
         import torch
 
         torch.set_num_threads(1)  # batch-1 inference: more threads only spin against other work on the cores
-    piece = read_song(song, reading.options, reading.keyboard, reading.hand)
+    piece = read_for_play(song, reading)
+    if not isinstance(piece, Piece):  # a two-hand file: both hands, each in a simulation of its own
+        if video is not None or gui:
+            raise PianobotError(
+                f"{'--video' if video is not None else '--gui'} shows one simulation, and {song.name}'s two hands play "
+                "each in a simulation of its own: play one hand for it with --hand right (or --hand left)"
+            )
+        play_both(
+            song,
+            output,
+            piece,
+            controller=controller.value,
+            models=models,
+            seed=seed,
+            keyboard=reading.keyboard,
+            hand=reading.hand,
+            options=dict(
+                general=use_general,
+                general_policy=general_policy,
+                fallback=fallback is not None,
+                phrase_notes=phrase_notes,
+                wrist_guard=wrist_guard,
+            ),
+            files=dict(report=report_path, json=json_path, wav=wav, soundfont=soundfont, html=html),
+            shown=dict(console=console, notes=notes, every=every, quiet=quiet),
+        )
+        return
     plan = plan_performance(
         piece,
         controller.value,
@@ -191,3 +218,61 @@ def play(
         title = f"{song.name}: {plan.performer}"
         write_html(html, report, title, plan=plan, seed=seed, video=video, audio=wav)
         console.print(f"report to open in a browser written to {said(html)}")
+
+
+def play_both(
+    song: Path, output: Path, reading, *, controller, models, seed, keyboard, hand, options, files, shown
+) -> None:
+    """`play` of a two-hand file (``reading``: a :class:`~pianobot.perform.hands.HandsReading`):
+    both hands, each in a simulation of its own (:func:`~pianobot.perform.hands.play_hands`), one
+    track per hand in ``output``, and the report of the whole piece and each hand."""
+    import warnings
+
+    from pianobot.cli import display
+    from pianobot.errors import PianobotWarning
+    from pianobot.music.instrument import KeyboardSpec
+    from pianobot.music.midi_io import write_midi
+    from pianobot.perform.audio import write_wav
+    from pianobot.perform.hands import AGAINST, APART, play_hands
+
+    console, quiet = shown["console"], shown["quiet"]
+    if not quiet:
+        console.print(f"both hands, {APART} (the simulator holds one hand so far); {AGAINST}", soft_wrap=True)
+        for name in reading.piece.hands:
+            console.print(said(reading.describe(name)), soft_wrap=True)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", PianobotWarning)
+        performance = play_hands(
+            reading.piece,
+            controller,
+            models,
+            seed,
+            hand,
+            None if keyboard == KeyboardSpec() else keyboard,  # (the default: each player's own keys)
+            **options,
+        )
+    changes = {line for h in performance.hands for line in h.changes}
+    for warning in caught:  # what each hand was given is on the first screen; the rest are warnings
+        if quiet or str(warning.message) not in changes:
+            warnings.warn(warning.message)
+    write_midi(performance.played, output)
+    report = performance.to_dict(reading)
+    atomic_write(files["report"], json.dumps(report, indent=2) + "\n")
+    if files["json"] is not None:
+        write_json(files["json"], report)
+    if not quiet:
+        console.print(display.hands_table(performance))
+        for h in performance.hands:
+            for line in h.changes:
+                console.print(f"[yellow]left out or reduced:[/yellow] {said(line)}", soft_wrap=True)
+        display.print_all(console, display.report_tables(performance.report(), shown["every"], shown["notes"]))
+    console.print(f"performance written to {said(output)} (one track per hand), report to {said(files['report'])}")
+    if files["wav"] is not None:
+        method = write_wav(performance.played, files["wav"], font=files["soundfont"])
+        console.print(f"audio written to {said(files['wav'])} ({method})")
+    if files["html"] is not None:
+        from pianobot.perform.report import write_html
+
+        title = f"{song.name}: both hands, {performance.performer}"
+        write_html(files["html"], performance.report(), title, seed=seed, hands=performance, reading=reading)
+        console.print(f"report to open in a browser written to {said(files['html'])}")

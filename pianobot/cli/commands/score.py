@@ -12,6 +12,7 @@ from pianobot.cli.options import (
     HtmlReport,
     Reading,
     check_html,
+    read_for_play,
     reads,
 )
 from pianobot.cli.terminal import err, out, said, write_json
@@ -41,10 +42,13 @@ def score(
     """Compare a performance with its reference: note F1, velocity and timing errors, fingering.
 
     The reading options apply to the reference, as `play` applied them to the piece it played:
-    `pianobot score out.mid original.mid --hand right --transpose -3` compares like with like."""
+    `pianobot score out.mid original.mid --hand right --transpose -3` compares like with like.
+    A two-hand reference (as `play` reads it) is scored as a whole and for each hand."""
     from pianobot.cli import display
     from pianobot.music import midi_io
-    from pianobot.music.metrics import compare, plot_report
+    from pianobot.music.hand_scores import compare_hands
+    from pianobot.music.metrics import plot_report
+    from pianobot.perform.hands import HandsReading
     from pianobot.pianist.reduce import load_for_hand
 
     if not 0 < onset_tolerance <= 1:
@@ -57,14 +61,22 @@ def score(
         if target is not None:
             check_writable(target)
     console = err if to_stdout else out  # standard output carries the JSON
-    reference_piece = load_for_hand(
-        reference, reading.options, reading.keyboard, reading.hand
-    )  # with --hand, reduced as play reduces it
+    as_played = read_for_play(reference, reading, keep_warnings=False)  # both hands where play plays both
+    if isinstance(as_played, HandsReading):
+        reference_piece = as_played.piece  # every note with its hand, as play scored it
+    else:
+        reference_piece = load_for_hand(
+            reference, reading.options, reading.keyboard, reading.hand
+        )  # with --hand, reduced as play reduces it
     played_piece = midi_io.read_midi(played)
-    report = compare(reference_piece, played_piece, onset_tolerance=onset_tolerance)
+    scores = compare_hands(reference_piece, played_piece, onset_tolerance=onset_tolerance)
+    report = scores.whole
+    if scores.hands:
+        console.print(display.hands_scores_table(scores))
     display.print_all(console, display.report_tables(report, every, None if notes else 0))
     if json_path is not None:
-        write_json(json_path, report.to_dict())
+        hands = {"hands": {hand: r.summary() for hand, r in scores.hands.items()}} if scores.hands else {}
+        write_json(json_path, {**report.to_dict(), **hands})
         if not to_stdout:
             console.print(f"figures written to {said(json_path)}")
     if plot is not None:

@@ -1,0 +1,177 @@
+"""`pianobot play`, `score` and `inspect` on two-hand files: both hands by default (each hand in a
+simulation of its own), one track per hand, the whole piece and each hand reported; `--hand` still
+plays one; bad input in one line."""
+
+import json
+from pathlib import Path
+
+import mido
+from conftest import assert_one_line_error, midi_file, off, on, run
+
+from pianobot.music.load import load_hands
+from pianobot.music.metrics import compare
+from pianobot.music.midi_io import read_midi
+
+EXAMPLES = Path(__file__).parent.parent / "examples" / "midi"
+
+
+def _track(*notes):
+    """(tick, message) events of (pitch, start beat, end beat) notes, 480 ticks a beat (0.5 s at 120 bpm)."""
+    return [event for p, a, b in notes for event in ((round(a * 480), on(p)), (round(b * 480), off(p)))]
+
+
+RIGHT = _track((72, 0, 1), (74, 1, 2), (76, 2, 3), (77, 3, 4))
+LEFT = _track((48, 0, 2), (55, 2, 4))
+
+
+def _duet(path, names=("Right Hand", "Left Hand"), right=RIGHT, left=LEFT):
+    return midi_file(path, [(names[0], right), (names[1], left)])
+
+
+def _one_track(path, *notes):
+    """A type-0 file of one unnamed track: nothing says which hand plays a note."""
+    events = sorted(_track(*notes), key=lambda e: e[0])
+    track, last = mido.MidiTrack(), 0
+    for tick, message in events:
+        track.append(message.copy(time=tick - last))
+        last = tick
+    midi = mido.MidiFile(type=0, ticks_per_beat=480)
+    midi.tracks.append(track)
+    midi.save(path)
+    return path
+
+
+def test_a_file_with_tracks_named_for_hands_plays_both_hands_one_track_each(tmp_path):
+    song = _duet(tmp_path / "duet.mid")
+    result = run("play", song, "-o", tmp_path / "out.mid", "--controller", "scripted", "--html", tmp_path / "r.html")
+    assert result.exit_code == 0, result.output
+    text = " ".join(result.stdout.split())
+    assert "each hand in a simulation of its own" in text and "against the piece as written" in text
+    assert "right hand: 4 notes, C5-F5, named by its track" in text
+    assert "left hand: 2 notes, C3-G3, named by its track" in text
+    assert "whole piece" in text and "mirrored about D" in text  # the first screen's table of hands
+    tracks = [t.name for t in mido.MidiFile(tmp_path / "out.mid").tracks]
+    assert tracks == ["Right Hand", "Left Hand"]
+    played = read_midi(tmp_path / "out.mid")
+    written = load_hands(song)
+    assert [(n.pitch, n.hand) for n in played.notes] == [(n.pitch, n.hand) for n in written.notes]
+    assert compare(written, played).f1 == 1.0
+    report = json.loads((tmp_path / "out.report.json").read_text())
+    assert report["performer"] == "scripted pianist (each hand in a simulation of its own)"
+    assert "simulation of its own" in report["hands_simulated"] and report["f1"] == 1.0
+    assert set(report["hands"]) == {"right", "left"}
+    left = report["hands"]["left"]
+    assert left["performer"] == "scripted pianist" and left["notes"] == 2 and left["named_by_file"] == 2
+    assert left["reference_notes"] == 2 and left["f1"] == 1.0 and left["left_out_or_reduced"] == []
+    page = (tmp_path / "r.html").read_text()
+    assert "<section id='hands'>" in page and "simulation of its own" in page and "left hand: 2 notes" in page
+
+
+def test_hand_still_plays_one_hand_as_before(tmp_path):
+    song = _duet(tmp_path / "duet.mid")
+    result = run("play", song, "-o", tmp_path / "out.mid", "--controller", "scripted", "--hand", "right")
+    assert result.exit_code == 0, result.output
+    assert "simulation of its own" not in result.output
+    report = json.loads((tmp_path / "out.report.json").read_text())
+    assert "hands" not in report and report["performer"] == "scripted pianist" and report["reference_notes"] == 4
+    assert len(mido.MidiFile(tmp_path / "out.mid").tracks) == 1
+
+
+def test_notes_one_hand_cannot_play_are_given_to_both_hands_by_the_planner(tmp_path):
+    """One unnamed track, a bass under a melody two octaves apart: refused as one hand's part
+    (outside its keyboard), so the fingering planner gives its notes to the two hands."""
+    song = _one_track(tmp_path / "bass.mid", (72, 0, 1), (74, 1, 2), (40, 0, 2), (43, 2, 4), (76, 2, 4))
+    result = run("play", song, "-o", tmp_path / "out.mid", "--controller", "scripted", "--quiet")
+    assert result.exit_code == 0, result.output
+    report = json.loads((tmp_path / "out.report.json").read_text())
+    assert {h: report["hands"][h]["assigned_by_planner"] for h in report["hands"]} == {"right": 3, "left": 2}
+    assert report["f1"] == 1.0
+
+
+def test_a_one_hand_melody_in_one_unnamed_track_plays_as_before(tmp_path):
+    song = _one_track(tmp_path / "melody.mid", (60, 0, 1), (62, 1, 2), (64, 2, 3))
+    result = run("play", song, "-o", tmp_path / "out.mid", "--controller", "scripted")
+    assert result.exit_code == 0, result.output
+    assert "hands" not in json.loads((tmp_path / "out.report.json").read_text())
+
+
+def test_what_a_hand_is_given_is_said_once_per_kind(tmp_path):
+    """A left-hand chord wider than the hand reaches: one line on the first screen, none twice."""
+    left = _track((36, 0, 2), (48, 0, 2), (43, 2, 4))
+    song = _duet(tmp_path / "wide.mid", left=left)
+    result = run("play", song, "-o", tmp_path / "out.mid", "--controller", "scripted")
+    assert result.exit_code == 0, result.output
+    lines = [line for line in result.output.splitlines() if "chords wider than this hand reaches" in line]
+    assert len(lines) == 1 and lines[0].startswith("left out or reduced: the left hand's part"), result.output
+    assert "kept their lowest notes" in lines[0]  # the written bass, not the mirror image's top
+    report = json.loads((tmp_path / "out.report.json").read_text())
+    assert report["hands"]["left"]["given_to_the_hand"] == 2 and report["hands"]["left"]["recall"] == 2 / 3
+    quiet = run("play", song, "-o", tmp_path / "out.mid", "--controller", "scripted", "--quiet")
+    assert "warning: the left hand's part has chords wider" in " ".join(quiet.stderr.split())
+
+
+def test_what_both_hands_cannot_do_yet_is_one_line(tmp_path):
+    song = _duet(tmp_path / "duet.mid")
+    for extra, words in (
+        (("--video", tmp_path / "v.mp4"), ("--video", "simulation of its own", "--hand right")),
+        (("--controller", "random"), ("'random'", "'scripted'")),
+    ):
+        assert_one_line_error(run("play", song, "-o", tmp_path / "out.mid", *extra), *words)
+    assert not (tmp_path / "out.mid").exists()
+
+
+# -- bad input (issue 35, item 8) ------------------------------------------------------------------
+def test_hands_that_cross_are_one_line(tmp_path):
+    song = _duet(tmp_path / "cross.mid", left=_track((48, 0, 2), (79, 2, 4)))
+    result = run("play", song, "-o", tmp_path / "out.mid", "--controller", "scripted")
+    assert_one_line_error(result, "the hands cross at 1.000 s", "--hand right")
+
+
+def test_notes_beyond_the_pianos_keys_are_one_line_named_or_not(tmp_path):
+    named = _duet(tmp_path / "named.mid", right=_track((110, 0, 1), (72, 1, 2)))
+    unnamed = _one_track(tmp_path / "unnamed.mid", (110, 0, 1), (72, 1, 2), (40, 0, 2))
+    for song in (named, unnamed):
+        result = run("play", song, "-o", tmp_path / "out.mid", "--controller", "scripted")
+        assert_one_line_error(result, "beyond the piano's 88 keys", "--transpose -12")
+
+
+def test_more_notes_at_once_than_two_hands_have_fingers_are_thinned_in_one_line(tmp_path):
+    chord = _track(*((p, 0, 2) for p in (36, 40, 43, 48, 52, 55, 60, 64, 67)), (72, 2, 4))
+    song = midi_file(tmp_path / "nine.mid", [("Piano", chord)])
+    result = run("play", song, "-o", tmp_path / "out.mid", "--controller", "scripted", "--quiet")
+    assert result.exit_code == 0, result.output
+    said = [line for line in result.stderr.splitlines() if "more than two hands of 3 fingers" in line]
+    assert len(said) == 1 and "dropped 3 inner note(s)" in said[0], result.stderr
+    report = json.loads((tmp_path / "out.report.json").read_text())
+    assert report["reference_notes"] == 7  # the piece as both hands can hold it
+
+
+def test_three_staves_are_given_to_the_hands_by_the_planner_said_in_one_line(tmp_path):
+    song = midi_file(
+        tmp_path / "staves.mid",
+        [("Soprano", _track((76, 0, 2))), ("Alto", _track((67, 0, 2))), ("Tenor", _track((43, 0, 2)))],
+    )
+    result = run("play", song, "-o", tmp_path / "out.mid", "--controller", "scripted", "--quiet")
+    assert result.exit_code == 0, result.output
+    said = [line for line in result.stderr.splitlines() if "tracks of notes" in line]
+    assert len(said) == 1 and "given to the hands by the fingering planner" in said[0], result.stderr
+
+
+def test_score_gives_the_whole_piece_and_each_hand_with_its_fingering(tmp_path):
+    from pianobot.music.midi_io import write_midi
+    from pianobot.music.piece import Note, Piece
+
+    right = [Note(0.5 * i, p, 0.5 * i + 0.4, 80, f, "right") for i, (p, f) in enumerate([(72, 2), (74, 3), (76, 4)])]
+    left = [Note(0.0, 48, 0.9, 80, 3, "left"), Note(1.0, 43, 1.4, 80, 4, "left")]
+    reference = write_midi(Piece((*right, *left)), tmp_path / "song.mid")
+    wrong = Piece((*right, left[0], Note(1.0, 43, 1.4, 80, 2, "left")))  # the left hand's last finger wrong
+    played = write_midi(wrong.with_hands(None), tmp_path / "out.mid")  # (no track names: hands from the reference)
+    result = run("score", played, reference, "--json", tmp_path / "s.json")
+    assert result.exit_code == 0, result.output
+    scores = json.loads((tmp_path / "s.json").read_text())
+    assert scores["f1"] == 1.0 and scores["fingering_accuracy"] == 4 / 5
+    assert {h: scores["hands"][h]["fingering_accuracy"] for h in ("right", "left")} == {"right": 1.0, "left": 0.5}
+    assert scores["hands"]["left"]["reference_notes"] == 2
+    assert "left hand" in result.stdout and "0.500" in result.stdout
+    one = json.loads(run("score", played, reference, "--hand", "right", "--json", "-").stdout)
+    assert "hands" not in one and one["reference_notes"] == 3
