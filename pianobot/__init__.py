@@ -8,7 +8,8 @@ stays quick (it registers the gymnasium ids ``pianobot/Piano-v0``, ``pianobot/On
 - :func:`load_policy`, :func:`policy_configs` -- a stored policy and the environment it was trained in;
 - :class:`ScriptedPianist` -- the hand-written pianist;
 - :func:`play` -- a whole piece performed as ``pianobot play`` performs it (:func:`plan_performance`
-  says who plays each stretch, :func:`perform_plan` plays a plan);
+  says who plays each stretch, :func:`perform_plan` plays a plan); a piece with both hands plays
+  both, each hand in a simulation of its own (:func:`load_two_hands` reads a two-hand file);
 - :func:`compare` -- note F1, velocity and timing errors of a performance against its score.
 """
 
@@ -33,7 +34,8 @@ _API = {
     "load_policy": "pianobot.agent.policy",
     "policy_configs": "pianobot.agent.policy",
     "rollout": "pianobot.perform.rollout",
-    "play": "pianobot.perform.plan",
+    "play": "pianobot.perform.hands",
+    "load_two_hands": "pianobot.pianist.hands",
     "plan_performance": "pianobot.perform.plan",
     "perform_plan": "pianobot.perform.plan",
 }

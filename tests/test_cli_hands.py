@@ -175,3 +175,22 @@ def test_score_gives_the_whole_piece_and_each_hand_with_its_fingering(tmp_path):
     assert "left hand" in result.stdout and "0.500" in result.stdout
     one = json.loads(run("score", played, reference, "--hand", "right", "--json", "-").stdout)
     assert "hands" not in one and one["reference_notes"] == 3
+
+
+def test_inspect_shows_each_hand_in_plays_words(tmp_path):
+    named = _duet(tmp_path / "duet.mid")
+    result = run("inspect", named, "--json", tmp_path / "i.json")
+    assert result.exit_code == 0, result.output
+    text = " ".join(result.stdout.split())
+    assert "right hand: 4 notes, C5-F5, named by its track" in text and "--hand right|left" in text
+    assert "each hand in a simulation of its own" in text
+    found = json.loads((tmp_path / "i.json").read_text())
+    assert found["hands"]["left"] == {"notes": 2, "range": ["C3", "G3"], "named_by_file": 2, "assigned_by_planner": 0}
+    unnamed = _one_track(tmp_path / "bass.mid", (72, 0, 1), (74, 1, 2), (40, 0, 2), (43, 2, 4), (76, 2, 4))
+    text = " ".join(run("inspect", unnamed).stdout.split())
+    assert "left hand: 2 notes, E2-G2, assigned by the fingering planner" in text
+    # what play says of the same file, in the same words
+    played = run("play", unnamed, "-o", tmp_path / "o.mid", "--controller", "scripted")
+    assert "left hand: 2 notes, E2-G2, assigned by the fingering planner" in " ".join(played.stdout.split())
+    crossing = _duet(tmp_path / "cross.mid", left=_track((48, 0, 2), (79, 2, 4)))
+    assert_one_line_error(run("inspect", crossing), "the hands cross")

@@ -59,14 +59,15 @@ def test_fingering_written_by_pretty_midi_is_read(tmp_path):
         assert [n.finger for n in read_midi(tmp_path / "pm.mid", track=track).notes] == [2, 3, 4]
 
 
-def test_a_two_hand_file_read_without_hand_suggests_it(tmp_path):
+def test_a_two_hand_file_read_without_hand_plays_both_and_says_hand_plays_one(tmp_path):
     notes = [Note(i * 0.5, 72 + i, i * 0.5 + 0.4, 80) for i in range(4)] + [
         Note(i * 0.5, 36 + i, i * 0.5 + 0.4, 70) for i in range(4)
     ]
     song = write_midi(Piece(tuple(notes), bpm=120), tmp_path / "two.mid")
     result = run("inspect", song)
-    assert result.exit_code == 2 and "--hand right" in result.stderr, result.output
-    assert len(result.stderr.strip().splitlines()) == 1
+    text = " ".join(result.stdout.split())
+    assert result.exit_code == 0 and "plays both" in text and "--hand right|left plays one" in text, result.output
+    assert "left hand: 4 notes, C2-D#2, assigned by the fingering planner" in text
     assert run("inspect", song, "--hand", "right").exit_code == 0
 
 

@@ -100,3 +100,20 @@ def test_the_parts_family_draws_fingered_hand_phrases_and_melodies_by_its_seed()
         check_playable(piece, keys, HandSpec())  # no finger asked to play while it holds a note
     # held notes under a moving voice and three-note chords: what melodies alone seldom hold
     assert sum(p.max_polyphony()[0] >= 2 for p in pieces) >= 8
+
+
+def test_pianobot_play_plays_both_hands_of_a_piece_with_both_and_one_hand_as_before():
+    import pianobot
+    from pianobot.perform.hands import HandsPerformance
+    from pianobot.perform.plan import Performance
+
+    right = [Note(0.5 * i, p, 0.5 * i + 0.4, hand="right") for i, p in enumerate([72, 74, 76])]
+    both = Piece((*right, Note(0.0, 48, 0.9, hand="left")))
+    performance = pianobot.play(both, controller="scripted")
+    assert isinstance(performance, HandsPerformance) and performance.report().reference_notes == 4
+    assert performance.report("left").f1 == 1.0 and performance.report("right").reference_notes == 3
+    assert performance.to_dict()["hands"]["left"]["performer"] == "scripted pianist"
+    one = pianobot.play(Piece(tuple(right)).with_fingers([2, 3, 4]), controller="scripted")  # one hand, as before
+    assert isinstance(one, Performance) and one.report().f1 == 1.0
+    with pytest.raises(PianobotError, match="a video shows one simulation"):
+        pianobot.play(both, controller="scripted", video=True)

@@ -218,6 +218,7 @@ def read_for_play(song: Path, reading: Reading, keep_warnings: bool = True):
         song,
         reading.options,
         reading.hand,
+        reading.keyboard,
         lambda: read_song(song, reading.options, reading.keyboard, reading.hand),
         keep_warnings,
     )

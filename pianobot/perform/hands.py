@@ -109,6 +109,7 @@ def read_one_or_two(
     path: str | Path,
     options: LoadOptions,
     spec: HandSpec,
+    keyboard: KeyboardSpec,
     one_hand: Callable[[], Piece],
     keep_warnings: bool = True,
 ) -> Piece | HandsReading:
@@ -116,10 +117,11 @@ def read_one_or_two(
     it is a two-hand file, else ``one_hand()`` (the one-hand reading, as before two hands).
 
     A two-hand file: without ``options.hand`` and ``options.track``, a file whose tracks are
-    named for both hands (or a PIG file with both hands' channels), or one whose notes cannot be
-    one hand's (``one_hand()`` refuses them) and that the fingering planner gives to both hands.
-    Where the planner gives them all to one hand, ``one_hand()``'s refusal stands. ``keep_warnings``
-    False drops the warnings of a one-hand reading made only to decide."""
+    named for both hands (or a PIG file with both hands' channels), or one that cannot be one
+    hand's, whose notes ``one_hand()`` refuses and span more keys than one hand's ``keyboard``
+    has, and that the fingering planner gives to both hands. Otherwise ``one_hand()``'s reading
+    (or its refusal) stands. ``keep_warnings`` False drops the warnings of a one-hand reading made
+    only to decide."""
     if options.hand is not None or options.track is not None:
         return one_hand()
     if names_hands(path):
@@ -135,8 +137,13 @@ def read_one_or_two(
         except PianobotError as error:
             refused = error
     if refused is not None:
-        hands = read_hands(path, options, spec)
-        if len(hands.piece.hands) == 2:
+        with warnings.catch_warnings(record=True) as read:
+            warnings.simplefilter("always")
+            hands = read_hands(path, options, spec)
+        pitches = [n.pitch for n in hands.piece.notes]
+        if len(hands.piece.hands) == 2 and max(pitches) - min(pitches) >= keyboard.count:
+            for warning in read:
+                warnings.warn(warning.message)
             return hands
     for warning in caught if keep_warnings else ():
         warnings.warn(warning.message)

@@ -13,9 +13,11 @@ from pianobot.cli.options import (
     AllRows,
     PlayPhraseNotes,
     Reading,
+    read_for_play,
     reads,
 )
 from pianobot.cli.terminal import err, out, said, write_json
+from pianobot.errors import PianobotError
 from pianobot.files import check_writable
 from pianobot.music.piece import pitch_name
 
@@ -39,6 +41,7 @@ def inspect(
     from pianobot.music.instrument import check_playable
     from pianobot.music.load import HANDS, hand_tracks
     from pianobot.perform.compose import missing_phrases, trained_split
+    from pianobot.perform.hands import HandsReading
     from pianobot.pianist.fingering import ensure_fingering
     from pianobot.pianist.reduce import load_for_hand
 
@@ -47,10 +50,11 @@ def inspect(
     if json_path is not None and not to_stdout:
         check_writable(json_path)
     console = err if to_stdout else out  # standard output carries the JSON
-    tracks = []
+    tracks, named = [], False
     if song.suffix.lower() != ".txt":
         tracks = midi_io.describe_tracks(song)
         hands = {i: h for h in HANDS for i in hand_tracks(tracks, h)}
+        named = bool(hands)
         console.print(display.tracks_table([replace(t, name=said(t.name)) for t in tracks], hands))
         with_notes = [t for t in tracks if t.notes]
         pedal = sum(t.pedal for t in tracks)
@@ -63,20 +67,20 @@ def inspect(
                 else "; no sustain pedal"
             )
         )
-        if len(with_notes) > 1 and options.track is None and options.hand is None:
-            console.print(
-                "[yellow]several tracks are merged; play one part with --track N or --hand right|left[/yellow]"
-            )
+    try:
+        as_played = read_for_play(song, reading, keep_warnings=False)
+    except PianobotError:
+        if named and options.track is None and options.hand is None:
+            raise  # the two-hand reading's refusal (hands that cross, notes beyond the piano)
+        as_played = None  # one hand's part: the reading below says what it found, then what is wrong
+    if isinstance(as_played, HandsReading):
+        _both_hands(console, as_played, tracks, json_path)
+        return
+    if len([t for t in tracks if t.notes]) > 1 and options.track is None and options.hand is None:
+        console.print("[yellow]several tracks are merged; play one part with --track N or --hand right|left[/yellow]")
     piece = load_for_hand(song, options, keyboard, hand_spec)
-    polyphony, _ = piece.max_polyphony()
-    given = sum(n.finger is not None for n in piece.notes)
-    low, high = min(n.pitch for n in piece.notes), max(n.pitch for n in piece.notes)
-    velocities = sorted({n.velocity for n in piece.notes})
-    console.print(
-        f"{len(piece)} notes, {piece.duration:.2f} s at {piece.bpm:.0f} bpm; range {pitch_name(low)}-{pitch_name(high)} "
-        f"({high - low} semitones); at most {polyphony} notes at once; velocities {velocities[0]}-{velocities[-1]}; "
-        f"{given}/{len(piece)} notes fingered in the file"
-    )
+    line, data = _summary(piece)
+    console.print(line)
     piece, plan = ensure_fingering(piece, keyboard, hand_spec, options.refinger)
     if plan is not None:
         console.print(
@@ -97,12 +101,7 @@ def inspect(
             json_path,
             {
                 "tracks": [{"index": t.index, "name": t.name, "notes": t.notes, "pedal": t.pedal} for t in tracks],
-                "notes": len(piece),
-                "duration": piece.duration,
-                "bpm": piece.bpm,
-                "range": [pitch_name(low), pitch_name(high)],
-                "polyphony": polyphony,
-                "fingered_in_file": given,
+                **data,
                 "playable": True,
                 "keyboard": keyboard.describe(),
                 "fingers": list(hand_spec.fingers),
@@ -117,6 +116,53 @@ def inspect(
                     }
                     for p in phrases
                 ],
+            },
+        )
+
+
+def _summary(piece) -> tuple[str, dict]:
+    """A piece in one line (its notes, length, range, polyphony, velocities, fingering), and as JSON."""
+    polyphony, _ = piece.max_polyphony()
+    given = sum(n.finger is not None for n in piece.notes)
+    low, high = min(n.pitch for n in piece.notes), max(n.pitch for n in piece.notes)
+    velocities = sorted({n.velocity for n in piece.notes})
+    line = (
+        f"{len(piece)} notes, {piece.duration:.2f} s at {piece.bpm:.0f} bpm; range {pitch_name(low)}-{pitch_name(high)} "
+        f"({high - low} semitones); at most {polyphony} notes at once; velocities {velocities[0]}-{velocities[-1]}; "
+        f"{given}/{len(piece)} notes fingered in the file"
+    )
+    data = {
+        "notes": len(piece),
+        "duration": piece.duration,
+        "bpm": piece.bpm,
+        "range": [pitch_name(low), pitch_name(high)],
+        "polyphony": polyphony,
+        "fingered_in_file": given,
+    }
+    return line, data
+
+
+def _both_hands(console, reading, tracks, json_path) -> None:
+    """What `inspect` says of a file `play` plays with both hands: each hand in play's words."""
+    from pianobot.perform.hands import APART
+
+    line, data = _summary(reading.piece)
+    console.print(line)
+    for hand in reading.piece.hands:
+        console.print(said(reading.describe(hand)), soft_wrap=True)
+    console.print(
+        f"[green]two hands[/green]: `pianobot play` plays both, {APART} (the simulator holds one hand so far); "
+        "--hand right|left plays one hand's part",
+        soft_wrap=True,
+    )
+    if json_path is not None:
+        write_json(
+            json_path,
+            {
+                "tracks": [{"index": t.index, "name": t.name, "notes": t.notes, "pedal": t.pedal} for t in tracks],
+                **data,
+                "hands": {hand: reading.to_dict(hand) for hand in reading.piece.hands},
+                "played_as": f"both hands, {APART}",
             },
         )
 
