@@ -1,6 +1,7 @@
 """The fingering planner, and reading recordings of human players (pieces built in code)."""
 
 import math
+from dataclasses import replace
 
 import mido
 import numpy as np
@@ -17,6 +18,7 @@ from pianobot.music.midi_io import read_midi, write_midi
 from pianobot.music.piece import Note, Piece, parse_pitch
 from pianobot.perform.perform import perform
 from pianobot.pianist.fingering import Planner, ensure_fingering, plan_fingering
+from pianobot.pianist.tuning import PianistTuning
 from pianobot.sim.hand import FINGER_BASE_X
 
 MAJOR = [0, 2, 4, 5, 7, 9, 11]
@@ -81,6 +83,21 @@ def test_wrist_moves_only_where_the_hand_must_shift():
     plan = plan_fingering(melody("C4 E4 G4 E4 C4 C5 E5 G5 E5 C5", beat=1.0))
     assert plan.moves == 1
     assert plan.travel == pytest.approx(7 * Planner().pitch, abs=2 * Planner().pitch)
+
+
+def test_the_planner_passes_a_note_to_another_finger_rather_than_cut_it_short():
+    """Issue 38's legato: A5 (0.42 s, written to the next onset) then G5. Without the legato cost the
+    planner plays both with finger 4, which must let go of A5 some 0.3 s early to hop; with it, G5 goes
+    to finger 3 and A5 can sound to its end; the scripted pianist then lets go of it within 50 ms of it."""
+    notes = [(0.0, 70, 0.279, 121), (0.294, 74, 0.574, 80), (0.588, 70, 0.824, 93), (0.882, 81, 1.301, 109)]
+    notes += [(1.324, 79, 1.676, 82), (1.765, 77, 2.471, 95), (2.647, 79, 3.706, 86)]
+    piece = Piece(tuple(Note(*n) for n in notes), bpm=68)
+    staccato = Planner(tuning=replace(PianistTuning(), legato_cost=0.0)).plan(piece).piece
+    assert staccato.notes[3].finger == staccato.notes[4].finger
+    legato = Planner().plan(piece).piece
+    assert legato.notes[3].finger != legato.notes[4].finger
+    a5 = next(r for r in perform(legato, "scripted").report().rows if r.reference == legato.notes[3])
+    assert abs(a5.played.offset - a5.reference.offset) <= 0.05
 
 
 def test_the_planner_is_deterministic():

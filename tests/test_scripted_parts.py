@@ -55,3 +55,34 @@ def test_the_tuning_is_one_frozen_dataclass_that_the_pianist_uses():
     assert np.array_equal(default, ScriptedPianist(config, PianistTuning()).act(observation))
     higher = ScriptedPianist(config, replace(PianistTuning(), idle_height=0.03)).act(observation)
     assert higher.shape == default.shape and not np.array_equal(higher, default)  # idle fingers wait higher
+
+
+def test_a_held_key_stays_down_while_another_finger_strikes_within_reach_and_not_beyond():
+    """Issue 38: the wrist may stand hold_reach from straight over a held key and strike_reach from
+    straight over a key to strike; a strike both allow does not make the holding finger let go."""
+    world = WorldConfig()
+    layout = KeyLayout(world)
+    planner = StrikePlanner(world, layout, PianistTuning())
+    first, last = world.hand.spec.fingers[0], world.hand.spec.fingers[-1]
+    tips = {f: Tip(height=0.01, y=0.11) for f in world.hand.spec.fingers}
+    wrist = layout.wrist_for(first, 0)  # straight over the held key
+    near = window([(0, 0, 11, 0.5, 0), (4, 6, 9, 0.5, 2)])  # two white keys up, with the outer finger
+    plans = planner.plan(near, near[0], tips, wrist)
+    assert plans[first].phase == "hold" and plans[last].key == 4
+    far = window([(0, 0, 11, 0.5, 0), (19, 6, 9, 0.5, 2)], keys=20)  # out of the held key's reach
+    assert first not in planner.plan(far, far[0], tips, wrist)
+
+
+def test_a_repeated_key_is_let_go_later_than_one_the_finger_must_leave():
+    """A finger holding a key lets go just long enough before striking it again for it to rise; before
+    a different key it needs prepare_steps."""
+    world = WorldConfig()
+    planner = StrikePlanner(world, KeyLayout(world), PianistTuning())
+    finger = world.hand.spec.fingers[1]
+    tips = {f: Tip(height=0.01, y=0.11) for f in world.hand.spec.fingers}
+    tips[finger] = planner._pressed(5)
+    repeat = window([(5, 0, 3, 0.5, 1), (5, 4, 8, 0.5, 1)])
+    hop = window([(5, 0, 3, 0.5, 1), (7, 4, 8, 0.5, 1)])
+    assert planner.plan(repeat, repeat[0], tips)[finger].phase == "hold"
+    assert planner.plan(hop, hop[0], tips)[finger].phase != "hold"
+    assert planner.release_steps(5, 5, 64) < planner.release_steps(5, 7, 64) <= planner.hop_steps(5, 7, 64)

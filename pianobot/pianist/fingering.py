@@ -109,7 +109,9 @@ class Reach:
 class Planner:
     """Fingering for one hand on one keyboard."""
 
-    def __init__(self, keyboard: KeyboardConfig = KeyboardConfig(), hand: HandConfig = HandConfig()):
+    def __init__(
+        self, keyboard: KeyboardConfig = KeyboardConfig(), hand: HandConfig = HandConfig(), tuning=PianistTuning()
+    ):
         self.keyboard, self.hand = keyboard, hand
         self.spec = keyboard.spec
         self.fingers = hand.spec.fingers
@@ -124,8 +126,9 @@ class Planner:
         self.pitch = keyboard.geometry.white_pitch
         self.grid = np.arange(0.0, keyboard_width(keyboard) + 1e-9, self.pitch / GRID)
         world = WorldConfig(keyboard=keyboard, hand=hand)
-        self.strikes = StrikePlanner(world, KeyLayout(world), PianistTuning())
-        """The scripted pianist's strike planning: how soon a finger can strike again."""
+        self.strikes = StrikePlanner(world, KeyLayout(world), tuning)
+        """The scripted pianist's strike planning (``tuning``: its constants): how soon a finger can strike
+        again, and how soon before the next strike it lets go of a key."""
 
     # -- one chord ---------------------------------------------------------------------------
     def _states(self, chord: Sequence[Note]) -> tuple[list[tuple[int, ...]], list[int], np.ndarray]:
