@@ -7,20 +7,28 @@ Each figure is the median of ``--repeats`` runs on the same work:
   then replayed open-loop (the simulator is deterministic, so every replay makes the same
   contacts), without and with the fingertips' tactile images; once on the paper's keyboard (24
   keys, C4-B5) and once on a whole piano's (88 keys, A0-C8) with the hand put where it played;
+  and two hands over 88 keys (:class:`TwoHands`: the world, both hands' state, fingertips and
+  tactile images, the left hand playing the right's mirror image);
 - the profile of one control step (one replay with touch per keyboard): the step's wall time
   split into phases by timers put around the simulator's and the environment's functions for
   that replay (:class:`Phases`; a function called inside another is counted in its own phase
   only), in microseconds per control step; "other" is what no timer covers (the Python of
   ``env.step`` and ``world.step`` themselves);
+- play's real-time factor: the scripted pianist performing ``--play`` (default the longest
+  one-hand example, mary.mid) as ``pianobot play --controller scripted`` does after start-up;
 - tactile frames/s: the renderer alone, on every fingertip state of that performance in which
   the fingertip touches a key (one core);
 - the peer RoboPianist's env steps/s with random actions, when ``--peer-python`` names a Python
   that has robopianist installed (run in the same session, so the ratio compares like with like).
+
+The figures are measured round by round (each once a round, the peer's among them), and the
+ratios to the peer are the medians of each round's ratio.
 """
 
 from __future__ import annotations
 
 import argparse
+import math
 import statistics
 import subprocess
 import sys
@@ -36,13 +44,18 @@ import pianobot.sim.world as world_module
 from pianobot.env.piano import EnvConfig, PianoEnv, idle_pose
 from pianobot.music.instrument import KeyboardSpec
 from pianobot.music.load import load_piece
+from pianobot.perform.perform import perform
 from pianobot.pianist.scripted import ScriptedPianist
 from pianobot.sim.keyboard import KeyboardConfig, KeySensor, key_x
 from pianobot.sim.tactile import TactileConfig, TactileRenderer
+from pianobot.sim.world import PianoWorld, WorldConfig
 
 ROOT = Path(__file__).resolve().parent.parent
 PAPER = KeyboardSpec()
 PIANO = KeyboardSpec(lowest=21, count=88)
+PLAY = ROOT / "examples" / "midi" / "mary.mid"
+"""The longest one-hand example (19 s)."""
+TWO = "steps/s, touch, two hands, 88 keys (world; no env yet)"
 
 
 def record(piece):
@@ -91,6 +104,55 @@ def env_rate(piece, actions, wrist, tactile: bool, keyboard: KeyboardSpec = PAPE
     return rate
 
 
+def mirrored(action: np.ndarray) -> np.ndarray:
+    """The left hand's action that mirrors a right hand's: the same joint speeds (its kinematics
+    are the mirror image), the wrist's speed reversed."""
+    out = np.array(action, dtype=float)
+    out[-1] = -out[-1]
+    return out
+
+
+class TwoHands:
+    """Two hands over 88 keys, stepped as an environment would (there is no two-hand environment
+    yet): the right hand replays the recording, the left hand its mirror image over the mirrored
+    keys (pitch p <-> 124 - p, about D4); after each step, both hands' state, fingertips and
+    tactile images."""
+
+    def __init__(self, wrist: float):
+        config = replace(WorldConfig(), keyboard=KeyboardConfig(spec=PIANO))
+        self.world = PianoWorld(config, hands=("right", "left"))
+        self.renderer = TactileRenderer(TactileConfig(), config.hand.geometry, self.world.boxes)
+        right = wrist + key_x(config.keyboard, PAPER.lowest) - key_x(KeyboardConfig(), PAPER.lowest)
+        left = 2 * key_x(config.keyboard, 62) - right
+        self.world.reset([right, left], np.tile(idle_pose(config), 3))
+
+    def step(self, action: np.ndarray) -> None:
+        self.world.step(np.concatenate([action, mirrored(action)]))
+        for hand in range(2):
+            self.world.hand_state(hand)
+            self.world.tip_points(hand)
+            self.touch(hand)
+
+    def touch(self, hand: int) -> list[np.ndarray]:
+        angles, _ = self.world.key_state()
+        forces = self.world.tip_forces(hand)
+        images = []
+        for finger, link in self.world.hands[hand].tips.items():
+            position, rotation = self.world.link_pose(link, hand)
+            images.append(self.renderer.image(position, rotation, angles, forces[finger]))
+        return images
+
+
+def two_hand_rate(actions, wrist) -> float:
+    hands = TwoHands(wrist)
+    start = time.perf_counter()
+    for action in actions:
+        hands.step(action)
+    rate = len(actions) / (time.perf_counter() - start)
+    hands.world.close()
+    return rate
+
+
 class Phases:
     """Wall time by phase: timers put around functions (exclusive: time spent in another timed
     function called inside is counted there, not twice)."""
@@ -133,15 +195,16 @@ PHASES = {
         (world_module.PianoWorld, "_colour_keys"),
         (KeySensor, "update"),
     ],
-    "tactile images": [(PianoEnv, "_tactile_image")],
+    "tactile images": [(PianoEnv, "_tactile_image"), (TwoHands, "touch")],
     "observation": [(PianoEnv, "_observe")],
     "reward": [(piano, "reward_terms"), (PianoEnv, "_fingertip_distances")],
 }
 
 
-def profile(piece, actions, wrist, keyboard: KeyboardSpec) -> dict[str, float]:
-    """Microseconds per control step by phase, for one replay with touch."""
-    env = replay_env(piece, wrist, True, keyboard)
+def profile(piece, actions, wrist, keyboard: KeyboardSpec | None) -> dict[str, float]:
+    """Microseconds per control step by phase, for one replay with touch: one hand over
+    ``keyboard`` in the environment, or (None) two hands over 88 keys (:class:`TwoHands`)."""
+    stepper = replay_env(piece, wrist, True, keyboard) if keyboard else TwoHands(wrist)
     phases = Phases()
     for phase, functions in PHASES.items():
         for owner, name in functions:
@@ -149,11 +212,11 @@ def profile(piece, actions, wrist, keyboard: KeyboardSpec) -> dict[str, float]:
     try:
         start = time.perf_counter()
         for action in actions:
-            env.step(action)
+            stepper.step(action)
         total = time.perf_counter() - start
     finally:
         phases.restore()
-        env.close()
+        (stepper if keyboard else stepper.world).close()
     out = {phase: phases.totals[phase] for phase in PHASES}
     out["other (Python of env.step, world.step)"] = total - sum(out.values())
     out["total"] = total
@@ -165,6 +228,15 @@ def tactile_rate(renderer, touching) -> float:
     for state in touching:
         renderer.image(*state)
     return len(touching) / (time.perf_counter() - start)
+
+
+def play_factor(path: Path) -> float:
+    """Real-time factor of the scripted pianist playing ``path`` as `pianobot play --controller
+    scripted` does after start-up (the environment built, the whole piece performed)."""
+    piece = load_piece(path)
+    start = time.perf_counter()
+    perform(piece, "scripted")
+    return piece.duration / (time.perf_counter() - start)
 
 
 def peer_rates(python: str, steps: int, repeats: int) -> list[float] | None:
@@ -185,22 +257,31 @@ def main() -> None:
     parser.add_argument("--repeats", type=int, default=5)
     parser.add_argument("--peer-python", help="a Python with robopianist installed")
     parser.add_argument("--no-profile", action="store_true", help="skip the profile of a step")
+    parser.add_argument("--play", type=Path, default=PLAY, help="the piece of the real-time factor figure")
     args = parser.parse_args()
 
     piece = load_piece(ROOT / "examples" / "midi" / "twinkle.mid")
     actions, wrist, touching, renderer = record(piece)
     touch = "env steps/s, touch"
-    figures = {
-        "env steps/s, no touch, 24 keys": [env_rate(piece, actions, wrist, False) for _ in range(args.repeats)],
-        f"{touch}, 24 keys": [env_rate(piece, actions, wrist, True) for _ in range(args.repeats)],
-        f"{touch}, 88 keys": [env_rate(piece, actions, wrist, True, PIANO) for _ in range(args.repeats)],
-        "tactile frames/s under contact (60x80)": [tactile_rate(renderer, touching) for _ in range(args.repeats)],
-    }
     peer = "RoboPianist env steps/s (peer: two hands, 88 keys)"
+    measures = {
+        "env steps/s, no touch, 24 keys": lambda: env_rate(piece, actions, wrist, False),
+        f"{touch}, 24 keys": lambda: env_rate(piece, actions, wrist, True),
+        f"{touch}, 88 keys": lambda: env_rate(piece, actions, wrist, True, PIANO),
+        TWO: lambda: two_hand_rate(actions, wrist),
+        "tactile frames/s under contact (60x80)": lambda: tactile_rate(renderer, touching),
+        f"play's real-time factor, scripted pianist, {args.play.name}": lambda: play_factor(args.play),
+    }
     if args.peer_python:
-        rates = peer_rates(args.peer_python, len(actions), args.repeats)
-        if rates:
-            figures[peer] = rates
+        measures[peer] = lambda: (peer_rates(args.peer_python, len(actions), 1) or [float("nan")])[0]
+    # round by round, every figure once a round: a shared machine's load changes over minutes,
+    # and the figures of one round (the peer's among them) see the same load
+    figures: dict[str, list[float]] = {name: [] for name in measures}
+    for _ in range(args.repeats):
+        for name, measure in measures.items():
+            figures[name].append(measure())
+    if peer in figures and any(math.isnan(v) for v in figures[peer]):
+        del figures[peer]
 
     print(
         f"{len(actions)} control steps per replay, {len(touching)} fingertip frames in contact, {args.repeats} repeats\n"
@@ -208,14 +289,18 @@ def main() -> None:
     print("| figure | median | runs |")
     print("| --- | ---: | --- |")
     for name, values in figures.items():
-        print(f"| {name} | {statistics.median(values):.0f} | {', '.join(f'{v:.0f}' for v in values)} |")
+        digits = 1 if "factor" in name else 0
+        cells = ", ".join(f"{v:.{digits}f}" for v in values)
+        print(f"| {name} | {statistics.median(values):.{digits}f} | {cells} |")
     if peer in figures:
-        for keys in ("24 keys", "88 keys"):
-            ratio = statistics.median(figures[f"{touch}, {keys}"]) / statistics.median(figures[peer])
-            print(f"\npianobot with touch, one hand over {keys} / RoboPianist: {ratio:.2f}x")
+        print()
+        for name in (f"{touch}, 24 keys", f"{touch}, 88 keys", TWO):
+            ratios = [ours / theirs for ours, theirs in zip(figures[name], figures[peer])]
+            print(f"{name} / RoboPianist, median of the rounds' ratios: {statistics.median(ratios):.2f}x")
 
     if not args.no_profile:
-        profiles = {k.describe(): profile(piece, actions, wrist, k) for k in (PAPER, PIANO)}
+        profiles = {f"one hand, {k.count} keys": profile(piece, actions, wrist, k) for k in (PAPER, PIANO)}
+        profiles["two hands, 88 keys"] = profile(piece, actions, wrist, None)
         print("\nWhere a control step's time goes (µs per step, one replay with touch, timers on):\n")
         print("| phase | " + " | ".join(profiles) + " |")
         print("| --- | " + " | ".join("---:" for _ in profiles) + " |")

@@ -349,20 +349,17 @@ class PianoWorld:
         ]
         touched = {key for key, *_ in self._contacts}
         read = sorted(self._moving | touched)
-        if not read:
-            return read
-        for k in read:
-            self.key_angles[k], self.key_speeds[k] = p.getJointState(self.keys[k], 0, physicsClientId=c)[:2]
-        angles = self.key_angles[read]
-        depth = np.clip(angles / kb.geometry.max_angle, 0.0, 1.0)
-        torque = kb.spring_torque + (kb.spring_torque_pressed - kb.spring_torque) * depth**2
+        max_angle, rest, pressed = kb.geometry.max_angle, kb.spring_torque, kb.spring_torque_pressed
         rest_angle, rest_speed = KEY_AT_REST
-        resting = (np.abs(angles) < rest_angle) & (np.abs(self.key_speeds[read]) < rest_speed)
-        for k, tau, still in zip(read, torque, resting):
-            if tau != self._spring[k]:
-                self._spring[k] = tau
-                self._set_spring(self.keys[k], tau)
-            if still and k not in touched:
+        for k in read:  # a few keys: plain Python is quicker than NumPy here
+            angle, speed = p.getJointState(self.keys[k], 0, physicsClientId=c)[:2]
+            self.key_angles[k], self.key_speeds[k] = angle, speed
+            depth = min(max(angle / max_angle, 0.0), 1.0)
+            torque = rest + (pressed - rest) * depth**2
+            if torque != self._spring[k]:
+                self._spring[k] = torque
+                self._set_spring(self.keys[k], torque)
+            if abs(angle) < rest_angle and abs(speed) < rest_speed and k not in touched:
                 self._moving.discard(k)
                 p.changeDynamics(self.keys[k], 0, activationState=p.ACTIVATION_STATE_SLEEP, physicsClientId=c)
             else:
@@ -442,9 +439,9 @@ class PianoWorld:
     def _finger_motors(self, hand: HandBody, mode: int, **arrays: np.ndarray) -> None:
         """Every finger joint's motor of ``hand`` in ``mode`` (velocity motors at most the hand's
         joint force, unless ``forces`` says otherwise)."""
-        if mode == p.VELOCITY_CONTROL and "forces" not in arrays:
-            arrays["forces"] = np.full(len(hand.fingers), self.config.hand.joint_force)
         lists = {name: np.asarray(values, dtype=float).tolist() for name, values in arrays.items()}
+        if mode == p.VELOCITY_CONTROL and "forces" not in lists:
+            lists["forces"] = [self.config.hand.joint_force] * len(hand.fingers)
         p.setJointMotorControlArray(hand.body, hand.fingers, mode, physicsClientId=self.client, **lists)
 
     def _drive_fingers(self, hand: int, torque: bool, left: int) -> None:
