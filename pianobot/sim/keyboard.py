@@ -153,19 +153,27 @@ class KeySensor:
         self.sounding[:] = False
         self.velocity[:] = 0
 
-    def update(self, time: float, angles: np.ndarray, speeds: np.ndarray) -> list[KeyEvent]:
-        """Feed one sample of all keys; returns the events it caused."""
-        struck = ~self.sounding & (angles >= self.strike)
-        released = self.sounding & (angles < self.release)
+    def update(
+        self, time: float, angles: np.ndarray, speeds: np.ndarray, keys: list[int] | None = None
+    ) -> list[KeyEvent]:
+        """Feed one sample of all keys; returns the events it caused. ``keys`` (sorted key
+        indices): only these can have changed since the last sample (the others are at rest and
+        do not sound), so only these are looked at."""
+        if keys is None:
+            keys = range(len(self.pitches))
+        index = np.asarray(keys, dtype=int)
+        angle, sounding = angles[index], self.sounding[index]
+        struck = index[~sounding & (angle >= self.strike)]
+        released = index[sounding & (angle < self.release)]
         events: list[KeyEvent] = []
-        if struck.any():
+        if struck.size:
             lever = self.config.geometry.white_length
             velocities = self.config.curve.velocity(np.maximum(speeds[struck], 0.0) * lever)
             self.velocity[struck] = velocities
-            self.sounding |= struck
+            self.sounding[struck] = True
             events += [KeyEvent(time, int(p), True, int(v)) for p, v in zip(self.pitches[struck], velocities)]
-        if released.any():
-            self.sounding &= ~released
+        if released.size:
+            self.sounding[released] = False
             self.velocity[released] = 0
             events += [KeyEvent(time, int(p), False) for p in self.pitches[released]]
         return events

@@ -503,9 +503,10 @@ class PianoWorld:
                 self._drive_fingers(hand, torque, self.config.substeps - substep)
             p.stepSimulation(physicsClientId=self.client)
             self.time += self.dt
-            if not self._update_keys():
+            read = self._update_keys()
+            if not read:
                 continue  # every key at rest: nothing can sound or release
-            new = self.sensor.update(self.time, self.key_angles, self.key_speeds)
+            new = self.sensor.update(self.time, self.key_angles, self.key_speeds, read)
             if new:
                 touch: dict[
                     int, tuple[int, int, float]
