@@ -6,6 +6,7 @@ import json
 from pathlib import Path
 
 import mido
+import pytest
 from conftest import assert_one_line_error, midi_file, off, on, run
 
 from pianobot.music.load import load_hands
@@ -194,3 +195,34 @@ def test_inspect_shows_each_hand_in_plays_words(tmp_path):
     assert "left hand: 2 notes, E2-G2, assigned by the fingering planner" in " ".join(played.stdout.split())
     crossing = _duet(tmp_path / "cross.mid", left=_track((48, 0, 2), (79, 2, 4)))
     assert_one_line_error(run("inspect", crossing), "the hands cross")
+
+
+# -- the two-hand examples (issue 35, item 7) ----------------------------------------------------------
+def _play_example_with_both_hands(name, tmp_path) -> float:
+    """`pianobot play EXAMPLE --controller scripted` (both hands by default), then `pianobot score`;
+    returns note F1 against the original file as read (not against a reduction), which score agrees with."""
+    from pianobot.music.load import load_piece
+
+    song, out = EXAMPLES / f"{name}.mid", tmp_path / "out.mid"
+    played = run("play", song, "-o", out, "--controller", "scripted", "--quiet")
+    assert played.exit_code == 0, played.output
+    scored = run("score", out, song, "--json", tmp_path / "s.json", "--no-notes")
+    assert scored.exit_code == 0, scored.output
+    scores = json.loads((tmp_path / "s.json").read_text())
+    assert set(scores["hands"]) == {"right", "left"}
+    original = compare(load_piece(song), read_midi(out))
+    assert original.reference_notes == scores["reference_notes"] and abs(original.f1 - scores["f1"]) < 1e-9
+    return original.f1
+
+
+def test_a_two_hand_example_plays_both_hands_end_to_end(tmp_path):
+    """Ode to Joy over a bass line (tracks named for the hands), about 10 s."""
+    assert _play_example_with_both_hands("ode-to-joy-performed", tmp_path) >= 0.95
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(
+    "name", ["chorale-performed", "prelude-performed", "minuet-performed", "twinkle-performed", "nocturne-performed"]
+)
+def test_every_two_hand_example_plays_both_hands_at_note_f1_090(name, tmp_path):
+    assert _play_example_with_both_hands(name, tmp_path) >= 0.9
