@@ -226,3 +226,16 @@ def test_a_two_hand_example_plays_both_hands_end_to_end(tmp_path):
 )
 def test_every_two_hand_example_plays_both_hands_at_note_f1_090(name, tmp_path):
     assert _play_example_with_both_hands(name, tmp_path) >= 0.9
+
+
+def test_the_keyboard_options_name_the_keys_each_hand_plays_on(tmp_path):
+    song = _duet(tmp_path / "duet.mid")
+    args = ("play", song, "-o", tmp_path / "out.mid", "--controller", "scripted", "--quiet")
+    report = tmp_path / "out.report.json"
+    assert run(*args).exit_code == 0
+    default = json.loads(report.read_text())["hands"]
+    assert default["right"]["played_as"] == "on C5-B5 (12 keys)"  # the scripted pianist: the part's own octaves
+    assert run(*args, "--lowest-note", "C3", "--keys", "36").exit_code == 0
+    hands = json.loads(report.read_text())["hands"]
+    assert hands["right"]["played_as"] == "on C3-B5 (36 keys)"
+    assert hands["left"]["played_as"] == "mirrored about D, on C3-B5 (36 keys)" and hands["left"]["f1"] == 1.0

@@ -287,7 +287,7 @@ def play_hands(
     ``models`` the model store, ``seed`` the hand start of every simulation, ``hand`` each hand's
     fingers; ``keyboard`` the keys every part is moved onto (default: the general policy's 24 keys
     for 'sac', each part's own range for 'scripted'); ``options`` go to
-    :func:`~pianobot.perform.plan.plan_performance` (``general``, ``fallback``, ...)."""
+    :func:`~pianobot.perform.plan.play` (``general``, ``fallback``, ``on_step`` for each hand, ...)."""
     if any(n.hand is None for n in piece.notes):
         raise PianobotError("every note needs a hand to play both hands: give the piece's notes a hand first")
     if controller not in ("sac", "scripted"):
@@ -318,5 +318,4 @@ def play(
         return plan.play(piece, controller, models, seed, **options)
     if options.pop("video", False):
         raise PianobotError(f"a video shows one simulation, and both hands play {APART}: play one hand for a video")
-    options.pop("on_step", None)
     return play_hands(piece, controller, models, seed, **options)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 from pathlib import Path
@@ -28,6 +29,18 @@ from pianobot.files import atomic_write, check_writable
 from pianobot.music.phrases import DEFAULT_MAX_NOTES
 from pianobot.music.piece import Piece
 from pianobot.perform.controllers import CONTROLLERS
+
+
+@contextlib.contextmanager
+def progress(what: str):
+    """A progress bar on standard error's terminal (none in a log: there a bar is noise, and its
+    last line break an empty line); yields the ``on_step(done, total)`` that moves it."""
+    from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
+
+    columns = (TextColumn("{task.description}"), BarColumn(), TimeRemainingColumn())
+    with Progress(*columns, console=err, transient=True, disable=not err.is_terminal) as bar:
+        task = bar.add_task(what, total=None)
+        yield lambda done, total: bar.update(task, completed=done, total=total)
 
 
 @reads()
@@ -91,8 +104,6 @@ def play(
     reading: Reading = None,
 ):
     """Perform a piece in the simulator; write the played notes (velocities, fingers) and a velocity-error report."""
-    from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
-
     from pianobot.cli import display
     from pianobot.music.midi_io import write_midi
     from pianobot.music.phrases import split_phrases
@@ -170,21 +181,8 @@ def play(
         console.print(
             f"[dim]{len(plan.phrases)} phrases of at most {most} note{'s' * (most > 1)}: the split the policies in {said(models)} were trained for[/dim]"
         )
-    with Progress(
-        TextColumn("{task.description}"),
-        BarColumn(),
-        TimeRemainingColumn(),
-        console=err,
-        transient=True,
-        disable=not err.is_terminal,  # (a bar in a log is noise, and its last line break an empty line)
-    ) as bar:
-        task = bar.add_task(f"playing {said(song.name)}", total=None)
-        performance = perform_plan(
-            plan,
-            seed=seed,
-            video=video is not None,
-            on_step=lambda done, total: bar.update(task, completed=done, total=total),
-        )
+    with progress(f"playing {said(song.name)}") as on_step:
+        performance = perform_plan(plan, seed=seed, video=video is not None, on_step=on_step)
     report = performance.report()
     write_midi(performance.played, output, name=f"pianobot ({plan.performer}): {song.stem}")
     atomic_write(report_path, json.dumps(performance.to_dict(), indent=2) + "\n")
@@ -240,7 +238,10 @@ def play_both(
         console.print(f"both hands, {APART} (the simulator holds one hand so far); {AGAINST}", soft_wrap=True)
         for name in reading.piece.hands:
             console.print(said(reading.describe(name)), soft_wrap=True)
-    with warnings.catch_warnings(record=True) as caught:
+    with (
+        warnings.catch_warnings(record=True) as caught,
+        progress(f"playing {said(song.name)}, hand by hand") as on_step,
+    ):
         warnings.simplefilter("always", PianobotWarning)
         performance = play_hands(
             reading.piece,
@@ -249,6 +250,7 @@ def play_both(
             seed,
             hand,
             None if keyboard == KeyboardSpec() else keyboard,  # (the default: each player's own keys)
+            on_step=on_step,
             **options,
         )
     changes = {line for h in performance.hands for line in h.changes}
