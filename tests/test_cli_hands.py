@@ -239,3 +239,15 @@ def test_the_keyboard_options_name_the_keys_each_hand_plays_on(tmp_path):
     hands = json.loads(report.read_text())["hands"]
     assert hands["right"]["played_as"] == "on C3-B5 (36 keys)"
     assert hands["left"]["played_as"] == "mirrored about D, on C3-B5 (36 keys)" and hands["left"]["f1"] == 1.0
+
+
+def test_a_pig_file_with_both_hands_channels_plays_both_hands(tmp_path):
+    from pianobot.music.piece import Note, Piece
+    from pianobot.music.pig import write_pig
+
+    right = [Note(0.5 * i, p, 0.5 * i + 0.4, 80, f, "right") for i, (p, f) in enumerate([(72, 2), (74, 3)])]
+    song = write_pig(Piece((*right, Note(0.0, 48, 0.9, 80, 2, "left"))), tmp_path / "duet.txt")
+    result = run("play", song, "-o", tmp_path / "out.mid", "--controller", "scripted")
+    assert result.exit_code == 0, result.output
+    assert "left hand: 1 note, C3-C3, named by the PIG channel" in " ".join(result.stdout.split())
+    assert json.loads((tmp_path / "out.report.json").read_text())["hands"]["left"]["f1"] == 1.0

@@ -73,7 +73,8 @@ class HandsReading:
             who = "assigned by the fingering planner"
         else:
             who = f"{named} named by {self.source}, {len(part) - named} assigned by the fingering planner"
-        return f"{hand} hand: {len(part)} notes, {pitch_name(low)}-{pitch_name(high)}, {who}"
+        notes = f"{len(part)} note{'s' * (len(part) != 1)}"
+        return f"{hand} hand: {notes}, {pitch_name(low)}-{pitch_name(high)}, {who}"
 
     def to_dict(self, hand: str) -> dict:
         part = self.piece.part(hand)
