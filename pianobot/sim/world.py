@@ -84,16 +84,14 @@ class StepResult:
 
 @dataclass(frozen=True)
 class HandBody:
-    """One hand in the world: its side, body, and the joints and links the world drives and reads."""
+    """One hand in the world: its ``side``, its ``body``, its ``wrist``'s (prismatic) joint, its
+    ``fingers``' joints in action order, and ``tips``: finger -> the link of its fingertip."""
 
     side: str
     body: int
     wrist: int
-    """The wrist's (prismatic) joint."""
     fingers: tuple[int, ...]
-    """The finger joints, in action order."""
     tips: dict[int, int]
-    """Finger -> the link of its fingertip (the distal link)."""
 
 
 RAY_GROUP, HAND_GROUP, KEY_GROUP = 1, 2, 4
