@@ -62,29 +62,29 @@ class HandsReading:
     source: str = "its track"
     """What named a note's hand in the file: 'its track', 'the PIG channel'."""
 
-    def describe(self, hand: str) -> str:
-        """One line on ``hand``'s part: 'right hand: 64 notes, C4-D5, named by its track'."""
-        part = self.piece.part(hand)
-        low, high = min(n.pitch for n in part.notes), max(n.pitch for n in part.notes)
-        named = min(self.named.get(hand, 0), len(part))
-        if named == len(part):
-            who = f"named by {self.source}"
-        elif named == 0:
-            who = "assigned by the fingering planner"
-        else:
-            who = f"{named} named by {self.source}, {len(part) - named} assigned by the fingering planner"
-        notes = f"{len(part)} note{'s' * (len(part) != 1)}"
-        return f"{hand} hand: {notes}, {pitch_name(low)}-{pitch_name(high)}, {who}"
-
     def to_dict(self, hand: str) -> dict:
+        """``hand``'s part: how many notes, its range, how many the file named and the planner assigned."""
         part = self.piece.part(hand)
-        named = min(self.named.get(hand, 0), len(part))
+        named = min(self.named.get(hand, 0), len(part))  # (a note the reading thinned away may have been named)
         return {
             "notes": len(part),
             "range": [pitch_name(min(n.pitch for n in part.notes)), pitch_name(max(n.pitch for n in part.notes))],
             "named_by_file": named,
             "assigned_by_planner": len(part) - named,
         }
+
+    def describe(self, hand: str) -> str:
+        """One line on ``hand``'s part: 'right hand: 64 notes, C4-D5, named by its track'."""
+        part = self.to_dict(hand)
+        named, assigned = part["named_by_file"], part["assigned_by_planner"]
+        if assigned == 0:
+            who = f"named by {self.source}"
+        elif named == 0:
+            who = "assigned by the fingering planner"
+        else:
+            who = f"{named} named by {self.source}, {assigned} assigned by the fingering planner"
+        notes = f"{part['notes']} note{'s' * (part['notes'] != 1)}"
+        return f"{hand} hand: {notes}, {'-'.join(part['range'])}, {who}"
 
 
 def read_hands(path: str | Path, options: LoadOptions = LoadOptions(), spec: HandSpec = HandSpec()) -> HandsReading:
@@ -118,7 +118,8 @@ def read_one_or_two(
     it is a two-hand file, else ``one_hand()`` (the one-hand reading, as before two hands).
 
     A two-hand file: without ``options.hand`` and ``options.track``, a file whose tracks are
-    named for both hands (or a PIG file with both hands' channels), or one that cannot be one
+    named for hands (the notes of others given hands by the fingering planner) and that has both
+    hands' notes (or a PIG file with both hands' channels), or one that cannot be one
     hand's, whose notes ``one_hand()`` refuses and span more keys than one hand's ``keyboard``
     has, and that the fingering planner gives to both hands. Otherwise ``one_hand()``'s reading
     (or its refusal) stands. ``keep_warnings`` False drops the warnings of a one-hand reading made
