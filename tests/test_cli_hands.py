@@ -64,6 +64,7 @@ def test_a_file_with_tracks_named_for_hands_plays_both_hands_one_track_each(tmp_
     left = report["hands"]["left"]
     assert left["performer"] == "scripted pianist" and left["notes"] == 2 and left["named_by_file"] == 2
     assert left["reference_notes"] == 2 and left["f1"] == 1.0 and left["left_out_or_reduced"] == []
+    assert [(n["pitch"], n["hand"]) for n in report["notes"]][:2] == [("C3", "left"), ("C5", "right")]
     page = (tmp_path / "r.html").read_text()
     assert "<section id='hands'>" in page and "simulation of its own" in page and "left hand: 2 notes" in page
 

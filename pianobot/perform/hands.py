@@ -239,12 +239,15 @@ class HandsPerformance:
                 "plan": h.performance.plan.to_dict(),
                 **self.report(h.hand).summary(),
             }
+        whole = self.report().to_dict()
+        for note, row in zip(whole["notes"], self.report().rows):  # each note with the hand that has it
+            note["hand"] = (row.reference or row.played).hand
         return {
             "seed": self.seed,
             "performer": self.performer,
             "hands_simulated": f"apart: {APART}, the two merged; {AGAINST}",
             "hands": hands,
-            **self.report().to_dict(),
+            **whole,
         }
 
 
