@@ -252,3 +252,15 @@ def test_a_pig_file_with_both_hands_channels_plays_both_hands(tmp_path):
     assert result.exit_code == 0, result.output
     assert "left hand: 1 note, C3-C3, named by the PIG channel" in " ".join(result.stdout.split())
     assert json.loads((tmp_path / "out.report.json").read_text())["hands"]["left"]["f1"] == 1.0
+
+
+def test_finger_writes_each_hands_fingering_one_track_each(tmp_path):
+    song = _duet(tmp_path / "duet.mid")
+    result = run("finger", song, "-o", tmp_path / "fingered.mid")
+    assert result.exit_code == 0, result.output
+    fingered = read_midi(tmp_path / "fingered.mid")
+    assert fingered.hands == ("right", "left") and fingered.has_fingering
+    assert all(n.finger in (2, 3, 4) for n in fingered.notes)
+    assert [(n.pitch, n.hand) for n in fingered.notes] == [(n.pitch, n.hand) for n in load_hands(song).notes]
+    text = " ".join(result.stdout.split())
+    assert "left hand, fingers 2 (index), 3 (middle), 4 (ring): wrist travel" in text and "one track per hand" in text

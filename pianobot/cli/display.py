@@ -51,11 +51,14 @@ def _shown(table: Table, total: int, rows: int | None, what: str, more: str = "-
 
 
 def notes_table(piece: Piece, phrases: list[Phrase], rows: int | None = ROWS) -> Table:
-    """The notes with their fingers and phrases (the first ``rows``; None: all)."""
+    """The notes with their fingers and phrases, or for a two-hand piece their hands (the first
+    ``rows``; None: all)."""
     phrase_of = {id(n): p.index for p in phrases for n in p.notes}
+    both = len(piece.hands) == 2  # (a hand column for a two-hand piece)
     table = Table(title=f"{len(piece)} notes")
-    for column in ("#", "onset s", "pitch", "duration s", "velocity", "finger", "phrase"):
-        table.add_column(column, justify="right" if column != "finger" else "left")
+    columns = ("#", "onset s", "pitch", "duration s", "velocity", "finger") + (("hand",) if both else ("phrase",))
+    for column in columns:
+        table.add_column(column, justify="right" if column not in ("finger", "hand") else "left")
     shown = _shown(table, len(piece), rows, "notes")
     for i, n in enumerate(piece.notes[:shown]):
         table.add_row(
@@ -65,7 +68,7 @@ def notes_table(piece: Piece, phrases: list[Phrase], rows: int | None = ROWS) ->
             f"{n.duration:.3f}",
             str(n.velocity),
             _finger(n.finger),
-            str(phrase_of.get(id(n), "-")),
+            n.hand if both else str(phrase_of.get(id(n), "-")),
         )
     return table
 

@@ -11,6 +11,7 @@ from pianobot.cli.options import (
     AllRows,
     Reading,
     check_midi_output,
+    read_for_play,
     reads,
 )
 from pianobot.cli.terminal import out, said
@@ -25,16 +26,32 @@ def finger(
     all_rows: bool = AllRows,
     reading: Reading = None,
 ):
-    """Plan a fingering for the robot hand (least wrist travel within its reach) and write it to a MIDI file."""
+    """Plan a fingering for the robot hand (least wrist travel within its reach) and write it to a MIDI file;
+    for a two-hand file (as `play` reads it), each hand's, one track per hand."""
     from pianobot.cli import display
     from pianobot.music.midi_io import write_midi
     from pianobot.music.phrases import split_phrases
+    from pianobot.perform.hands import HandsReading
     from pianobot.pianist.fingering import ensure_fingering
+    from pianobot.pianist.hands import finger_hands
     from pianobot.pianist.reduce import load_for_hand
 
     check_midi_output(output, song, "the fingered piece")
     check_writable(output)
     keyboard, hand_spec = reading.keyboard, reading.hand
+    as_played = read_for_play(song, reading, keep_warnings=False)
+    if isinstance(as_played, HandsReading):  # a two-hand file: each hand fingered, one track each
+        fingered = finger_hands(as_played.piece, hand_spec, refinger=True)
+        write_midi(fingered.piece, output)
+        out.print(display.notes_table(fingered.piece, [], None if all_rows else display.ROWS))
+        for hand, plan in fingered.plans.items():
+            count = len(fingered.piece.part(hand))
+            travel = f"wrist travel {plan.travel * 100:.1f} cm in {plan.moves} moves" if plan else "as the file had it"
+            out.print(f"{hand} hand, fingers {hand_spec.describe()}: {travel} over {count} notes", soft_wrap=True)
+            for problem in plan.problems if plan else ():
+                out.print(f"[yellow]cannot be played at this tempo:[/yellow] {said(phrase(problem))}")
+        out.print(f"fingering for both hands written to {said(output)} (one track per hand)")
+        return
     piece = load_for_hand(song, reading.options, keyboard, hand_spec)
     piece, plan = ensure_fingering(piece, keyboard, hand_spec, refinger=True)
     write_midi(piece, output, name=f"{song.stem} fingered by pianobot")
