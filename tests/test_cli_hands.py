@@ -168,8 +168,10 @@ def test_score_gives_the_whole_piece_and_each_hand_with_its_fingering(tmp_path):
     reference = write_midi(Piece((*right, *left)), tmp_path / "song.mid")
     wrong = Piece((*right, left[0], Note(1.0, 43, 1.4, 80, 2, "left")))  # the left hand's last finger wrong
     played = write_midi(wrong.with_hands(None), tmp_path / "out.mid")  # (no track names: hands from the reference)
-    result = run("score", played, reference, "--json", tmp_path / "s.json")
+    result = run("score", played, reference, "--json", tmp_path / "s.json", "--html", tmp_path / "s.html")
     assert result.exit_code == 0, result.output
+    page = (tmp_path / "s.html").read_text()
+    assert "<section id='hands'>" in page and "<td>left hand</td><td>2 of 2, 0 extra</td>" in page
     scores = json.loads((tmp_path / "s.json").read_text())
     assert scores["f1"] == 1.0 and scores["fingering_accuracy"] == 4 / 5
     assert {h: scores["hands"][h]["fingering_accuracy"] for h in ("right", "left")} == {"right": 1.0, "left": 0.5}

@@ -373,6 +373,29 @@ def _hands_section(performance, reading) -> str:
     )
 
 
+def _scores_section(scores) -> str:
+    """Each hand of a two-hand reference, scored (:class:`~pianobot.music.hand_scores.HandsReport`)."""
+    from html import escape
+
+    head = "".join(f"<th>{h}</th>" for h in ("part", "notes played", "note F1", "key-press F1 per step", "fingering"))
+    rows = []
+    for name, report in (("whole piece", scores.whole), *((f"{h} hand", r) for h, r in scores.hands.items())):
+        extra = report.played_notes - report.matched_notes
+        cells = (
+            name,
+            f"{report.matched_notes} of {report.reference_notes}, {extra} extra",
+            f"{report.f1:.3f}",
+            f"{report.step_f1:.3f}",
+            _opt(report.fingering_accuracy, ".3f"),
+        )
+        rows.append("<tr>" + "".join(f"<td>{escape(c)}</td>" for c in cells) + "</tr>")
+    return (
+        "<section id='hands'><h2>Each hand</h2><p class='what'>The reference's notes of each hand against "
+        "the played notes matched to them (an extra note counts for its own hand, else the nearest "
+        f"reference note's).</p><table class='hands'><tr>{head}</tr>{''.join(rows)}</table></section>"
+    )
+
+
 def _media(path: Path | None, kind: str, mime: str) -> str:
     import base64
 
@@ -392,13 +415,15 @@ def html_report(
     audio: Path | None = None,
     hands=None,
     reading=None,
+    scores=None,
 ) -> str:
     """One self-contained HTML page (no file or network needed beside it): the figures with what
     they mean, the video (with its sound) and the audio when given, the piano roll of the score
     against what was played, each note's velocity and timing errors, who played each phrase
     (``plan``: a :class:`~pianobot.perform.plan.PerformancePlan`) and every note; for a two-hand
     performance (``hands``: a :class:`~pianobot.perform.hands.HandsPerformance`, ``reading``
-    what the file named), each hand."""
+    what the file named) or a two-hand reference scored (``scores``: a
+    :class:`~pianobot.music.hand_scores.HandsReport`), each hand."""
     from html import escape
 
     stretches = sections(plan) if plan is not None else []
@@ -428,6 +453,8 @@ def html_report(
     ]
     if hands is not None:
         parts.append(_hands_section(hands, reading))
+    elif scores is not None and scores.hands:
+        parts.append(_scores_section(scores))
     if video is not None or audio is not None:
         parts += [
             "<section id='media'><h2>Watch and listen</h2>",

@@ -85,5 +85,5 @@ def score(
     if html is not None:
         from pianobot.perform.report import write_html
 
-        write_html(html, report, f"{played.name} against {reference.name}")
+        write_html(html, report, f"{played.name} against {reference.name}", scores=scores)
         console.print(f"report to open in a browser written to {said(html)}")
