@@ -216,3 +216,25 @@ def test_each_strike_of_a_repeated_note_is_announced_once_and_the_hold_between_t
     strikes = [env.lead_steps, env.lead_steps + 10]  # 20 Hz: the onsets' steps
     assert [t for t, flag in enumerate(now) if flag] == strikes
     assert all(holding[strikes[0] + 1 : strikes[1] - 1]) and not holding[strikes[0]] and not holding[strikes[1] - 1]
+
+
+def test_render_honours_the_render_mode():
+    """Issue 36, item 5: a frame with render_mode='rgb_array'; None and gymnasium's warning without
+    one; another mode refused. gymnasium's checker passes with rendering checked."""
+    import warnings
+
+    rendering = PianoEnv(piece=PHRASE, config=EnvConfig(tactile=False), render_mode="rgb_array")
+    rendering.reset(seed=0)
+    frame = rendering.render()
+    assert frame.ndim == 3 and frame.shape[2] == 3 and frame.dtype == np.uint8 and frame.any()
+    check_env(rendering)
+    rendering.close()
+    quiet = PianoEnv(piece=PHRASE, config=EnvConfig(tactile=False))
+    quiet.reset(seed=0)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        assert quiet.render() is None
+    assert any("render_mode" in str(w.message) for w in caught)
+    quiet.close()
+    with pytest.raises(ValueError, match="render_mode 'human'"):
+        PianoEnv(piece=PHRASE, render_mode="human")

@@ -210,6 +210,8 @@ class PianoEnv(gym.Env):
     ):
         if [piece, task, sampler].count(None) != 2:
             raise ValueError("give exactly one of piece=, task= or sampler=")
+        if render_mode not in (None, *self.metadata["render_modes"]):
+            raise ValueError(f"render_mode {render_mode!r}: choose None or 'rgb_array'")
         if task is not None:
             if task not in TASKS:
                 raise ValueError(
@@ -407,7 +409,14 @@ class PianoEnv(gym.Env):
             obs["key_velocities"] = _bounded(key_speeds / (max_angle * cfg.world.control_hz))
         return obs
 
-    def render(self):
+    def render(self) -> np.ndarray | None:
+        """The simulation's camera frame (height x width x 3, uint8) with ``render_mode="rgb_array"``;
+        without a render mode, None and a warning, as gymnasium's environments do."""
+        if self.render_mode is None:
+            gym.logger.warn(
+                'render() is called without a render mode: make the environment with render_mode="rgb_array"'
+            )
+            return None
         return self.world.render()
 
     def close(self):

@@ -40,7 +40,7 @@ def perform(
     ``controller`` is 'scripted', 'random', or a function that makes a controller for the
     environment (compositional execution passes one). ``on_step(done, total)`` reports progress.
     """
-    env = PianoEnv(piece=piece, config=config)
+    env = PianoEnv(piece=piece, config=config, render_mode="rgb_array" if video else None)
     try:
         agent = controller(env) if callable(controller) else make_controller(controller, env, seed)
         return rollout(env, agent, seed=seed, video=video, on_step=on_step)
