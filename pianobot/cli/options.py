@@ -208,20 +208,12 @@ def read_song(song: Path, options: LoadOptions, keyboard: KeyboardSpec, hand: Ha
     return piece
 
 
-def read_for_play(song: Path, reading: Reading, keep_warnings: bool = True):
-    """The piece as `play` reads it: a :class:`~pianobot.perform.hands.HandsReading` when the file
-    plays both hands, else the one-hand piece of :func:`read_song` (``keep_warnings`` False: that
-    reading's warnings are dropped, for a command that only asks which it is)."""
-    from pianobot.perform.hands import read_one_or_two
+def both_hands(song: Path, reading: Reading):
+    """Both hands of ``song`` where `play` plays both (a :class:`~pianobot.perform.hands.HandsReading`),
+    else None: the reading options read one hand's part, as before two hands."""
+    from pianobot.perform.hands import two_hands
 
-    return read_one_or_two(
-        song,
-        reading.options,
-        reading.hand,
-        reading.keyboard,
-        lambda: read_song(song, reading.options, reading.keyboard, reading.hand),
-        keep_warnings,
-    )
+    return two_hands(song, reading.options, reading.hand, reading.keyboard)
 
 
 def refuse_training_into(start: Path | None, jobs) -> None:

@@ -19,7 +19,7 @@ Notes outside the window are left out, and the part is then reduced to what the 
 (:func:`~pianobot.pianist.reduce.reduce_part`), each kind of change said in one warning line; the
 figures are always against the piece as written, so what was left out counts as missed.
 
-Reading: :func:`read_one_or_two` decides, as ``pianobot play`` does, whether a file plays both
+Reading: :func:`two_hands` decides, as ``pianobot play`` does, whether a file plays both
 hands (tracks named for the hands, or notes one hand cannot play that the fingering planner gives
 to both) or one, as before two hands; :func:`play` (``pianobot.play``) plays a piece with both
 hands hand by hand and any other piece as one hand.
@@ -30,13 +30,12 @@ from __future__ import annotations
 import warnings
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Callable
 
 from pianobot.errors import PianobotError, PianobotWarning
 from pianobot.music import midi_io
 from pianobot.music.hand_scores import HandsReport, compare_hands
 from pianobot.music.instrument import HandSpec, KeyboardSpec
-from pianobot.music.load import LoadOptions, load_hands, thin_hand
+from pianobot.music.load import LoadOptions, load_hands, load_piece, thin_hand
 from pianobot.music.metrics import Report
 from pianobot.music.piece import HANDS, Note, Piece, pitch_name
 from pianobot.music.window import Window, window_for
@@ -106,52 +105,45 @@ def names_hands(path: str | Path) -> bool:
     return any(t.notes and midi_io.track_hand(t.name) for t in midi_io.describe_tracks(path))
 
 
-def read_one_or_two(
-    path: str | Path,
-    options: LoadOptions,
-    spec: HandSpec,
-    keyboard: KeyboardSpec,
-    one_hand: Callable[[], Piece],
-    keep_warnings: bool = True,
-) -> Piece | HandsReading:
-    """The file at ``path`` as ``pianobot play`` reads it: both hands (a :class:`HandsReading`) when
-    it is a two-hand file, else ``one_hand()`` (the one-hand reading, as before two hands).
+def two_hands(
+    path: str | Path, options: LoadOptions, spec: HandSpec = HandSpec(), keyboard: KeyboardSpec = KeyboardSpec()
+) -> HandsReading | None:
+    """Both hands of the file at ``path`` where ``pianobot play`` plays both, else None: read it
+    as one hand, as before two hands.
 
-    A two-hand file: without ``options.hand`` and ``options.track``, a file whose tracks are
-    named for hands (the notes of others given hands by the fingering planner) and that has both
-    hands' notes (or a PIG file with both hands' channels), or one that cannot be one
-    hand's, whose notes ``one_hand()`` refuses and span more keys than one hand's ``keyboard``
-    has, and that the fingering planner gives to both hands. Otherwise ``one_hand()``'s reading
-    (or its refusal) stands. ``keep_warnings`` False drops the warnings of a one-hand reading made
-    only to decide."""
+    Both hands: without ``options.hand`` and ``options.track``, a file whose tracks are named for
+    hands (the notes of others given hands by the fingering planner), or a PIG file, with notes
+    for both hands; or a file that cannot be one hand's, its notes spanning more keys than one
+    hand's ``keyboard`` has (one hand's reading refuses it), whose notes the fingering planner
+    gives to both hands. The reading's warnings are said only where both hands play (or where it
+    refuses the file: hands that cross, notes beyond the piano)."""
+    path = Path(path)
     if options.hand is not None or options.track is not None:
-        return one_hand()
-    if names_hands(path):
-        if Path(path).suffix.lower() == ".txt" and (options.tempo or options.fingering or options.quantize):
-            return one_hand()  # (refused there in its own words)
-        hands = read_hands(path, options, spec)
-        return hands if len(hands.piece.hands) == 2 else one_hand()
-    refused = None
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        try:
-            piece = one_hand()
-        except PianobotError as error:
-            refused = error
-    if refused is not None:
-        with warnings.catch_warnings(record=True) as read:
+        return None
+    if path.suffix.lower() == ".txt" and (options.tempo or options.fingering or options.quantize):
+        return None  # (one hand's reading refuses them in its own words)
+    if not names_hands(path):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # said when the piece is read
+            pitches = [n.pitch for n in load_piece(path, options).notes]
+        if max(pitches) - min(pitches) < keyboard.count:
+            return None
+    try:
+        with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
             hands = read_hands(path, options, spec)
-        pitches = [n.pitch for n in hands.piece.notes]
-        if len(hands.piece.hands) == 2 and max(pitches) - min(pitches) >= keyboard.count:
-            for warning in read:
-                warnings.warn(warning.message)
-            return hands
-    for warning in caught if keep_warnings else ():
+    except PianobotError:
+        _warn_again(caught)
+        raise
+    if len(hands.piece.hands) < 2:
+        return None
+    _warn_again(caught)
+    return hands
+
+
+def _warn_again(caught: list) -> None:
+    for warning in caught:
         warnings.warn(warning.message)
-    if refused is not None:
-        raise refused
-    return piece
 
 
 @dataclass(frozen=True)
@@ -305,8 +297,7 @@ def play_hands(
             warnings.simplefilter("always", PianobotWarning)
             window, part, start, left_out = prepare_part(piece, name, keyboard, fingers)
         changes = tuple(str(w.message) for w in caught if issubclass(w.category, PianobotWarning))
-        for warning in caught:
-            warnings.warn(warning.message)
+        _warn_again(caught)
         performance = plan.play(part, controller, models, seed=seed, keyboard=window.keyboard, hand=fingers, **options)
         done.append(HandPerformance(name, window, part, start, left_out, performance, changes))
     return HandsPerformance(piece, tuple(done), seed)

@@ -10,8 +10,8 @@ from pianobot.cli.flags import phrase
 from pianobot.cli.options import (
     AllRows,
     Reading,
+    both_hands,
     check_midi_output,
-    read_for_play,
     reads,
 )
 from pianobot.cli.terminal import out, said
@@ -31,7 +31,6 @@ def finger(
     from pianobot.cli import display
     from pianobot.music.midi_io import write_midi
     from pianobot.music.phrases import split_phrases
-    from pianobot.perform.hands import HandsReading
     from pianobot.pianist.fingering import ensure_fingering
     from pianobot.pianist.hands import finger_hands
     from pianobot.pianist.reduce import load_for_hand
@@ -39,9 +38,9 @@ def finger(
     check_midi_output(output, song, "the fingered piece")
     check_writable(output)
     keyboard, hand_spec = reading.keyboard, reading.hand
-    as_played = read_for_play(song, reading, keep_warnings=False)
-    if isinstance(as_played, HandsReading):  # a two-hand file: each hand fingered, one track each
-        fingered = finger_hands(as_played.piece, hand_spec, refinger=True)
+    hands = both_hands(song, reading)
+    if hands is not None:  # a two-hand file: each hand fingered, one track each
+        fingered = finger_hands(hands.piece, hand_spec, refinger=True)
         write_midi(fingered.piece, output)
         out.print(display.notes_table(fingered.piece, [], None if all_rows else display.ROWS))
         for hand, plan in fingered.plans.items():

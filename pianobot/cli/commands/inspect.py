@@ -13,7 +13,7 @@ from pianobot.cli.options import (
     AllRows,
     PlayPhraseNotes,
     Reading,
-    read_for_play,
+    both_hands,
     reads,
 )
 from pianobot.cli.terminal import err, out, said, write_json
@@ -41,7 +41,6 @@ def inspect(
     from pianobot.music.instrument import check_playable
     from pianobot.music.load import HANDS, hand_tracks
     from pianobot.perform.compose import missing_phrases, trained_split
-    from pianobot.perform.hands import HandsReading
     from pianobot.pianist.fingering import ensure_fingering
     from pianobot.pianist.reduce import load_for_hand
 
@@ -68,13 +67,13 @@ def inspect(
             )
         )
     try:
-        as_played = read_for_play(song, reading, keep_warnings=False)
+        both = both_hands(song, reading)
     except PianobotError:
-        if named and options.track is None and options.hand is None:
+        if named:
             raise  # the two-hand reading's refusal (hands that cross, notes beyond the piano)
-        as_played = None  # one hand's part: the reading below says what it found, then what is wrong
-    if isinstance(as_played, HandsReading):
-        _both_hands(console, as_played, tracks, json_path)
+        both = None  # one hand's reading, below, says what it found, then what is wrong
+    if both is not None:
+        _both_hands(console, both, tracks, json_path)
         return
     if len([t for t in tracks if t.notes]) > 1 and options.track is None and options.hand is None:
         console.print("[yellow]several tracks are merged; play one part with --track N or --hand right|left[/yellow]")

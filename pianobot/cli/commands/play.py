@@ -18,16 +18,16 @@ from pianobot.cli.options import (
     HtmlReport,
     PlayPhraseNotes,
     Reading,
+    both_hands,
     check_html,
     check_midi_output,
-    read_for_play,
+    read_song,
     reads,
 )
 from pianobot.cli.terminal import err, out, said, write_json
 from pianobot.errors import PianobotError
 from pianobot.files import atomic_write, check_writable
 from pianobot.music.phrases import DEFAULT_MAX_NOTES
-from pianobot.music.piece import Piece
 from pianobot.perform.controllers import CONTROLLERS
 
 
@@ -131,8 +131,8 @@ def play(
         import torch
 
         torch.set_num_threads(1)  # batch-1 inference: more threads only spin against other work on the cores
-    piece = read_for_play(song, reading)
-    if not isinstance(piece, Piece):  # a two-hand file: both hands, each in a simulation of its own
+    hands = both_hands(song, reading)
+    if hands is not None:  # a two-hand file: both hands, each in a simulation of its own
         if video is not None or gui:
             raise PianobotError(
                 f"{'--video' if video is not None else '--gui'} shows one simulation, and {song.name}'s two hands play "
@@ -141,7 +141,7 @@ def play(
         play_both(
             song,
             output,
-            piece,
+            hands,
             controller=controller.value,
             models=models,
             seed=seed,
@@ -158,6 +158,7 @@ def play(
             shown=dict(console=console, notes=notes, every=every, quiet=quiet),
         )
         return
+    piece = read_song(song, reading.options, reading.keyboard, reading.hand)
     plan = plan_performance(
         piece,
         controller.value,

@@ -11,8 +11,8 @@ from pianobot.cli.options import (
     AllFigures,
     HtmlReport,
     Reading,
+    both_hands,
     check_html,
-    read_for_play,
     reads,
 )
 from pianobot.cli.terminal import err, out, said, write_json
@@ -48,7 +48,6 @@ def score(
     from pianobot.music import midi_io
     from pianobot.music.hand_scores import compare_hands
     from pianobot.music.metrics import plot_report
-    from pianobot.perform.hands import HandsReading
     from pianobot.pianist.reduce import load_for_hand
 
     if not 0 < onset_tolerance <= 1:
@@ -61,9 +60,9 @@ def score(
         if target is not None:
             check_writable(target)
     console = err if to_stdout else out  # standard output carries the JSON
-    as_played = read_for_play(reference, reading, keep_warnings=False)  # both hands where play plays both
-    if isinstance(as_played, HandsReading):
-        reference_piece = as_played.piece  # every note with its hand, as play scored it
+    hands = both_hands(reference, reading)
+    if hands is not None:
+        reference_piece = hands.piece  # every note with its hand, as play scored it
     else:
         reference_piece = load_for_hand(
             reference, reading.options, reading.keyboard, reading.hand
