@@ -44,8 +44,19 @@ def _one_track(path, *notes):
 
 def test_a_file_with_tracks_named_for_hands_plays_both_hands_one_track_each(tmp_path):
     song = _duet(tmp_path / "duet.mid")
-    result = run("play", song, "-o", tmp_path / "out.mid", "--controller", "scripted", "--html", tmp_path / "r.html")
+    files = ("--html", tmp_path / "r.html", "--wav", tmp_path / "both.wav")
+    result = run("play", song, "-o", tmp_path / "out.mid", "--controller", "scripted", *files)
     assert result.exit_code == 0, result.output
+    import wave
+
+    import numpy as np
+
+    with wave.open(str(tmp_path / "both.wav")) as sound:  # the left hand's C3 (131 Hz) sounds in it
+        rate, samples = sound.getframerate(), np.frombuffer(sound.readframes(sound.getnframes()), np.int16)
+    spectrum = np.abs(np.fft.rfft(samples.astype(float)))
+    frequencies = np.fft.rfftfreq(len(samples), 1 / rate)
+    near = lambda hz: spectrum[np.abs(frequencies - hz) < 2].max()  # noqa: E731
+    assert near(130.8) > 20 * near(110.0)  # C3 against A2, which nobody played
     text = " ".join(result.stdout.split())
     assert "each hand in a simulation of its own" in text and "against the piece as written" in text
     assert "right hand: 4 notes, C5-F5, named by its track" in text
