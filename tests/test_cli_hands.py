@@ -56,7 +56,7 @@ def test_a_file_with_tracks_named_for_hands_plays_both_hands_one_track_each(tmp_
     spectrum = np.abs(np.fft.rfft(samples.astype(float)))
     frequencies = np.fft.rfftfreq(len(samples), 1 / rate)
     near = lambda hz: spectrum[np.abs(frequencies - hz) < 2].max()  # noqa: E731
-    assert near(130.8) > 20 * near(110.0)  # C3 against A2, which nobody played
+    assert near(130.8) > 5 * near(110.0)  # C3 against A2, which nobody played (right hand alone: 0.6)
     text = " ".join(result.stdout.split())
     assert "each hand in a simulation of its own" in text and "against the piece as written" in text
     assert "right hand: 4 notes, C5-F5, named by its track" in text
