@@ -86,9 +86,10 @@ def test_warnings_come_before_the_error_that_stopped_the_command(tmp_path):
     assert lines[:-1] and all(line.startswith("warning: ") for line in lines[:-1]), lines
 
 
-def test_inspect_names_each_hand_as_play_reads_it(tmp_path):
+def two_tracks(path, names: tuple[str, str]):
+    """A type 1 file of two tracks named ``names``, one note each (C5, D3)."""
     midi = mido.MidiFile(type=1)
-    for name, pitch in (("Soprano", 72), ("Left Hand", 50)):
+    for name, pitch in zip(names, (72, 50)):
         midi.tracks.append(
             mido.MidiTrack(
                 [
@@ -98,9 +99,18 @@ def test_inspect_names_each_hand_as_play_reads_it(tmp_path):
                 ]
             )
         )
-    midi.save(tmp_path / "two.mid")
-    output = " ".join(run("inspect", tmp_path / "two.mid").output.split())
+    midi.save(path)
+    return path
+
+
+def test_inspect_names_each_hand_as_play_reads_it(tmp_path):
+    output = " ".join(run("inspect", two_tracks(tmp_path / "two.mid", ("Soprano", "Left Hand"))).output.split())
     assert "no track is named for the right hand" in output and "track 1 named for the left hand" in output
+    unnamed = two_tracks(tmp_path / "unnamed.mid", ("Flute", "Cello"))
+    args = ("play", unnamed, "--hand", "right", "--controller", "scripted", "-o", tmp_path / "o.mid")
+    played = run(*args)
+    assert played.exit_code == 0, played.output
+    assert "no track is named for the right hand: took track 0" in " ".join(played.output.split())
 
 
 def test_play_json_notes_and_quiet(tmp_path):

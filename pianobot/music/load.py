@@ -111,13 +111,13 @@ def _read_hand(path: Path, options: LoadOptions, bpm: float | None, grid: float 
         chosen = high if options.hand == "right" else low
         warnings.warn(
             PianobotWarning(
-                f"no track is named for a hand: took track {chosen.index} (the {'higher' if chosen is high else 'lower'} of two) as the {options.hand} hand"
+                f"no track is named for the {options.hand} hand: took track {chosen.index} (the {'higher' if chosen is high else 'lower'} of two) as the {options.hand} hand"
             )
         )
         return midi_io.read_midi(path, tracks=[chosen.index], bpm=bpm, grid=grid)
     warnings.warn(
         PianobotWarning(
-            f"no track is named for a hand: took the notes {'at or above' if options.hand == 'right' else 'below'} {pitch_name(options.split)} (load.split)"
+            f"no track is named for the {options.hand} hand: took the notes {'at or above' if options.hand == 'right' else 'below'} {pitch_name(options.split)} (load.split)"
         )
     )
     piece = midi_io.read_midi(path, bpm=bpm, grid=grid)
