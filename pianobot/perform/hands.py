@@ -42,7 +42,7 @@ from pianobot.music.window import Window, window_for
 from pianobot.perform import plan
 from pianobot.perform.plan import Performance
 from pianobot.pianist.fingering import ensure_fingering
-from pianobot.pianist.hands import _reduce, load_two_hands
+from pianobot.pianist.hands import load_two_hands, reduce_hand
 
 APART = "each hand in a simulation of its own"
 """How both hands play until the simulator holds two: said wherever a two-hand performance is reported."""
@@ -265,7 +265,7 @@ def prepare_part(
     start = moved.notes[0].onset
     # (the simulated hand is a right hand: its top notes are a left hand's lowest)
     thinned = thin_hand(moved.shift(-start), hand, fingers, "lowest" if hand == "left" else "highest")
-    reduced = _reduce(thinned, window.keyboard, fingers, hand)
+    reduced = reduce_hand(thinned, window.keyboard, fingers, hand)
     fingered, _ = ensure_fingering(reduced, window.keyboard, fingers, refinger=True)
     return window, fingered, start, left_out
 

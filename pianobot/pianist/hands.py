@@ -321,7 +321,7 @@ MIRRORED_WORDS = (
 as its mirror image (where its top notes are the written bass)."""
 
 
-def _reduce(part: Piece, keyboard: KeyboardSpec, spec: HandSpec, hand: str) -> Piece:
+def reduce_hand(part: Piece, keyboard: KeyboardSpec, spec: HandSpec, hand: str) -> Piece:
     """:func:`~pianobot.pianist.reduce.reduce_part` of ``hand``'s part (the left hand's mirrored),
     its warning lines worded for the written part."""
     with warnings.catch_warnings(record=True) as caught:
@@ -350,7 +350,7 @@ def finger_hands(piece: Piece, spec: HandSpec = HandSpec(), refinger: bool = Fal
         part = part.mirror() if hand == "left" else part  # now a right hand's part
         thinned = thin_hand(part, hand, spec, "lowest" if hand == "left" else "highest")
         keyboard = keyboard_for(thinned)
-        reduced = _reduce(thinned.with_hands(None), keyboard, spec, hand)
+        reduced = reduce_hand(thinned.with_hands(None), keyboard, spec, hand)
         fingered, plan = ensure_fingering(reduced, keyboard, spec, refinger=refinger)
         fingered = fingered.with_hands("right")
         notes.extend((fingered.mirror() if hand == "left" else fingered).notes)
