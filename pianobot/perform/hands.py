@@ -1,6 +1,6 @@
-"""Both hands of a piece, each played by the one simulated hand pianobot has today.
+"""Both hands of a piece, each played by one simulated hand in a simulation of its own.
 
-Until the simulator holds two hands over one keyboard, a two-hand piece is performed hand by
+Until the environment plays the simulator's two hands over one keyboard, a two-hand piece is performed hand by
 hand: each hand's part in a simulation of its own, and what the two keyboards sounded merged into
 one performance, scored against the whole piece as written. What that leaves out, and says: the
 hands never meet (no collision, no key shared between them), and each hand plays on a keyboard
@@ -45,7 +45,7 @@ from pianobot.pianist.fingering import ensure_fingering
 from pianobot.pianist.hands import load_two_hands, reduce_hand
 
 APART = "each hand in a simulation of its own"
-"""How both hands play until the simulator holds two: said wherever a two-hand performance is reported."""
+"""How both hands play until the environment plays two: said wherever a two-hand performance is reported."""
 AGAINST = "figures against the piece as written (notes left out or reduced count as missed)"
 """What a two-hand performance's figures are measured against."""
 

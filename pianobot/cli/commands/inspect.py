@@ -150,7 +150,7 @@ def _both_hands(console, reading, tracks, json_path) -> None:
     for hand in reading.piece.hands:
         console.print(said(reading.describe(hand)), soft_wrap=True)
     console.print(
-        f"[green]two hands[/green]: `pianobot play` plays both, {APART} (the simulator holds one hand so far); "
+        f"[green]two hands[/green]: `pianobot play` plays both, {APART} (the environment plays one hand so far); "
         "--hand right|left plays one hand's part",
         soft_wrap=True,
     )

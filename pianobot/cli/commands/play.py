@@ -236,7 +236,7 @@ def play_both(
 
     console, quiet = shown["console"], shown["quiet"]
     if not quiet:
-        console.print(f"both hands, {APART} (the simulator holds one hand so far); {AGAINST}", soft_wrap=True)
+        console.print(f"both hands, {APART} (the environment plays one hand so far); {AGAINST}", soft_wrap=True)
         for name in reading.piece.hands:
             console.print(said(reading.describe(name)), soft_wrap=True)
     with (
