@@ -127,7 +127,7 @@ def _summary(piece) -> tuple[str, dict]:
     velocities = sorted({n.velocity for n in piece.notes})
     line = (
         f"{len(piece)} notes, {piece.duration:.2f} s at {piece.bpm:.0f} bpm; range {pitch_name(low)}-{pitch_name(high)} "
-        f"({high - low} semitones); at most {polyphony} notes at once; velocities {velocities[0]}-{velocities[-1]}; "
+        f"({high - low} semitones); at most {polyphony} note{'s' * (polyphony != 1)} at once; velocities {velocities[0]}-{velocities[-1]}; "
         f"{given}/{len(piece)} notes fingered in the file"
     )
     data = {

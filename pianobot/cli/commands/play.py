@@ -45,14 +45,17 @@ def progress(what: str):
 
 @reads()
 def play(
-    song: Path = typer.Argument(..., help="The piece to play, a .mid file with fingering."),
+    song: Path = typer.Argument(
+        ...,
+        help="The piece to play: a .mid file (or a PIG .txt file); notes without fingering are fingered by the planner.",
+    ),
     output: Path = typer.Option(
         ..., "--output", "-o", help="Write what the simulated piano sounded to this .mid file."
     ),
     controller: Controller = typer.Option(
         CONTROLLERS[0],
         "--controller",
-        help="Who plays: 'sac' (the trained phrase policies), 'scripted' (the hand-written pianist) or 'random'.",
+        help="Who plays: 'sac' (each phrase's trained policy, else the general policy), 'scripted' (the hand-written pianist) or 'random'.",
     ),
     models: Path = typer.Option(Path("models"), "--models", help="Folder of the model store (for --controller sac)."),
     fallback: Optional[Fallback] = typer.Option(
@@ -103,7 +106,7 @@ def play(
     ),
     reading: Reading = None,
 ):
-    """Perform a piece in the simulator; write the played notes (velocities, fingers) and a velocity-error report."""
+    """Perform a piece (both hands of a two-hand file) in the simulator; write the played notes (velocities, fingers, hands) and a report."""
     from pianobot.cli import display
     from pianobot.music.midi_io import write_midi
     from pianobot.music.phrases import split_phrases
