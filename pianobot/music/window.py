@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from pianobot.music.instrument import KeyboardSpec
+from pianobot.music.instrument import KeyboardSpec, keyboard_for
 from pianobot.music.piece import Piece, mirror_pitch
 
 OCTAVE = 12
@@ -36,14 +36,12 @@ class Window:
 
 def window_for(part: Piece, hand: str, keyboard: KeyboardSpec | None) -> Window:
     """The window for ``hand``'s ``part``: on ``keyboard`` (a policy's) the octave shift that keeps
-    the most notes on it (the lower shift on a tie); with ``keyboard`` None, the part's own range
-    rounded out to octaves (every note kept)."""
+    the most notes on it (the smallest shift on a tie); with ``keyboard`` None, the part's own range
+    rounded out to octaves (:func:`~pianobot.music.instrument.keyboard_for`: every note kept)."""
+    if keyboard is None:
+        return Window(hand, keyboard_for(part.mirror() if hand == "left" else part), 0)
     plain = Window(hand, KeyboardSpec(), 0)
     pitches = [plain.inward(n.pitch) for n in part.notes]
-    if keyboard is None:
-        low = min(pitches) - min(pitches) % OCTAVE
-        high = max(pitches) + OCTAVE - 1 - max(pitches) % OCTAVE
-        return Window(hand, KeyboardSpec(low, min(88, high - low + 1)), 0)
     spans = range(-10, 11)
     kept = {k: sum(p + OCTAVE * k in keyboard for p in pitches) for k in spans}
     best = max(spans, key=lambda k: (kept[k], -abs(k)))
