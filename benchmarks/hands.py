@@ -1,7 +1,11 @@
-"""Two-hand pieces played hand by hand (pianobot/perform/hands.py): the general policy zero-shot,
+"""Two-hand pieces played with both hands (pianobot/perform/hands.py): the general policy zero-shot,
 beside the scripted pianist, against the pieces as written.
 
-    python -m benchmarks.hands [--duets 50] [--seed 35] [--polyphonic 20] [--json out.json]
+    python -m benchmarks.hands [--duets 50] [--seed 35] [--polyphonic 20] [--general DIR] [--apart]
+                               [--json out.json]
+
+(``python -m benchmarks.zeroshot --sets duets polyphonic`` plays the same sets beside the
+one-hand ones.)
 
 Sets:
 
@@ -12,8 +16,10 @@ Sets:
   or two voices (seed ``--seed`` + 1): one hand's polyphonic part, chords and a held note under a
   moving voice.
 
-Each piece is played once from hand start 0, each hand in a simulation of its own, by the general
-policy (the packaged one: the model store is an empty folder) and by the scripted pianist. Prints a
+Each piece is played once from hand start 0, both hands in one simulation as ``pianobot play``
+plays them (``--apart``: each hand in a simulation of its own), by the general policy (the
+packaged one: the model store is an empty folder; ``--general`` names another) and by the
+scripted pianist. Prints a
 Markdown table per set: note F1 (whole piece, right hand, left hand), per-step key-press F1, note
 F1 with offsets, notes left outside the general policy's 24 keys, and the general policy's share
 of the scripted pianist's note F1.
@@ -38,10 +44,11 @@ PLAYERS = ("sac", "scripted")
 NAMES = {"sac": "general", "scripted": "scripted"}
 
 
-def figures(piece, controller: str, models) -> dict:
+def figures(piece, controller: str, models, general=None, together: bool = True) -> dict:
+    options = {"general_policy": general} if controller == "sac" and general is not None else {}
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", PianobotWarning)  # the left-out counts are in the figures
-        performance = play_hands(piece, controller, models)
+        performance = play_hands(piece, controller, models, together=together, **options)
     whole = performance.report()
     out = {
         "f1": whole.f1,
@@ -87,11 +94,26 @@ def table(name: str, rows: list[dict]) -> str:
     return "\n".join(lines)
 
 
+def play_set(pieces, general=None, together: bool = True) -> list[dict]:
+    """Every piece of a set played by both players: one row of figures per piece."""
+    rows = []
+    with tempfile.TemporaryDirectory() as models:
+        for label, piece in pieces:
+            piece = piece if piece.hands else piece.with_hands("left")
+            row = {"piece": label, "notes": len(piece)}
+            row.update({player: figures(piece, player, models, general, together) for player in PLAYERS})
+            rows.append(row)
+            print(f"{label}: general {row['sac']['f1']:.3f}, scripted {row['scripted']['f1']:.3f}", flush=True)
+    return rows
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--duets", type=int, default=50)
     parser.add_argument("--polyphonic", type=int, default=20)
     parser.add_argument("--seed", type=int, default=35)
+    parser.add_argument("--general", help="the general policy's folder (default: the packaged one)")
+    parser.add_argument("--apart", action="store_true", help="each hand in a simulation of its own")
     parser.add_argument("--json", help="write every piece's figures here")
     args = parser.parse_args()
     torch.set_num_threads(1)
@@ -101,17 +123,9 @@ def main() -> None:
     }
     results = {}
     started = time.perf_counter()
-    with tempfile.TemporaryDirectory() as models:
-        for name, pieces in sets.items():
-            rows = []
-            for label, piece in pieces:
-                piece = piece if piece.hands else piece.with_hands("left")
-                row = {"piece": label, "notes": len(piece)}
-                row.update({player: figures(piece, player, models) for player in PLAYERS})
-                rows.append(row)
-                print(f"{label}: general {row['sac']['f1']:.3f}, scripted {row['scripted']['f1']:.3f}", flush=True)
-            results[name] = rows
-            print(table(name, rows), flush=True)
+    for name, pieces in sets.items():
+        results[name] = play_set(pieces, args.general, not args.apart)
+        print(table(name, results[name]), flush=True)
     print(f"{time.perf_counter() - started:.0f} s")
     if args.json:
         with open(args.json, "w") as f:

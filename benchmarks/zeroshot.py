@@ -1,10 +1,11 @@
 """The general policy on pieces it was never trained on, beside the scripted pianist (its teacher).
 
-    python benchmarks/zeroshot.py [--general DIR] [--melodies 50] [--seed 2026] [--per-task 10]
-                                  [--sets examples melodies tasks] [--wrist-guard]
+    python -m benchmarks.zeroshot [--general DIR] [--melodies 50] [--seed 2026] [--per-task 10]
+                                  [--sets examples melodies articulation tasks duets polyphonic]
+                                  [--duets 50] [--duet-seed 35] [--polyphonic 20] [--wrist-guard]
                                   [--json out.json] [--plot docs/zeroshot.png]
 
-Three sets, each played in one continuous simulation per piece, from hand start 0, as
+One-hand sets, each played in one continuous simulation per piece, from hand start 0, as
 ``pianobot play`` plays a piece no phrase policy was trained for (the general policy, through the
 wrist guard, :mod:`pianobot.perform.guard`, with ``--wrist-guard``):
 
@@ -19,6 +20,15 @@ wrist guard, :mod:`pianobot.perform.guard`, with ``--wrist-guard``):
 - ``articulation``: as many random melodies drawn the same way with slurs (notes written to last
   until the next one sounds; :data:`SLURS`), seeded ``[38, index, draw]``: how long notes are held;
 - ``tasks``: ``--per-task`` instances of each of the paper's task families (seeds 0, 1, ...).
+
+Two-hand sets, both hands in one simulation as ``pianobot play`` plays them (:mod:`benchmarks.hands`,
+its own table: note F1 of the whole piece and each hand, per-step key-press F1, note F1 with
+offsets, notes left out):
+
+- ``duets``: ``--duets`` random two-hand pieces (:func:`pianobot.music.duets.duet_set`, seed
+  ``--duet-seed``; no training run draws from them);
+- ``polyphonic``: ``--polyphonic`` left-hand parts with block chords or two voices (seed
+  ``--duet-seed`` + 1), alone: one hand's polyphonic part.
 
 For each piece: note F1, velocity MAE (matched notes, MIDI units), per-step key-press F1 (the
 paper's frame-level measure), note F1 with offsets and the played/written duration ratio by note
@@ -41,8 +51,11 @@ from pathlib import Path
 import numpy as np
 import torch
 
+from benchmarks import hands
+from benchmarks.hands import polyphonic_set
 from pianobot.agent.general import find_general
 from pianobot.agent.policy import policy_configs
+from pianobot.music.duets import duet_set
 from pianobot.music.instrument import HandSpec, KeyboardSpec
 from pianobot.music.load import LoadOptions, load_piece
 from pianobot.music.melodies import describe, random_melody
@@ -60,6 +73,8 @@ EXAMPLES = ("c-major-scale", "mary", "ode-to-joy", "twinkle", "one-note", "three
 hand part reduced or five fingers)."""
 MELODY_DRAWS = 50
 SETS = ("examples", "melodies", "articulation", "tasks")
+HAND_SETS = ("duets", "polyphonic")
+"""Two-hand sets, played as ``pianobot play`` plays both hands (:mod:`benchmarks.hands`)."""
 ARTICULATION_SEED = 38
 """The articulation set's first seed entry (issue 38), apart from the melodies' ``--seed``."""
 SLURS = 0.35
@@ -242,7 +257,16 @@ def main() -> None:
     parser.add_argument("--melodies", type=int, default=50, help="random melodies (default 50)")
     parser.add_argument("--seed", type=int, default=2026, help="first entry of the melodies' generator seeds")
     parser.add_argument("--per-task", type=int, default=10, help="instances of each paper task family (default 10)")
-    parser.add_argument("--sets", nargs="+", choices=SETS, default=list(SETS), help="which sets to play (default all)")
+    parser.add_argument(
+        "--sets",
+        nargs="+",
+        choices=SETS + HAND_SETS,
+        default=list(SETS + HAND_SETS),
+        help="which sets to play (default all)",
+    )
+    parser.add_argument("--duets", type=int, default=50, help="random two-hand pieces (default 50)")
+    parser.add_argument("--duet-seed", type=int, default=35, help="their seed (the polyphonic parts': one more)")
+    parser.add_argument("--polyphonic", type=int, default=20, help="one hand's polyphonic parts (default 20)")
     parser.add_argument("--wrist-guard", action="store_true", help="play the general policy through the wrist guard")
     parser.add_argument("--json", help="write every piece's figures here")
     parser.add_argument("--plot", help="draw every piece's note F1 to this PNG")
@@ -261,8 +285,17 @@ def main() -> None:
             results[name] = [
                 {"piece": label, **play_both(piece, general, Path(empty), args.wrist_guard)} for label, piece in pieces
             ]
+    drawn = {
+        "duets": lambda: duet_set(args.duet_seed, args.duets),
+        "polyphonic": lambda: polyphonic_set(args.duet_seed + 1, args.polyphonic),
+    }
+    for name in (n for n in HAND_SETS if n in args.sets):
+        results[name] = hands.play_set(drawn[name](), general)
     print(f"general policy: {general}{' (wrist guard)' * args.wrist_guard}\n")
-    print(table(results))
+    if any(name in results for name in SETS):
+        print(table({name: rows for name, rows in results.items() if name in SETS}))
+    for name in (n for n in HAND_SETS if n in results):
+        print("\n" + hands.table(name, results[name]))
     if "melodies" in results:
         print("\nRandom melodies: the share of notes the general policy played (count), by place\n")
         print(where_table(results["melodies"]))
@@ -276,7 +309,7 @@ def main() -> None:
                 indent=1,
             )
     if args.plot:
-        plot(results, args.plot)
+        plot({name: rows for name, rows in results.items() if name in SETS}, args.plot)
 
 
 if __name__ == "__main__":

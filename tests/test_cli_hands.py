@@ -1,5 +1,5 @@
-"""`pianobot play`, `score` and `inspect` on two-hand files: both hands by default (each hand in a
-simulation of its own), one track per hand, the whole piece and each hand reported; `--hand` still
+"""`pianobot play`, `score` and `inspect` on two-hand files: both hands by default (in one
+simulation), one track per hand, the whole piece and each hand reported; `--hand` still
 plays one; bad input in one line."""
 
 import json
@@ -58,7 +58,7 @@ def test_a_file_with_tracks_named_for_hands_plays_both_hands_one_track_each(tmp_
     near = lambda hz: spectrum[np.abs(frequencies - hz) < 2].max()  # noqa: E731
     assert near(130.8) > 5 * near(110.0)  # C3 against A2, which nobody played (right hand alone: 0.6)
     text = " ".join(result.stdout.split())
-    assert "each hand in a simulation of its own" in text and "against the piece as written" in text
+    assert "both hands in one simulation" in text and "against the piece as written" in text
     assert "right hand: 4 notes, C5-F5, named by its track" in text
     assert "left hand: 2 notes, C3-G3, named by its track" in text
     assert "whole piece" in text and "mirrored about D" in text  # the first screen's table of hands
@@ -69,22 +69,22 @@ def test_a_file_with_tracks_named_for_hands_plays_both_hands_one_track_each(tmp_
     assert [(n.pitch, n.hand) for n in played.notes] == [(n.pitch, n.hand) for n in written.notes]
     assert compare(written, played).f1 == 1.0
     report = json.loads((tmp_path / "out.report.json").read_text())
-    assert report["performer"] == "scripted pianist (each hand in a simulation of its own)"
-    assert "simulation of its own" in report["hands_simulated"] and report["f1"] == 1.0
+    assert report["performer"] == "scripted pianist (both hands in one simulation)"
+    assert "one simulation" in report["hands_simulated"] and report["f1"] == 1.0
     assert set(report["hands"]) == {"right", "left"}
     left = report["hands"]["left"]
     assert left["performer"] == "scripted pianist" and left["notes"] == 2 and left["named_by_file"] == 2
     assert left["reference_notes"] == 2 and left["f1"] == 1.0 and left["left_out_or_reduced"] == []
     assert [(n["pitch"], n["hand"]) for n in report["notes"]][:2] == [("C3", "left"), ("C5", "right")]
     page = (tmp_path / "r.html").read_text()
-    assert "<section id='hands'>" in page and "simulation of its own" in page and "left hand: 2 notes" in page
+    assert "<section id='hands'>" in page and "both hands in one simulation" in page and "left hand: 2 notes" in page
 
 
 def test_hand_still_plays_one_hand_as_before(tmp_path):
     song = _duet(tmp_path / "duet.mid")
     result = run("play", song, "-o", tmp_path / "out.mid", "--controller", "scripted", "--hand", "right")
     assert result.exit_code == 0, result.output
-    assert "simulation of its own" not in result.output
+    assert "one simulation" not in result.output
     report = json.loads((tmp_path / "out.report.json").read_text())
     assert "hands" not in report and report["performer"] == "scripted pianist" and report["reference_notes"] == 4
     assert len(mido.MidiFile(tmp_path / "out.mid").tracks) == 1
@@ -126,7 +126,7 @@ def test_what_a_hand_is_given_is_said_once_per_kind(tmp_path):
 def test_what_both_hands_cannot_do_yet_is_one_line(tmp_path):
     song = _duet(tmp_path / "duet.mid")
     for extra, words in (
-        (("--video", tmp_path / "v.mp4"), ("--video", "simulation of its own", "--hand right")),
+        (("--video", tmp_path / "v.mp4"), ("--video", "shows one hand so far", "--hand right")),
         (("--controller", "random"), ("'random'", "'scripted'")),
     ):
         assert_one_line_error(run("play", song, "-o", tmp_path / "out.mid", *extra), *words)
@@ -198,7 +198,7 @@ def test_inspect_shows_each_hand_in_plays_words(tmp_path):
     assert result.exit_code == 0, result.output
     text = " ".join(result.stdout.split())
     assert "right hand: 4 notes, C5-F5, named by its track" in text and "--hand right|left" in text
-    assert "each hand in a simulation of its own" in text
+    assert "both hands in one simulation" in text
     found = json.loads((tmp_path / "i.json").read_text())
     assert found["hands"]["left"] == {"notes": 2, "range": ["C3", "G3"], "named_by_file": 2, "assigned_by_planner": 0}
     unnamed = _one_track(tmp_path / "bass.mid", (72, 0, 1), (74, 1, 2), (40, 0, 2), (43, 2, 4), (76, 2, 4))

@@ -1,4 +1,4 @@
-"""Both hands of a piece played hand by hand (pianobot/perform/hands.py), and the random two-hand
+"""Both hands of a piece played (pianobot/perform/hands.py): in one simulation and hand by hand, and the random two-hand
 pieces they are measured on (pianobot/music/duets.py)."""
 
 import warnings
@@ -52,6 +52,30 @@ def test_the_scripted_pianist_plays_both_hands_of_a_duet_at_the_written_pitches(
     assert max(n.pitch for n in played.part("left").notes) < 60 <= min(n.pitch for n in played.part("right").notes)
     assert performance.report("left").f1 == 1.0 and performance.report("right").f1 == 1.0, name
     assert performance.report().reference_notes == len(piece)
+
+
+def test_both_hands_share_one_simulation_unless_asked_apart_and_play_alike_there():
+    (name, piece), *_ = [d for d in duet_set(2, 8) if "block" in d[0]]
+    together = play_hands(piece, "scripted")
+    apart = play_hands(piece, "scripted", together=False)
+    assert together.together and not apart.together and "one simulation" in together.performer
+    assert "simulation of its own" in apart.performer
+    for performance in (together, apart):
+        assert performance.report("right").f1 == 1.0 and performance.report("left").f1 == 1.0, name
+    # the right hand's notes are the right hand's: none credited to the other in one world
+    assert {(n.pitch, n.hand) for n in together.played.notes} == {(n.pitch, n.hand) for n in piece.notes}
+
+
+def test_parts_too_far_apart_for_one_keyboard_play_apart_and_say_so():
+    """The scripted pianist's windows are the parts' ranges rounded out to octaves: A0 and C8 need
+    keys from C0 (mirrored) to B8, more than 88, so each hand plays in a simulation of its own."""
+    piece = Piece((Note(0.0, 108, 0.5, hand="right"), Note(0.0, 21, 0.5, hand="left")))
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        performance = play_hands(piece, "scripted")
+    said = [str(w.message) for w in caught if issubclass(w.category, PianobotWarning)]
+    assert any("more than a piano's 88" in line and "simulation of its own" in line for line in said), said
+    assert not performance.together and performance.report().f1 == 1.0
 
 
 def test_notes_outside_the_window_are_said_and_count_as_missed():
@@ -115,5 +139,6 @@ def test_pianobot_play_plays_both_hands_of_a_piece_with_both_and_one_hand_as_bef
     assert performance.to_dict()["hands"]["left"]["performer"] == "scripted pianist"
     one = pianobot.play(Piece(tuple(right)).with_fingers([2, 3, 4]), controller="scripted")  # one hand, as before
     assert isinstance(one, Performance) and one.report().f1 == 1.0
-    with pytest.raises(PianobotError, match="a video shows one simulation"):
+    assert performance.together and "one simulation" in performance.performer
+    with pytest.raises(PianobotError, match="a video of both hands is not made yet"):
         pianobot.play(both, controller="scripted", video=True)

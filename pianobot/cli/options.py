@@ -105,7 +105,7 @@ READING = {  # parameter name: (type, option); the commands' --help shows them i
     "tempo": _reading(Optional[float], None, "--tempo", "Re-time the piece at this constant tempo in bpm (the paper uses 60)."),
     "transpose": _reading(int, LoadOptions.transpose, "--transpose", "Shift every note by this many semitones."),
     "fingering": _reading(Optional[Path], None, "--fingering", "PIG fingering file for the notes (default: <song>_fingering.txt beside the .mid, if any)."),
-    "hand_part": _reading(Optional[HandPart], None, "--hand", "Play one hand's part of a two-hand piece: right or left (tracks named for it, else split by pitch); without it, play plays both hands of a two-hand file, each in a simulation of its own."),
+    "hand_part": _reading(Optional[HandPart], None, "--hand", "Play one hand's part of a two-hand piece: right or left (tracks named for it, else split by pitch); without it, play plays both hands of a two-hand file, in one simulation."),
     "split": _reading(str, pitch_name(LoadOptions.split), "--split", "With --hand and no track named for it: lowest note of the right hand's part."),
     "quantize": _reading(Optional[str], None, "--quantize", "Move onsets and offsets to a grid, e.g. 1/16 (for recordings of human players)."),
     "refinger": _reading(bool, LoadOptions.refinger, "--refinger/--no-refinger", "Replace the file's fingering with the planner's (e.g. human fingering for five fingers)."),

@@ -36,6 +36,8 @@ says how older records are read):
   on average over a performance (as running the old keyboard at 45 solver iterations instead of
   50 does) and now and then a note by one physics step or one velocity unit: the scripted
   pianist meets its targets on 47 of the 48 random melodies instead of 48 (docs/simulator.md#world).
+- v0, 2026-11-24 (issue 35): ``length=`` and ``view=`` (one hand of a two-hand world,
+  :mod:`pianobot.env.hands`); a one-hand environment observes, acts and rewards as before.
 """
 
 from __future__ import annotations
@@ -54,10 +56,11 @@ from pianobot.music.instrument import check_playable
 from pianobot.music.piece import Piece
 from pianobot.music.tasks import TASKS, make_task
 from pianobot.music.tensor import FINGER, NOTE, VELOCITY, ScoreSpec, score_tensor, steps_for
+from pianobot.sim.frame import HandView
 from pianobot.sim.hand import finger_ik, joint_limits, joint_names
 from pianobot.sim.keyboard import strike_points
 from pianobot.sim.tactile import TactileConfig, TactileRenderer, pool, to_uint8
-from pianobot.sim.world import PianoWorld, WorldConfig
+from pianobot.sim.world import PianoWorld, StepResult, WorldConfig
 
 JOINT_KINDS = ("abd", "mcp", "pip", "dip")
 """Each finger's joints, in action order."""
@@ -196,7 +199,13 @@ class EnvConfig:
 
 class PianoEnv(gym.Env):
     """The hand plays ``piece`` (a phrase), or a fresh instance from ``sampler`` (or of the
-    paper's task ``task``) at each reset."""
+    paper's task ``task``) at each reset.
+
+    ``length``: seconds the episode's score lasts at least (the piece's duration by default; the
+    rest silent). ``view``: one hand of a two-hand world, seen through its window
+    (:class:`~pianobot.sim.frame.HandView`), instead of a world of its own; the world's owner
+    (:class:`~pianobot.env.hands.HandsEnv`) resets it between :meth:`draw_start` and
+    :meth:`begin`, and steps it before :meth:`absorb`."""
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": WorldConfig.control_hz}
 
@@ -207,6 +216,8 @@ class PianoEnv(gym.Env):
         config: EnvConfig = EnvConfig(),
         render_mode: str | None = None,
         sampler: Sampler | None = None,
+        length: float | None = None,
+        view: HandView | None = None,
     ):
         if [piece, task, sampler].count(None) != 2:
             raise ValueError("give exactly one of piece=, task= or sampler=")
@@ -226,8 +237,13 @@ class PianoEnv(gym.Env):
         self.render_mode = render_mode
         if piece is not None:
             check_playable(piece, self.spec_score.keyboard, self.spec_score.hand)
+        if view is not None and (view.config.keyboard.spec != config.world.keyboard.spec or render_mode is not None):
+            raise ValueError("a hand's view needs the environment's keyboard to be the view's, and no render mode")
         self.piece = piece
-        self.world = PianoWorld(config.world)
+        self.length = length
+        self.world = view if view is not None else PianoWorld(config.world)
+        self.owns_world = view is None
+        """False for one hand of a world of two (:class:`pianobot.env.hands.HandsEnv` steps and resets it)."""
         self.n_fingers = len(config.world.hand.spec.fingers)
         self.n_joints = len(joint_names(config.world.hand.spec))
         keys = self.spec_score.keyboard.count
@@ -269,7 +285,7 @@ class PianoEnv(gym.Env):
     def _set_piece(self, piece: Piece) -> None:
         self.piece = piece
         spec = self.spec_score
-        body = steps_for(piece.duration + self.config.tail, spec)
+        body = steps_for(max(piece.duration, self.length or 0.0) + self.config.tail, spec)
         self.horizon = self.lead_steps + body
         padded = self.horizon + self.config.lookahead + 1
         tensor = score_tensor(piece, spec, steps=body)
@@ -291,14 +307,27 @@ class PianoEnv(gym.Env):
         return (self.lead_steps + 0.5) / self.spec_score.control_hz
 
     def reset(self, *, seed: int | None = None, options: dict | None = None):
+        wrist = self.draw_start(seed)
+        self.world.reset(wrist, self.start_pose())
+        return self.begin()
+
+    # (one hand of a world of two resets in three parts: its world's owner resets the world between them)
+    def draw_start(self, seed: int | None = None) -> float:
+        """Seed the episode, draw its piece (from a sampler) and the wrist's start (m along the keyboard)."""
         super().reset(seed=seed)
         if self.sampler is not None:
             piece = self.sampler(self.np_random)
             check_playable(piece, self.spec_score.keyboard, self.spec_score.hand)
             self._set_piece(piece)
-        world = self.world
-        wrist = float(self.np_random.uniform(0.0, world.width)) if self.config.random_start else world.width / 2
-        world.reset(wrist, np.tile(idle_pose(self.config.world), self.n_fingers))
+        width = self.world.width
+        return float(self.np_random.uniform(0.0, width)) if self.config.random_start else width / 2
+
+    def start_pose(self) -> np.ndarray:
+        """Every finger joint's angle at the start of an episode."""
+        return np.tile(idle_pose(self.config.world), self.n_fingers)
+
+    def begin(self) -> tuple[dict, dict]:
+        """The episode's first observation and info, once the world is reset."""
         self._tip_cache = None
         self.t = 0
         self.key_finger = np.zeros(self.spec_score.keyboard.count, dtype=int)
@@ -317,7 +346,11 @@ class PianoEnv(gym.Env):
         return full
 
     def step(self, action):
-        result = self.world.step(self.full_action(np.asarray(action, dtype=np.float64)))
+        return self.absorb(self.world.step(self.full_action(np.asarray(action, dtype=np.float64))))
+
+    def absorb(self, result: StepResult):
+        """Observe and reward what a step of the world did (``step`` without acting: one hand of a
+        world of two is acted for by the world's owner)."""
         self._tip_cache = None  # the hand has moved
         lowest = self.spec_score.keyboard.lowest
         for event in result.events:
@@ -420,4 +453,5 @@ class PianoEnv(gym.Env):
         return self.world.render()
 
     def close(self):
-        self.world.close()
+        if self.owns_world:
+            self.world.close()

@@ -1,13 +1,8 @@
-"""Both hands of a piece, each played by one simulated hand in a simulation of its own.
+"""Both hands of a piece, played in one simulation (or each hand in a simulation of its own).
 
-Until the environment plays the simulator's two hands over one keyboard, a two-hand piece is performed hand by
-hand: each hand's part in a simulation of its own, and what the two keyboards sounded merged into
-one performance, scored against the whole piece as written. What that leaves out, and says: the
-hands never meet (no collision, no key shared between them), and each hand plays on a keyboard
-of its own.
-
-Each part becomes a part for the simulated hand, a right hand, in two steps that keep every key's
-colour and every distance between keys:
+Each hand's part is given to a player that knows one right hand (the scripted pianist, the
+general policy, phrase policies), in two steps that keep every key's colour and every distance
+between keys:
 
 1. the left hand's part is mirrored about D (:meth:`~pianobot.music.piece.Piece.mirror`): the
    mirror image of a left hand is a right hand with the same finger numbers;
@@ -19,10 +14,18 @@ Notes outside the window are left out, and the part is then reduced to what the 
 (:func:`~pianobot.pianist.reduce.reduce_part`), each kind of change said in one warning line; the
 figures are always against the piece as written, so what was left out counts as missed.
 
+By default both hands then play in one simulation (:class:`~pianobot.env.hands.HandsEnv`): two
+hands on one keyboard of the keys both windows need, each player seeing its hand through its
+window, the hands kept apart by the world (the right wrist at least a hand's thumb reach above
+the left; their links collide), a key struck by one sounding for both. Where that cannot be
+(the windows span more than 88 keys, or the two hands' players were trained with different
+physics) each hand plays in a simulation of its own, said in one warning line, and what the
+two keyboards sounded is merged.
+
 Reading: :func:`two_hands` decides, as ``pianobot play`` does, whether a file plays both
 hands (tracks named for the hands, or notes one hand cannot play that the fingering planner gives
 to both) or one, as before two hands; :func:`play` (``pianobot.play``) plays a piece with both
-hands hand by hand and any other piece as one hand.
+hands with :func:`play_hands` and any other piece as one hand.
 """
 
 from __future__ import annotations
@@ -30,6 +33,7 @@ from __future__ import annotations
 import warnings
 from dataclasses import dataclass, field, replace
 from pathlib import Path
+from typing import Callable
 
 from pianobot.errors import PianobotError, PianobotWarning
 from pianobot.music import midi_io
@@ -41,11 +45,14 @@ from pianobot.music.piece import HANDS, Note, Piece, pitch_name
 from pianobot.music.window import Window, window_for
 from pianobot.perform import plan
 from pianobot.perform.plan import Performance
+from pianobot.perform.rollout import Rollout
 from pianobot.pianist.fingering import ensure_fingering
 from pianobot.pianist.hands import load_two_hands, reduce_hand
 
 APART = "each hand in a simulation of its own"
-"""How both hands play until the environment plays two: said wherever a two-hand performance is reported."""
+"""How both hands play with ``together=False``: said wherever such a performance is reported."""
+TOGETHER = "both hands in one simulation"
+"""How both hands play by default (:class:`~pianobot.env.hands.HandsEnv`)."""
 AGAINST = "figures against the piece as written (notes left out or reduced count as missed)"
 """What a two-hand performance's figures are measured against."""
 
@@ -161,10 +168,15 @@ class HandPerformance:
     performance: Performance
     changes: tuple[str, ...] = ()
     """What was left out or reduced to make the part playable: one line per kind."""
+    sounded: Piece | None = None
+    """Played with the other hand in one simulation: what this hand sounded, at the written
+    pitches and times (else :attr:`played` is read from its own simulation)."""
 
     @property
     def played(self) -> Piece:
         """What this hand sounded, back at the written pitches and times, each note with its hand."""
+        if self.sounded is not None:
+            return self.sounded
         notes = [
             replace(n, pitch=self.window.outward(n.pitch), hand=self.hand)
             for n in self.performance.played.shift(self.start).notes
@@ -189,13 +201,15 @@ class HandPerformance:
 
 @dataclass(frozen=True)
 class HandsPerformance:
-    """A two-hand piece performed hand by hand (the module's notes)."""
+    """A two-hand piece performed (the module's notes)."""
 
     piece: Piece
     """The piece as written, every note with its hand: what the figures are against."""
     hands: tuple[HandPerformance, ...]
     """Right hand first."""
     seed: int = 0
+    together: bool = False
+    """Both hands in one simulation (else each in a simulation of its own)."""
     played: Piece = field(init=False)
     """What both keyboards sounded, as one piece at the written pitches, each note with its hand."""
     scores: HandsReport = field(init=False, repr=False, compare=False)
@@ -213,9 +227,14 @@ class HandsPerformance:
 
     @property
     def performer(self) -> str:
-        """Who played, in words: 'scripted pianist (each hand in a simulation of its own)'."""
+        """Who played, in words: 'scripted pianist (both hands in one simulation)'."""
         names = dict.fromkeys(h.performer for h in self.hands)
-        return f"{' and '.join(names)} ({APART})"
+        return f"{' and '.join(names)} ({self.simulated})"
+
+    @property
+    def simulated(self) -> str:
+        """How the hands were simulated, in words: :data:`TOGETHER` or :data:`APART`."""
+        return TOGETHER if self.together else APART
 
     def to_dict(self, reading: HandsReading | None = None) -> dict:
         """The report's JSON: who played each hand, where, what was left out or reduced, and the
@@ -237,17 +256,20 @@ class HandsPerformance:
         return {
             "seed": self.seed,
             "performer": self.performer,
-            "hands_simulated": f"apart: {APART}, the two merged; {AGAINST}",
+            "hands_simulated": f"{self.simulated}; {AGAINST}"
+            if self.together
+            else f"apart: {APART}, the two merged; {AGAINST}",
             "hands": hands,
             **whole,
         }
 
 
 def prepare_part(
-    piece: Piece, hand: str, keyboard: KeyboardSpec | None, fingers: HandSpec
+    piece: Piece, hand: str, keyboard: KeyboardSpec | None, fingers: HandSpec, start: float | None = None
 ) -> tuple[Window, Piece, float, int]:
     """``hand``'s part of ``piece`` as the simulated hand is given it: (window, part, start, notes
-    left out). Each kind of change is one :class:`PianobotWarning`, worded for the written part."""
+    left out), the part moved ``start`` seconds earlier (default: to its first note). Each kind of
+    change is one :class:`PianobotWarning`, worded for the written part."""
     part = piece.part(hand)
     window = window_for(part, hand, keyboard)
     inside = [n for n in part.notes if window.inward(n.pitch) in window.keyboard]
@@ -262,7 +284,7 @@ def prepare_part(
     if not inside:
         raise PianobotError(f"none of the {hand} hand's notes fits the keyboard its player knows")
     moved = Piece(tuple(Note(n.onset, window.inward(n.pitch), n.offset, n.velocity) for n in inside), bpm=piece.bpm)
-    start = moved.notes[0].onset
+    start = moved.notes[0].onset if start is None else start
     # (the simulated hand is a right hand: its top notes are a left hand's lowest)
     thinned = thin_hand(moved.shift(-start), hand, fingers, "lowest" if hand == "left" else "highest")
     reduced = reduce_hand(thinned, window.keyboard, fingers, hand)
@@ -277,41 +299,112 @@ def play_hands(
     seed: int = 0,
     hand: HandSpec | None = None,
     keyboard: KeyboardSpec | None = None,
+    together: bool = True,
+    on_step: Callable[[int, int], None] | None = None,
     **options,
 ) -> HandsPerformance:
-    """Perform ``piece``, every note of which has a hand, hand by hand (the module's notes):
-    ``controller`` 'sac' (the general policy, or policies trained for the part) or 'scripted',
-    ``models`` the model store, ``seed`` the hand start of every simulation, ``hand`` each hand's
-    fingers; ``keyboard`` the keys every part is moved onto (default: the general policy's 24 keys
-    for 'sac', each part's own range for 'scripted'); ``options`` go to
-    :func:`~pianobot.perform.plan.play` (``general``, ``fallback``, ``on_step`` for each hand, ...)."""
+    """Perform ``piece``, every note of which has a hand (the module's notes): ``controller``
+    'sac' (the general policy, or policies trained for the part) or 'scripted', ``models`` the
+    model store, ``seed`` the hand starts, ``hand`` each hand's fingers; ``keyboard`` the keys
+    every part is moved onto (default: the general policy's 24 keys for 'sac', each part's own
+    range for 'scripted'); ``together``: both hands in one simulation (else hand by hand, each in
+    a simulation of its own); ``on_step(done, total)`` reports progress; ``options`` go to
+    :func:`~pianobot.perform.plan.plan_performance` (``general``, ``fallback``, ...)."""
     if any(n.hand is None for n in piece.notes):
         raise PianobotError("every note needs a hand to play both hands: give the piece's notes a hand first")
     if controller not in ("sac", "scripted"):
         raise PianobotError(f"controller {controller!r}: both hands are played by 'sac' or 'scripted'")
     fingers = hand or HandSpec()
     keyboard = keyboard or (KeyboardSpec() if controller == "sac" else None)
-    done = []
-    for name in (h for h in HANDS if h in piece.hands):
+    names = [h for h in HANDS if h in piece.hands]
+    together = together and len(names) == 2
+    begin = piece.notes[0].onset if together else None  # (one timeline for both hands)
+    parts = {}
+    for name in names:
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", PianobotWarning)
-            window, part, start, left_out = prepare_part(piece, name, keyboard, fingers)
+            prepared = prepare_part(piece, name, keyboard, fingers, begin)
         changes = tuple(str(w.message) for w in caught if issubclass(w.category, PianobotWarning))
         _warn_again(caught)
-        performance = plan.play(part, controller, models, seed=seed, keyboard=window.keyboard, hand=fingers, **options)
+        parts[name] = (*prepared, changes)
+    if together:
+        plans = {
+            name: plan.plan_performance(part, controller, models, keyboard=window.keyboard, hand=fingers, **options)
+            for name, (window, part, *_) in parts.items()
+        }
+        try:
+            return _play_together(piece, parts, plans, seed, on_step)
+        except HandsApart as e:
+            warnings.warn(PianobotWarning(f"{e}: each hand plays in a simulation of its own"))
+    done = []
+    for name, (window, part, start, left_out, changes) in parts.items():
+        performance = plan.play(
+            part, controller, models, seed=seed, keyboard=window.keyboard, hand=fingers, on_step=on_step, **options
+        )
         done.append(HandPerformance(name, window, part, start, left_out, performance, changes))
     return HandsPerformance(piece, tuple(done), seed)
+
+
+class HandsApart(Exception):
+    """Why both hands cannot play in one simulation."""
+
+
+def _play_together(
+    piece: Piece, parts: dict, plans: dict[str, plan.PerformancePlan], seed: int, on_step: Callable | None
+) -> HandsPerformance:
+    """Both hands' plans played in one :class:`~pianobot.env.hands.HandsEnv` from hand start ``seed``."""
+    from pianobot.env.hands import HandsEnv  # (the simulator loads only when something plays)
+    from pianobot.sim.recorder import NoteRecorder
+
+    try:
+        env = HandsEnv({h: (parts[h][0], parts[h][1]) for h in HANDS}, {h: plans[h].config for h in HANDS})
+    except ValueError as e:  # parts too far apart for 88 keys, players of different physics
+        raise HandsApart(str(e)) from None
+    try:
+        controllers = {h: plan.controller_for(plans[h], env.hands[h], seed) for h in HANDS}
+        observations, _ = env.reset(seed=seed)
+        for c in controllers.values():
+            c.reset()
+        recorder, rewards, steps = NoteRecorder(), dict.fromkeys(HANDS, 0.0), 0
+        while True:
+            observations, _, _, truncated, info = env.step({h: c.act(observations[h]) for h, c in controllers.items()})
+            recorder.add(info["events"], info["fingers"], info["struck_by"])
+            for h in HANDS:
+                rewards[h] += info["rewards"][h]
+            steps += 1
+            if on_step is not None:
+                on_step(steps, env.horizon)
+            if truncated:
+                break
+        begin = parts["right"][2]
+        sounded = recorder.piece(end=env.world.time, start=env.score_start, bpm=piece.bpm).shift(begin)
+    finally:
+        env.close()
+    done = []
+    for h in HANDS:
+        window, part, start, left_out, changes = parts[h]
+        own = Piece(tuple(n for n in sounded.notes if n.hand == h), bpm=piece.bpm)
+        moved = [
+            replace(n, pitch=window.inward(n.pitch))
+            for n in own.shift(-start).notes
+            if 0 <= window.inward(n.pitch) <= 127
+        ]
+        inward = Piece(tuple(moved), bpm=piece.bpm)  # (what the hand's player saw itself play)
+        rollout = Rollout(part, inward, rewards[h], steps, None, env.score_start)
+        performance = Performance(plans[h], rollout, seed, plan.slowed_steps(controllers[h]))
+        done.append(HandPerformance(h, window, part, start, left_out, performance, changes, own))
+    return HandsPerformance(piece, tuple(done), seed, together=True)
 
 
 def play(
     piece: Piece, controller: str = "sac", models: Path | str | None = None, seed: int = 0, **options
 ) -> Performance | HandsPerformance:
     """``pianobot.play``: a piece with both hands (every note with its hand, both hands with notes)
-    plays both, :func:`play_hands` (each hand in a simulation of its own; ``options`` as there);
+    plays both, :func:`play_hands` (``options`` as there);
     any other piece plays as one hand, :func:`pianobot.perform.plan.play` (``options`` as there:
     ``video``, ``on_step``, ``keyboard``, ``hand``, ``general``, ...)."""
     if len(piece.hands) < 2:
         return plan.play(piece, controller, models, seed, **options)
     if options.pop("video", False):
-        raise PianobotError(f"a video shows one simulation, and both hands play {APART}: play one hand for a video")
+        raise PianobotError("a video of both hands is not made yet: play one hand for a video")
     return play_hands(piece, controller, models, seed, **options)

@@ -28,7 +28,7 @@ from typing import Callable
 from pianobot.agent import store
 from pianobot.agent.general import PACKAGED, describe, find_general, general_candidates
 from pianobot.agent.policy import policy_configs
-from pianobot.env.piano import EnvConfig
+from pianobot.env.piano import EnvConfig, PianoEnv
 from pianobot.errors import PianobotError, SettingError
 from pianobot.music.instrument import HandSpec, KeyboardSpec
 from pianobot.music.metrics import Report
@@ -36,10 +36,10 @@ from pianobot.music.phrases import DEFAULT_MAX_NOTES, Phrase, split_phrases
 from pianobot.music.piece import Piece
 from pianobot.perform import perform as simulation  # (called through the module: tests replace simulation.perform)
 from pianobot.perform.compose import CompositionalController, find_policy, trained_split
-from pianobot.perform.controllers import CONTROLLERS
+from pianobot.perform.controllers import CONTROLLERS, make_controller
 from pianobot.perform.guard import WristGuard
 from pianobot.perform.perform import PLAY_CONFIG
-from pianobot.perform.rollout import Rollout
+from pianobot.perform.rollout import Controller, Rollout
 from pianobot.sim.hand import HandConfig
 from pianobot.sim.keyboard import KeyboardConfig
 from pianobot.sim.world import WorldConfig
@@ -318,24 +318,36 @@ def plan_performance(
     return PerformancePlan(piece, replace(env, world=replace(env.world, gui=gui)), stretches, wrist_guard)
 
 
+def controller_for(plan: PerformancePlan, env: PianoEnv, seed: int = 0) -> Controller:
+    """The controller that plays ``plan`` in ``env`` (an environment of ``plan.config`` for
+    ``plan.piece``): one scripted pianist or random controller for the whole piece, else
+    compositional execution of the plan's stretches."""
+    (first, *others) = plan.stretches
+    if not others and first.player in (Player.SCRIPTED, Player.RANDOM):
+        return make_controller("scripted" if first.player is Player.SCRIPTED else "random", env, seed)
+    return CompositionalController(env, plan.stretches, plan.wrist_guard)
+
+
+def slowed_steps(controller: Controller) -> int | None:
+    """Steps at which the wrist guard slowed the general policy's wrist in ``controller`` (None: no guard played)."""
+    sections = controller.sections if isinstance(controller, CompositionalController) else []
+    guards = [s.controller for s in sections if isinstance(s.controller, WristGuard)]
+    return guards[0].capped if guards else None
+
+
 def perform_plan(
     plan: PerformancePlan, seed: int = 0, video: bool = False, on_step: Callable[[int, int], None] | None = None
 ) -> Performance:
     """Play ``plan`` in one continuous simulation from hand start ``seed``; ``video`` keeps the
     frames; ``on_step(done, total)`` reports progress."""
-    (first, *others) = plan.stretches
-    if not others and first.player in (Player.SCRIPTED, Player.RANDOM):
-        name = "scripted" if first.player is Player.SCRIPTED else "random"
-        return Performance(plan, simulation.perform(plan.piece, name, plan.config, seed, video, on_step), seed)
-    made: list[CompositionalController] = []
+    made: list[Controller] = []
 
     def controller(env):
-        made.append(CompositionalController(env, plan.stretches, plan.wrist_guard))
+        made.append(controller_for(plan, env, seed))
         return made[0]
 
     played = simulation.perform(plan.piece, controller, plan.config, seed, video, on_step)
-    guards = [s.controller for s in made[0].sections if isinstance(s.controller, WristGuard)]
-    return Performance(plan, played, seed, guards[0].capped if guards else None)
+    return Performance(plan, played, seed, slowed_steps(made[0]))
 
 
 def play(

@@ -341,7 +341,7 @@ def _hands_section(performance, reading) -> str:
     who played it, where, what it was given, its figures, what was left out or reduced."""
     from html import escape
 
-    from pianobot.perform.hands import AGAINST, APART
+    from pianobot.perform.hands import AGAINST
 
     head = "".join(
         f"<th>{h}</th>"
@@ -365,8 +365,8 @@ def _hands_section(performance, reading) -> str:
     listed = "".join(f"<li>{escape(line)}</li>" for line in changes) or "<li>nothing: every note was given</li>"
     return (
         "<section id='hands'><h2>Each hand</h2>"
-        f"<p class='what'>Both hands played, {escape(APART)} (the environment plays one hand so far): each hand's "
-        "part given to one simulated hand (the left hand's mirrored about D), what the two sounded merged; "
+        f"<p class='what'>Both hands played, {escape(performance.simulated)}: each hand's part given to its "
+        "player as a right hand's (the left hand's mirrored about D); "
         f"{escape(AGAINST)}. In the piano roll the left hand's notes are hatched.</p>"
         f"<table class='hands'><tr>{head}</tr>{''.join(rows)}</table>"
         f"<h3>Left out or reduced</h3><ul class='changes'>{listed}</ul></section>"

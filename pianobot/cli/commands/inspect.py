@@ -143,15 +143,14 @@ def _summary(piece) -> tuple[str, dict]:
 
 def _both_hands(console, reading, tracks, json_path) -> None:
     """What `inspect` says of a file `play` plays with both hands: each hand in play's words."""
-    from pianobot.perform.hands import APART
+    from pianobot.perform.hands import TOGETHER
 
     line, data = _summary(reading.piece)
     console.print(line)
     for hand in reading.piece.hands:
         console.print(said(reading.describe(hand)), soft_wrap=True)
     console.print(
-        f"[green]two hands[/green]: `pianobot play` plays both, {APART} (the environment plays one hand so far); "
-        "--hand right|left plays one hand's part",
+        f"[green]two hands[/green]: `pianobot play` plays both, {TOGETHER}; --hand right|left plays one hand's part",
         soft_wrap=True,
     )
     if json_path is not None:
@@ -161,7 +160,7 @@ def _both_hands(console, reading, tracks, json_path) -> None:
                 "tracks": [{"index": t.index, "name": t.name, "notes": t.notes, "pedal": t.pedal} for t in tracks],
                 **data,
                 "hands": {hand: reading.to_dict(hand) for hand in reading.piece.hands},
-                "played_as": f"both hands, {APART}",
+                "played_as": f"both hands, {TOGETHER}",
             },
         )
 

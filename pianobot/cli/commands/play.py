@@ -135,11 +135,11 @@ def play(
 
         torch.set_num_threads(1)  # batch-1 inference: more threads only spin against other work on the cores
     hands = both_hands(song, reading)
-    if hands is not None:  # a two-hand file: both hands, each in a simulation of its own
+    if hands is not None:  # a two-hand file: both hands, in one simulation
         if video is not None or gui:
             raise PianobotError(
-                f"{'--video' if video is not None else '--gui'} shows one simulation, and {song.name}'s two hands play "
-                "each in a simulation of its own: play one hand for it with --hand right (or --hand left)"
+                f"{'--video' if video is not None else '--gui'} shows one hand so far, and {song.name} plays with two: "
+                "play one hand for it with --hand right (or --hand left)"
             )
         play_both(
             song,
@@ -226,7 +226,7 @@ def play_both(
     song: Path, output: Path, reading, *, controller, models, seed, keyboard, hand, options, files, shown
 ) -> None:
     """`play` of a two-hand file (``reading``: a :class:`~pianobot.perform.hands.HandsReading`):
-    both hands, each in a simulation of its own (:func:`~pianobot.perform.hands.play_hands`), one
+    both hands in one simulation (:func:`~pianobot.perform.hands.play_hands`), one
     track per hand in ``output``, and the report of the whole piece and each hand."""
     import warnings
 
@@ -235,16 +235,16 @@ def play_both(
     from pianobot.music.instrument import KeyboardSpec
     from pianobot.music.midi_io import write_midi
     from pianobot.perform.audio import write_wav
-    from pianobot.perform.hands import AGAINST, APART, play_hands
+    from pianobot.perform.hands import AGAINST, TOGETHER, play_hands
 
     console, quiet = shown["console"], shown["quiet"]
     if not quiet:
-        console.print(f"both hands, {APART} (the environment plays one hand so far); {AGAINST}", soft_wrap=True)
+        console.print(f"both hands, {TOGETHER}; {AGAINST}", soft_wrap=True)
         for name in reading.piece.hands:
             console.print(said(reading.describe(name)), soft_wrap=True)
     with (
         warnings.catch_warnings(record=True) as caught,
-        progress(f"playing {said(song.name)}, hand by hand") as on_step,
+        progress(f"playing {said(song.name)}, both hands") as on_step,
     ):
         warnings.simplefilter("always", PianobotWarning)
         performance = play_hands(

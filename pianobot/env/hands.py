@@ -1,0 +1,148 @@
+"""Both hands in one simulation: each plays its part, seen by its player as a right hand.
+
+:class:`HandsEnv` holds one world of two hands (:class:`~pianobot.sim.world.PianoWorld` with
+``hands=("right", "left")``) over the keys both parts need, and one
+:class:`~pianobot.env.piano.PianoEnv` per hand built on a :class:`~pianobot.sim.frame.HandView`
+of it: each hand's observations, action and reward are exactly those of the one-hand
+environment (the left hand's mirrored), so every one-hand player (the scripted pianist, the
+general policy, phrase policies) plays either hand unchanged. ``step`` takes an action per hand,
+steps the world once with both, and gives each hand what it sees.
+
+What the hands share: the keys (a key struck by one sounds in the other's view too; its reward
+counts only its own fingers' strikes) and the space over the keyboard: the world keeps the right
+wrist at least ``PianoWorld.min_separation`` above the left one and the hands' links collide.
+
+Spaces are dicts keyed by hand ('right', 'left'); the reward is the sum of the hands'
+(``info["rewards"]`` has each); ``info["hands"]`` holds each hand's step info, and ``info``
+also the world's key events with the finger and hand of each strike.
+
+Version history: v0 (2026-11-24), the first two-hand environment; no id is registered with
+gymnasium (a two-hand piece's parts need the fingering planner and the windows, above this layer:
+:func:`pianobot.perform.hands.play_hands` builds one).
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import gymnasium as gym
+import numpy as np
+from gymnasium import spaces
+
+from pianobot.env.piano import EnvConfig, PianoEnv
+from pianobot.music.instrument import KeyboardSpec
+from pianobot.music.piece import HANDS, Piece
+from pianobot.music.window import Window
+from pianobot.sim.frame import HandView
+from pianobot.sim.world import PianoWorld
+
+
+def world_keyboard(windows: list[Window]) -> KeyboardSpec:
+    """The keys of a world on which every window's keys lie: from the lowest to the highest of
+    them, at most the piano's 88."""
+    pitches = [w.outward(q) for w in windows for q in (w.keyboard.lowest, w.keyboard.lowest + w.keyboard.count - 1)]
+    low, high = min(pitches), max(pitches)
+    if high - low + 1 > 88:
+        raise ValueError(
+            f"the hands' keyboards span {high - low + 1} keys together, more than a piano's 88: "
+            "the parts lie too far apart to be played in one simulation"
+        )
+    return KeyboardSpec(lowest=low, count=high - low + 1)
+
+
+class HandsEnv(gym.Env):
+    """Each hand of ``parts`` (hand -> (window, part)) plays its part, given in its window's keys
+    (:meth:`~pianobot.music.window.Window.inward`: the left hand's mirrored) and fingered for it,
+    in one world; ``configs``: each hand's environment (its keyboard is replaced by its window's;
+    the hands' physics settings must agree). Both parts run as long as the longer one."""
+
+    metadata = {"render_modes": []}
+
+    def __init__(self, parts: dict[str, tuple[Window, Piece]], configs: dict[str, EnvConfig]):
+        if set(parts) != set(HANDS) or set(configs) != set(HANDS):
+            raise ValueError(f"give a part and a configuration for each of {', '.join(HANDS)}")
+        windows = [parts[h][0] for h in HANDS]
+        if any(parts[h][0].hand != h for h in HANDS):
+            raise ValueError("each hand's part needs that hand's window")
+        worlds = {replace(configs[h].world, keyboard=configs["right"].world.keyboard, gui=False) for h in HANDS}
+        if len(worlds) > 1:
+            raise ValueError("both hands' environments must share their physics (control, rates, hand, solver)")
+        base = configs["right"].world
+        world_config = replace(base, keyboard=replace(base.keyboard, spec=world_keyboard(windows)))
+        self.world = PianoWorld(world_config, hands=HANDS)
+        length = max(parts[h][1].duration for h in HANDS)
+        self.hands: dict[str, PianoEnv] = {}
+        try:
+            for index, hand in enumerate(HANDS):
+                window, part = parts[hand]
+                view = HandView(self.world, index, window)
+                config = replace(configs[hand], world=replace(view.config, gui=False))
+                self.hands[hand] = PianoEnv(piece=part, config=config, length=length, view=view)
+        except Exception:
+            self.world.close()
+            raise
+        self.observation_space = spaces.Dict({h: env.observation_space for h, env in self.hands.items()})
+        self.action_space = spaces.Dict({h: env.action_space for h, env in self.hands.items()})
+        self.horizon = self.hands["right"].horizon
+        self.score_start = self.hands["right"].score_start
+
+    def view(self, hand: str) -> HandView:
+        return self.hands[hand].world
+
+    def reset(self, *, seed: int | None = None, options: dict | None = None):
+        """Each hand starts where its environment draws it (seeded with ``seed``), moved apart
+        where the two would be closer than the world allows."""
+        super().reset(seed=seed)
+        wrists = {h: self.view(h).world_wrist(env.draw_start(seed)) for h, env in self.hands.items()}
+        right, left = self._apart(wrists["right"], wrists["left"])
+        self.world.reset([right, left], np.concatenate([self.hands[h].start_pose() for h in HANDS]))
+        firsts = {h: env.begin() for h, env in self.hands.items()}
+        return {h: obs for h, (obs, _) in firsts.items()}, {
+            "pieces": {h: info["piece"] for h, (_, info) in firsts.items()}
+        }
+
+    def _apart(self, right: float, left: float) -> tuple[float, float]:
+        """Wrist starts at least ``min_separation`` apart (each moved half the shortfall, within the rail)."""
+        gap, width = self.world.min_separation, self.world.width
+        short = gap - (right - left)
+        if short > 0:
+            right, left = right + short / 2, left - short / 2
+            if left < 0:
+                right, left = right - left, 0.0
+            if right > width:
+                right, left = width, left - (right - width)
+        return right, left
+
+    def step(self, action: dict):
+        full = np.concatenate(
+            [
+                self.view(h).world_action(env.full_action(np.asarray(action[h], dtype=np.float64)))
+                for h, env in self.hands.items()
+            ]
+        )
+        result = self.world.step(full)
+        observations, rewards, infos = {}, {}, {}
+        truncated = True
+        for hand, env in self.hands.items():
+            observations[hand], rewards[hand], _, done, infos[hand] = env.absorb(self.view(hand).result(result))
+            truncated = truncated and done
+        struck = {pitch: HANDS[h] for pitch, h in result.hands.items()}
+        for event in result.events:  # a strike no fingertip was touching: the nearer hand's
+            if event.on and event.pitch not in struck:
+                struck[event.pitch] = self._nearer(event.pitch)
+        info = {
+            "hands": infos,
+            "rewards": rewards,
+            "events": result.events,
+            "fingers": result.fingers,
+            "struck_by": struck,
+        }
+        return observations, float(sum(rewards.values())), False, truncated, info
+
+    def _nearer(self, pitch: int) -> str:
+        x = self.world.boxes[pitch - self.world.config.keyboard.spec.lowest].center[0]
+        distances = [abs(self.world.hand_state(i)[0] - x) for i in range(len(HANDS))]
+        return HANDS[int(np.argmin(distances))]
+
+    def close(self):
+        self.world.close()
