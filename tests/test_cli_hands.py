@@ -44,9 +44,16 @@ def _one_track(path, *notes):
 
 def test_a_file_with_tracks_named_for_hands_plays_both_hands_one_track_each(tmp_path):
     song = _duet(tmp_path / "duet.mid")
-    files = ("--html", tmp_path / "r.html", "--wav", tmp_path / "both.wav")
+    files = ("--html", tmp_path / "r.html", "--wav", tmp_path / "both.wav", "--video", tmp_path / "both.mp4")
     result = run("play", song, "-o", tmp_path / "out.mid", "--controller", "scripted", *files)
     assert result.exit_code == 0, result.output
+    import subprocess
+
+    import imageio_ffmpeg
+
+    ffmpeg = [imageio_ffmpeg.get_ffmpeg_exe(), "-i", str(tmp_path / "both.mp4")]
+    info = subprocess.run(ffmpeg, capture_output=True, text=True).stderr
+    assert "Video: h264" in info and "720x320" in info and "Audio: aac" in info  # both hands, with their sound
     import wave
 
     import numpy as np
@@ -78,6 +85,7 @@ def test_a_file_with_tracks_named_for_hands_plays_both_hands_one_track_each(tmp_
     assert [(n["pitch"], n["hand"]) for n in report["notes"]][:2] == [("C3", "left"), ("C5", "right")]
     page = (tmp_path / "r.html").read_text()
     assert "<section id='hands'>" in page and "both hands in one simulation" in page and "left hand: 2 notes" in page
+    assert "<video" in page
 
 
 def test_hand_still_plays_one_hand_as_before(tmp_path):
@@ -123,10 +131,11 @@ def test_what_a_hand_is_given_is_said_once_per_kind(tmp_path):
     assert "warning: the left hand's part has chords wider" in " ".join(quiet.stderr.split())
 
 
-def test_what_both_hands_cannot_do_yet_is_one_line(tmp_path):
+def test_what_both_hands_cannot_do_yet_is_one_line(tmp_path, monkeypatch):
+    monkeypatch.setenv("DISPLAY", ":0")  # (as on a desktop: the two hands are what --gui refuses)
     song = _duet(tmp_path / "duet.mid")
     for extra, words in (
-        (("--video", tmp_path / "v.mp4"), ("--video", "shows one hand so far", "--hand right")),
+        (("--gui",), ("--gui", "shows one hand so far", "--hand right", "--video")),
         (("--controller", "random"), ("'random'", "'scripted'")),
     ):
         assert_one_line_error(run("play", song, "-o", tmp_path / "out.mid", *extra), *words)

@@ -34,7 +34,7 @@ from pianobot.music.instrument import KeyboardSpec
 from pianobot.music.piece import HANDS, Piece
 from pianobot.music.window import Window
 from pianobot.sim.frame import HandView
-from pianobot.sim.world import PianoWorld
+from pianobot.sim.world import PianoWorld, WorldConfig
 
 
 def world_keyboard(windows: list[Window]) -> KeyboardSpec:
@@ -56,9 +56,16 @@ class HandsEnv(gym.Env):
     in one world; ``configs``: each hand's environment (its keyboard is replaced by its window's;
     the hands' physics settings must agree). Both parts run as long as the longer one."""
 
-    metadata = {"render_modes": []}
+    metadata = {"render_modes": ["rgb_array"], "render_fps": WorldConfig.control_hz}
+    FRAME = (720, 320)
+    """A rendered frame's width and height: wide, for a keyboard of up to 88 keys."""
 
-    def __init__(self, parts: dict[str, tuple[Window, Piece]], configs: dict[str, EnvConfig]):
+    def __init__(
+        self, parts: dict[str, tuple[Window, Piece]], configs: dict[str, EnvConfig], render_mode: str | None = None
+    ):
+        if render_mode not in (None, *self.metadata["render_modes"]):
+            raise ValueError(f"render_mode {render_mode!r}: choose None or 'rgb_array'")
+        self.render_mode = render_mode
         if set(parts) != set(HANDS) or set(configs) != set(HANDS):
             raise ValueError(f"give a part and a configuration for each of {', '.join(HANDS)}")
         windows = [parts[h][0] for h in HANDS]
@@ -143,6 +150,16 @@ class HandsEnv(gym.Env):
         x = self.world.boxes[pitch - self.world.config.keyboard.spec.lowest].center[0]
         distances = [abs(self.world.hand_state(i)[0] - x) for i in range(len(HANDS))]
         return HANDS[int(np.argmin(distances))]
+
+    def render(self) -> np.ndarray | None:
+        """The whole keyboard and both hands from above the pianist (height x width x 3, uint8)
+        with ``render_mode="rgb_array"``; else None and a warning, as gymnasium's environments do."""
+        if self.render_mode is None:
+            gym.logger.warn(
+                'render() is called without a render mode: make the environment with render_mode="rgb_array"'
+            )
+            return None
+        return self.world.render(*self.FRAME)
 
     def close(self):
         self.world.close()

@@ -210,6 +210,11 @@ class HandsPerformance:
     seed: int = 0
     together: bool = False
     """Both hands in one simulation (else each in a simulation of its own)."""
+    frames: list | None = field(default=None, repr=False, compare=False)
+    """With a video asked for: the simulation's rendered frames, the first before the first step."""
+    start: float = 0.0
+    """Simulated time (s), from the first frame, at which the piece's time 0 falls (less than 0
+    when the piece begins with a rest longer than the lead-in): where the video's sound starts."""
     played: Piece = field(init=False)
     """What both keyboards sounded, as one piece at the written pitches, each note with its hand."""
     scores: HandsReport = field(init=False, repr=False, compare=False)
@@ -230,6 +235,11 @@ class HandsPerformance:
         """Who played, in words: 'scripted pianist (both hands in one simulation)'."""
         names = dict.fromkeys(h.performer for h in self.hands)
         return f"{' and '.join(names)} ({self.simulated})"
+
+    @property
+    def fps(self) -> float:
+        """Frames per second of :attr:`frames`: the control rate."""
+        return self.hands[0].performance.plan.config.world.control_hz
 
     @property
     def simulated(self) -> str:
@@ -301,6 +311,7 @@ def play_hands(
     keyboard: KeyboardSpec | None = None,
     together: bool = True,
     on_step: Callable[[int, int], None] | None = None,
+    video: bool = False,
     **options,
 ) -> HandsPerformance:
     """Perform ``piece``, every note of which has a hand (the module's notes): ``controller``
@@ -308,7 +319,8 @@ def play_hands(
     model store, ``seed`` the hand starts, ``hand`` each hand's fingers; ``keyboard`` the keys
     every part is moved onto (default: the general policy's 24 keys for 'sac', each part's own
     range for 'scripted'); ``together``: both hands in one simulation (else hand by hand, each in
-    a simulation of its own); ``on_step(done, total)`` reports progress; ``options`` go to
+    a simulation of its own); ``on_step(done, total)`` reports progress; ``video``: keep the
+    frames (both hands in one simulation only); ``options`` go to
     :func:`~pianobot.perform.plan.plan_performance` (``general``, ``fallback``, ...)."""
     if any(n.hand is None for n in piece.notes):
         raise PianobotError("every note needs a hand to play both hands: give the piece's notes a hand first")
@@ -333,9 +345,13 @@ def play_hands(
             for name, (window, part, *_) in parts.items()
         }
         try:
-            return _play_together(piece, parts, plans, seed, on_step)
+            return _play_together(piece, parts, plans, seed, on_step, video)
         except HandsApart as e:
+            if video:
+                raise PianobotError(f"{e}: no video can show both hands; play one hand for it") from None
             warnings.warn(PianobotWarning(f"{e}: each hand plays in a simulation of its own"))
+    elif video:
+        raise PianobotError("a video of both hands needs them in one simulation: play one hand for it")
     done = []
     for name, (window, part, start, left_out, changes) in parts.items():
         performance = plan.play(
@@ -350,14 +366,18 @@ class HandsApart(Exception):
 
 
 def _play_together(
-    piece: Piece, parts: dict, plans: dict[str, plan.PerformancePlan], seed: int, on_step: Callable | None
+    piece: Piece, parts: dict, plans: dict[str, plan.PerformancePlan], seed: int, on_step: Callable | None, video: bool
 ) -> HandsPerformance:
     """Both hands' plans played in one :class:`~pianobot.env.hands.HandsEnv` from hand start ``seed``."""
     from pianobot.env.hands import HandsEnv  # (the simulator loads only when something plays)
     from pianobot.sim.recorder import NoteRecorder
 
     try:
-        env = HandsEnv({h: (parts[h][0], parts[h][1]) for h in HANDS}, {h: plans[h].config for h in HANDS})
+        env = HandsEnv(
+            {h: (parts[h][0], parts[h][1]) for h in HANDS},
+            {h: plans[h].config for h in HANDS},
+            render_mode="rgb_array" if video else None,
+        )
     except ValueError as e:  # parts too far apart for 88 keys, players of different physics
         raise HandsApart(str(e)) from None
     try:
@@ -366,8 +386,11 @@ def _play_together(
         for c in controllers.values():
             c.reset()
         recorder, rewards, steps = NoteRecorder(), dict.fromkeys(HANDS, 0.0), 0
+        frames = [env.render()] if video else None
         while True:
             observations, _, _, truncated, info = env.step({h: c.act(observations[h]) for h, c in controllers.items()})
+            if frames is not None:
+                frames.append(env.render())
             recorder.add(info["events"], info["fingers"], info["struck_by"])
             for h in HANDS:
                 rewards[h] += info["rewards"][h]
@@ -393,7 +416,8 @@ def _play_together(
         rollout = Rollout(part, inward, rewards[h], steps, None, env.score_start)
         performance = Performance(plans[h], rollout, seed, plan.slowed_steps(controllers[h]))
         done.append(HandPerformance(h, window, part, start, left_out, performance, changes, own))
-    return HandsPerformance(piece, tuple(done), seed, together=True)
+    start = env.score_start - begin
+    return HandsPerformance(piece, tuple(done), seed, together=True, frames=frames, start=start)
 
 
 def play(
@@ -405,6 +429,4 @@ def play(
     ``video``, ``on_step``, ``keyboard``, ``hand``, ``general``, ...)."""
     if len(piece.hands) < 2:
         return plan.play(piece, controller, models, seed, **options)
-    if options.pop("video", False):
-        raise PianobotError("a video of both hands is not made yet: play one hand for a video")
     return play_hands(piece, controller, models, seed, **options)

@@ -533,7 +533,8 @@ class PianoWorld:
             p.changeVisualShape(self.keys[key], 0, rgbaColor=colour, physicsClientId=self.client)
 
     def render(self, width: int = 480, height: int = 320) -> np.ndarray:
-        """An RGB frame (height, width, 3) from a camera above the pianist's side of the keyboard.
+        """An RGB frame (height, width, 3) from a camera above the pianist's side of the keyboard,
+        far enough to show the whole keyboard (and no nearer than one hand's 24 keys need).
 
         The world is built with the pianist on the +y side, which makes it the mirror image of a
         real piano (low notes on the pianist's right); the frame is mirrored back, so it shows
@@ -541,7 +542,8 @@ class PianoWorld:
         """
         c = self.client
         target = [self.width / 2, 0.11, 0.0]
-        view = p.computeViewMatrixFromYawPitchRoll(target, 0.42, 180, -68, 0, 2, physicsClientId=c)
+        distance = max(0.42, 1.1 * self.width / (2 * np.tan(np.radians(22.5)) * width / height))
+        view = p.computeViewMatrixFromYawPitchRoll(target, distance, 180, -68, 0, 2, physicsClientId=c)
         projection = p.computeProjectionMatrixFOV(45, width / height, 0.01, 2.0, physicsClientId=c)
         _, _, rgba, _, _ = p.getCameraImage(
             width, height, view, projection, renderer=p.ER_TINY_RENDERER, physicsClientId=c

@@ -136,10 +136,10 @@ def play(
         torch.set_num_threads(1)  # batch-1 inference: more threads only spin against other work on the cores
     hands = both_hands(song, reading)
     if hands is not None:  # a two-hand file: both hands, in one simulation
-        if video is not None or gui:
+        if gui:
             raise PianobotError(
-                f"{'--video' if video is not None else '--gui'} shows one hand so far, and {song.name} plays with two: "
-                "play one hand for it with --hand right (or --hand left)"
+                f"--gui shows one hand so far, and {song.name} plays with two: "
+                "play one hand for it with --hand right (or --hand left), or watch both with --video"
             )
         play_both(
             song,
@@ -157,7 +157,7 @@ def play(
                 phrase_notes=phrase_notes,
                 wrist_guard=wrist_guard,
             ),
-            files=dict(report=report_path, json=json_path, wav=wav, soundfont=soundfont, html=html),
+            files=dict(report=report_path, json=json_path, wav=wav, soundfont=soundfont, html=html, video=video),
             shown=dict(console=console, notes=notes, every=every, quiet=quiet),
         )
         return
@@ -255,6 +255,7 @@ def play_both(
             hand,
             None if keyboard == KeyboardSpec() else keyboard,  # (the default: each player's own keys)
             on_step=on_step,
+            video=files["video"] is not None,
             **options,
         )
     changes = {line for h in performance.hands for line in h.changes}
@@ -273,6 +274,19 @@ def play_both(
                 console.print(f"[yellow]left out or reduced:[/yellow] {said(line)}", soft_wrap=True)
         display.print_all(console, display.report_tables(performance.report(), shown["every"], shown["notes"]))
     console.print(f"performance written to {said(output)} (one track per hand), report to {said(files['report'])}")
+    if files["video"] is not None:
+        import tempfile
+
+        from pianobot.perform.perform import write_video
+
+        start = performance.start  # (the sound starts with the first frame)
+        with tempfile.TemporaryDirectory() as scratch:
+            sound = Path(scratch) / "sound.wav"
+            method = write_wav(
+                performance.played.shift(min(start, 0.0)), sound, font=files["soundfont"], delay=max(start, 0.0)
+            )
+            write_video(performance.frames, files["video"], fps=performance.fps, audio=sound)
+        console.print(f"video written to {said(files['video'])}, with sound ({method})")
     if files["wav"] is not None:
         method = write_wav(performance.played, files["wav"], font=files["soundfont"])
         console.print(f"audio written to {said(files['wav'])} ({method})")
@@ -280,5 +294,13 @@ def play_both(
         from pianobot.perform.report import write_html
 
         title = f"{song.name}: both hands, {performance.performer}"
-        write_html(files["html"], performance.report(), title, seed=seed, hands=performance, reading=reading)
+        write_html(
+            files["html"],
+            performance.report(),
+            title,
+            seed=seed,
+            hands=performance,
+            reading=reading,
+            video=files["video"],
+        )
         console.print(f"report to open in a browser written to {said(files['html'])}")
