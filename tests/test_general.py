@@ -337,3 +337,18 @@ def test_the_newest_general_policy_is_the_last_trained_not_the_last_checked_out(
     (older / store.MANIFEST_FILE).write_text(json.dumps(legacy))
     os.utime(older / store.MANIFEST_FILE, (2e9, 2e9))  # 2033
     assert store.find_policies(models, GENERAL_KEY) == [older, newer]
+
+
+def test_a_parts_family_policy_is_a_general_policy_and_the_newest_comes_first(models, general):
+    """`train --task parts` policies (melodies and hand parts) are general policies too: the newest
+    of either family in the store is the one `play` and `train` take, before the packaged one."""
+    from pianobot.agent.general import general_candidates
+
+    parts = models / general.name.replace(GENERAL_KEY, "task-parts")
+    shutil.copytree(general, parts)
+    manifest = manifest_of(parts)
+    manifest["saved"] = "2999-01-01T00:00:00+00:00"  # trained after the melody policy
+    (parts / store.MANIFEST_FILE).write_text(json.dumps(manifest))
+    found = general_candidates(models)
+    assert found[:2] == [parts, models / general.name]
+    assert all(PACKAGED in f.resolve().parents for f in found[2:]) and len(found) > 2

@@ -1,10 +1,12 @@
 """The general policy: one policy trained on the ``melody`` task family (random one-hand phrases,
-docs/training.md), which plays the phrases that have no policy of their own and is where the
+docs/training.md) or the ``parts`` family (those and phrases of one hand of random two-hand
+pieces), which plays the phrases that have no policy of their own and is where the
 training of a new phrase begins (fine-tuning).
 
 Where it lives: the committed general policy ships inside the package (:data:`PACKAGED`), so it
 is found from any folder and from a wheel install; a user's model store, where ``pianobot train
---task melody`` puts one (folder ``task-melody-<config hash>``), comes first. ``pianobot play``
+--task melody`` (or ``--task parts``) puts one (folder ``task-melody-<config hash>``, or
+``task-parts-...``), comes first. ``pianobot play``
 and ``pianobot train`` take the newest such folder in the store whose environment is the one they
 need, then the packaged one, and ``--general-policy DIR`` names another (any trained policy folder). It plays consecutive phrases without a policy of their own as one stretch:
 the sliding score window of that stretch, and its finger targets (:mod:`pianobot.perform.compose`).
@@ -26,15 +28,18 @@ from pianobot.agent.policy import policy_configs
 from pianobot.config import to_dict
 from pianobot.env.piano import EnvConfig
 from pianobot.errors import PianobotError, SettingError
-from pianobot.music.tasks import MELODY
+from pianobot.music.tasks import MELODY, PARTS
 
 if TYPE_CHECKING:
     import torch
 
 GENERAL_TASK = MELODY
-"""The task family whose policy is the general policy."""
+"""The task family whose policy is the general policy: random one-hand phrases."""
 GENERAL_KEY = store.task_key(GENERAL_TASK)
 """Its folders' key in the model store: ``task-melody-<config hash>``."""
+GENERAL_KEYS = (GENERAL_KEY, store.task_key(PARTS))
+"""The folders' keys of every general policy: the ``melody`` family's, and the ``parts`` family's
+(melody phrases and phrases of one hand of a two-hand piece: a general policy too)."""
 PACKAGED = Path(__file__).resolve().parent.parent / "policies"
 """The policies that ship with pianobot (package data): the committed general policy."""
 
@@ -108,11 +113,14 @@ def explain(folder: Path, found: tuple[str, Any, Any], ours: str) -> str:
 def general_candidates(models: Path | None) -> list[Path]:
     """Every general policy there is: the newest first in ``models`` (the user's store), then the
     packaged ones (:data:`PACKAGED`)."""
-    found = store.find_policies(models, GENERAL_KEY) if models is not None else []
-    packaged = [
-        p for p in store.find_policies(PACKAGED, GENERAL_KEY) if p.resolve() not in {f.resolve() for f in found}
-    ]
+    found = _newest_first(models) if models is not None else []
+    packaged = [p for p in _newest_first(PACKAGED) if p.resolve() not in {f.resolve() for f in found}]
     return found + packaged
+
+
+def _newest_first(root: Path) -> list[Path]:
+    found = [folder for key in GENERAL_KEYS for folder in store.find_policies(root, key)]
+    return sorted(found, key=store.saved_at, reverse=True)
 
 
 def find_general(
@@ -124,7 +132,7 @@ def find_general(
     remedy: str = "",
 ) -> Path | None:
     """The general policy's folder: ``path`` when given (any trained policy), else the newest
-    ``task-melody`` policy in ``models``, then the packaged one (:func:`general_candidates`), that
+    ``task-melody`` or ``task-parts`` policy in ``models``, then the packaged one (:func:`general_candidates`), that
     fits ``env`` (and ``sac``'s networks, when given); None when there is none. A policy of the
     user's (``path``, or in ``models``) that does not fit is refused: a one-line
     :class:`PianobotError` naming the first field that differs (and its option) and ``remedy``.

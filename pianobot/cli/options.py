@@ -69,7 +69,7 @@ PhraseNotes = typer.Option(DEFAULT_MAX_NOTES, "--phrase-notes", help="Most notes
 GeneralPolicy = typer.Option(
     None,
     "--general-policy",
-    help="The general policy's folder (any trained policy; default: the newest `pianobot train --task melody` "
+    help="The general policy's folder (any trained policy; default: the newest `pianobot train --task melody` or `--task parts` "
     "policy in --models whose environment fits).",
 )
 PlayPhraseNotes = typer.Option(

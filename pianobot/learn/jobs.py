@@ -77,7 +77,7 @@ def general_start(
     config: TrainConfig, models: Path, path: Path | None = None, networks_given: bool = False
 ) -> tuple[TrainConfig, Path | None]:
     """Where a piece's phrases begin: (``config``, the general policy's folder) when
-    ``config.from_general`` asks for it and there is one (``path``, else the newest ``task-melody``
+    ``config.from_general`` asks for it and there is one (``path``, else the newest ``task-melody`` or ``task-parts``
     policy in ``models`` whose environment is the run's); else (``config`` with ``from_general``
     off, None): from scratch. A run that starts from a policy takes its networks
     (:data:`~pianobot.agent.general.NETWORK_FIELDS`), unless ``networks_given`` (an option set them):

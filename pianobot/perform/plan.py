@@ -190,7 +190,7 @@ def assign(
                 f"phrase {phrase.index} ({notes}) has no policy of its own in the model store {models} "
                 f"({Path(models).resolve()}) and no general policy plays it (looked there and in {PACKAGED}): "
                 "train it with `pianobot train` (same reading options), train a general policy with "
-                "`pianobot train --task melody`, name another store with store.models DIR, add play.fallback scripted, "
+                "`pianobot train --task parts`, name another store with store.models DIR, add play.fallback scripted, "
                 "or play with play.controller scripted",
                 "store.models",
             )
@@ -255,7 +255,7 @@ def _general_for(
         f"the general policy {theirs[0]} plays {world.keyboard.spec.describe()} with fingers "
         f"{world.hand.spec.describe()}, this piece is read for {keyboard.describe()} with fingers {hand.describe()} "
         "(keyboard.lowest, keyboard.count, hand.fingers): play with play.controller scripted, or train a general policy for them "
-        "with `pianobot train --task melody` and the same options",
+        "with `pianobot train --task parts` and the same options",
         "keyboard.lowest",
     )
 

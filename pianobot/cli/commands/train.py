@@ -79,7 +79,7 @@ def train(
     from_general: bool = typer.Option(
         TrainConfig.from_general,
         "--from-general/--no-from-general",
-        help="Start every phrase from the general policy (the newest `pianobot train --task melody` policy in --models "
+        help="Start every phrase from the general policy (the newest `pianobot train --task melody` or `--task parts` policy in --models "
         "whose options are this run's, or --general-policy): load its actor, encoder, critic and temperature (Adam "
         "starts afresh), evaluate it before any training step, and stop the phrase at the first evaluation that "
         f"reaches note F1 {TrainConfig.finetune_until_f1} (--until-f1 sets another), keeping the best evaluated "
@@ -90,7 +90,7 @@ def train(
     general_policy: Optional[Path] = typer.Option(
         None,
         "--general-policy",
-        help="The policy to start from (any trained policy; default: the newest `pianobot train --task melody` "
+        help="The policy to start from (any trained policy; default: the newest `pianobot train --task melody` or `--task parts` "
         "policy in --models whose options fit). With --task there is no default: a task family trains from scratch, "
         "or, given this, that policy's training goes on, on the family.",
     ),
@@ -260,7 +260,7 @@ def train(
                 )
             elif from_general:
                 console.print(
-                    f"[dim]no general policy in {said(models)} (`pianobot train --task melody` trains one): "
+                    f"[dim]no general policy in {said(models)} (`pianobot train --task parts` trains one): "
                     "training from scratch[/dim]"
                 )
         todo, done = plan_jobs(jobs, force)
