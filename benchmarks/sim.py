@@ -7,8 +7,8 @@ Each figure is the median of ``--repeats`` runs on the same work:
   then replayed open-loop (the simulator is deterministic, so every replay makes the same
   contacts), without and with the fingertips' tactile images; once on the paper's keyboard (24
   keys, C4-B5) and once on a whole piano's (88 keys, A0-C8) with the hand put where it played;
-  and two hands over 88 keys (:class:`TwoHands`: the world, both hands' state, fingertips and
-  tactile images, the left hand playing the right's mirror image);
+  and two hands over 88 keys in the two-hand environment (:func:`two_hands`: each hand's
+  observations, tactile images included, the left hand playing the right's mirror image);
 - the profile of one control step (one replay with touch per keyboard): the step's wall time
   split into phases by timers put around the simulator's and the environment's functions for
   that replay (:class:`Phases`; a function called inside another is counted in its own phase
@@ -41,21 +41,22 @@ import numpy as np
 
 import pianobot.env.piano as piano
 import pianobot.sim.world as world_module
+from pianobot.env.hands import HandsEnv
 from pianobot.env.piano import EnvConfig, PianoEnv, idle_pose
 from pianobot.music.instrument import KeyboardSpec
 from pianobot.music.load import load_piece
+from pianobot.music.window import Window
 from pianobot.perform.perform import perform
 from pianobot.pianist.scripted import ScriptedPianist
 from pianobot.sim.keyboard import KeyboardConfig, KeySensor, key_x
 from pianobot.sim.tactile import TactileConfig, TactileRenderer
-from pianobot.sim.world import PianoWorld, WorldConfig
 
 ROOT = Path(__file__).resolve().parent.parent
 PAPER = KeyboardSpec()
 PIANO = KeyboardSpec(lowest=21, count=88)
 PLAY = ROOT / "examples" / "midi" / "mary.mid"
 """The longest one-hand example (19 s)."""
-TWO = "steps/s, touch, two hands, 88 keys (world; no env yet)"
+TWO = "env steps/s, touch, two hands, 88 keys"
 
 
 def record(piece):
@@ -104,52 +105,26 @@ def env_rate(piece, actions, wrist, tactile: bool, keyboard: KeyboardSpec = PAPE
     return rate
 
 
-def mirrored(action: np.ndarray) -> np.ndarray:
-    """The left hand's action that mirrors a right hand's: the same joint speeds (its kinematics
-    are the mirror image), the wrist's speed reversed."""
-    out = np.array(action, dtype=float)
-    out[-1] = -out[-1]
-    return out
+def two_hands(piece, wrist: float) -> HandsEnv:
+    """Two hands over 88 keys in the two-hand environment, reset as the recording started: the
+    right hand's part on C4-B5, the left hand's its mirror image over the mirrored keys an octave
+    lower (F1-E3), each hand's observations (tactile images included) made at every step."""
+    config = EnvConfig(tactile=True)
+    windows = {"right": Window("right", PAPER, 0), "left": Window("left", PAPER, -1)}
+    env = HandsEnv({h: (w, piece) for h, w in windows.items()}, {h: config for h in windows}, keyboard=PIANO)
+    env.reset(seed=0)
+    starts = [env.view(h).world_wrist(wrist) for h in ("right", "left")]
+    env.world.reset(starts, np.tile(idle_pose(config.world), 6))
+    return env
 
 
-class TwoHands:
-    """Two hands over 88 keys, stepped as an environment would (there is no two-hand environment
-    yet): the right hand replays the recording, the left hand its mirror image over the mirrored
-    keys (pitch p <-> 124 - p, about D4); after each step, both hands' state, fingertips and
-    tactile images."""
-
-    def __init__(self, wrist: float):
-        config = replace(WorldConfig(), keyboard=KeyboardConfig(spec=PIANO))
-        self.world = PianoWorld(config, hands=("right", "left"))
-        self.renderer = TactileRenderer(TactileConfig(), config.hand.geometry, self.world.boxes)
-        right = wrist + key_x(config.keyboard, PAPER.lowest) - key_x(KeyboardConfig(), PAPER.lowest)
-        left = 2 * key_x(config.keyboard, 62) - right
-        self.world.reset([right, left], np.tile(idle_pose(config), 3))
-
-    def step(self, action: np.ndarray) -> None:
-        self.world.step(np.concatenate([action, mirrored(action)]))
-        for hand in range(2):
-            self.world.hand_state(hand)
-            self.world.tip_points(hand)
-            self.touch(hand)
-
-    def touch(self, hand: int) -> list[np.ndarray]:
-        angles, _ = self.world.key_state()
-        forces = self.world.tip_forces(hand)
-        images = []
-        for finger, link in self.world.hands[hand].tips.items():
-            position, rotation = self.world.link_pose(link, hand)
-            images.append(self.renderer.image(position, rotation, angles, forces[finger]))
-        return images
-
-
-def two_hand_rate(actions, wrist) -> float:
-    hands = TwoHands(wrist)
+def two_hand_rate(piece, actions, wrist) -> float:
+    env = two_hands(piece, wrist)
     start = time.perf_counter()
     for action in actions:
-        hands.step(action)
+        env.step({"right": action, "left": action})  # (the left's, in its view, is the right's)
     rate = len(actions) / (time.perf_counter() - start)
-    hands.world.close()
+    env.close()
     return rate
 
 
@@ -195,7 +170,7 @@ PHASES = {
         (world_module.PianoWorld, "_colour_keys"),
         (KeySensor, "update"),
     ],
-    "tactile images": [(PianoEnv, "_tactile_image"), (TwoHands, "touch")],
+    "tactile images": [(PianoEnv, "_tactile_image")],
     "observation": [(PianoEnv, "_observe")],
     "reward": [(piano, "reward_terms"), (PianoEnv, "_fingertip_distances")],
 }
@@ -203,8 +178,8 @@ PHASES = {
 
 def profile(piece, actions, wrist, keyboard: KeyboardSpec | None) -> dict[str, float]:
     """Microseconds per control step by phase, for one replay with touch: one hand over
-    ``keyboard`` in the environment, or (None) two hands over 88 keys (:class:`TwoHands`)."""
-    stepper = replay_env(piece, wrist, True, keyboard) if keyboard else TwoHands(wrist)
+    ``keyboard`` in the environment, or (None) two hands over 88 keys (:func:`two_hands`)."""
+    stepper = replay_env(piece, wrist, True, keyboard) if keyboard else two_hands(piece, wrist)
     phases = Phases()
     for phase, functions in PHASES.items():
         for owner, name in functions:
@@ -212,11 +187,11 @@ def profile(piece, actions, wrist, keyboard: KeyboardSpec | None) -> dict[str, f
     try:
         start = time.perf_counter()
         for action in actions:
-            stepper.step(action)
+            stepper.step(action if keyboard else {"right": action, "left": action})
         total = time.perf_counter() - start
     finally:
         phases.restore()
-        (stepper if keyboard else stepper.world).close()
+        stepper.close()
     out = {phase: phases.totals[phase] for phase in PHASES}
     out["other (Python of env.step, world.step)"] = total - sum(out.values())
     out["total"] = total
@@ -268,7 +243,7 @@ def main() -> None:
         "env steps/s, no touch, 24 keys": lambda: env_rate(piece, actions, wrist, False),
         f"{touch}, 24 keys": lambda: env_rate(piece, actions, wrist, True),
         f"{touch}, 88 keys": lambda: env_rate(piece, actions, wrist, True, PIANO),
-        TWO: lambda: two_hand_rate(actions, wrist),
+        TWO: lambda: two_hand_rate(piece, actions, wrist),
         "tactile frames/s under contact (60x80)": lambda: tactile_rate(renderer, touching),
         f"play's real-time factor, scripted pianist, {args.play.name}": lambda: play_factor(args.play),
     }

@@ -38,8 +38,8 @@ from pianobot.sim.world import PianoWorld, WorldConfig
 
 
 def world_keyboard(windows: list[Window]) -> KeyboardSpec:
-    """The keys of a world on which every window's keys lie: from the lowest to the highest of
-    them, at most the piano's 88."""
+    """The fewest keys of a world on which every window's keys lie: from the lowest to the highest
+    of them, at most the piano's 88."""
     pitches = [w.outward(q) for w in windows for q in (w.keyboard.lowest, w.keyboard.lowest + w.keyboard.count - 1)]
     low, high = min(pitches), max(pitches)
     if high - low + 1 > 88:
@@ -54,14 +54,19 @@ class HandsEnv(gym.Env):
     """Each hand of ``parts`` (hand -> (window, part)) plays its part, given in its window's keys
     (:meth:`~pianobot.music.window.Window.inward`: the left hand's mirrored) and fingered for it,
     in one world; ``configs``: each hand's environment (its keyboard is replaced by its window's;
-    the hands' physics settings must agree). Both parts run as long as the longer one."""
+    the hands' physics settings must agree); ``keyboard``: the world's keys (default: the fewest
+    that hold both windows', :func:`world_keyboard`). Both parts run as long as the longer one."""
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": WorldConfig.control_hz}
     FRAME = (720, 320)
     """A rendered frame's width and height: wide, for a keyboard of up to 88 keys."""
 
     def __init__(
-        self, parts: dict[str, tuple[Window, Piece]], configs: dict[str, EnvConfig], render_mode: str | None = None
+        self,
+        parts: dict[str, tuple[Window, Piece]],
+        configs: dict[str, EnvConfig],
+        render_mode: str | None = None,
+        keyboard: KeyboardSpec | None = None,
     ):
         if render_mode not in (None, *self.metadata["render_modes"]):
             raise ValueError(f"render_mode {render_mode!r}: choose None or 'rgb_array'")
@@ -75,7 +80,7 @@ class HandsEnv(gym.Env):
         if len(worlds) > 1:
             raise ValueError("both hands' environments must share their physics (control, rates, hand, solver)")
         base = configs["right"].world
-        world_config = replace(base, keyboard=replace(base.keyboard, spec=world_keyboard(windows)))
+        world_config = replace(base, keyboard=replace(base.keyboard, spec=keyboard or world_keyboard(windows)))
         self.world = PianoWorld(world_config, hands=HANDS)
         length = max(parts[h][1].duration for h in HANDS)
         self.hands: dict[str, PianoEnv] = {}
