@@ -67,12 +67,11 @@ def test_a_hands_view_maps_places_and_keys_both_ways():
     env = mirrored_env()
     try:
         left: HandView = env.view("left")
-        assert left.pitch(left.window.outward(62)) == 62
-        for q in (60, 61, 70, 83):
+        for q in (60, 61, 70, 83):  # each key of the view lies where the world's key it stands for does
             world_pitch = LEFT.outward(q)
+            assert world_pitch == 124 - (q + 12) and left.pitch(world_pitch) == q
             box = env.world.boxes[world_pitch - env.world.config.keyboard.spec.lowest]
             assert left.x(box.center[0]) == pytest.approx(left.boxes[q - KEYS.lowest].center[0])
-            assert left.world_x(left.x(0.3)) == pytest.approx(0.3)
         assert left.pitch(RIGHT.outward(70)) is None  # a key of the right hand's half: not the left's
         assert left.world_action(np.ones(13))[-1] == -1.0  # the mirrored wrist moves the other way
     finally:
@@ -112,19 +111,64 @@ def test_both_hands_play_their_parts_and_each_note_is_credited_to_its_hand():
     )  # as long as the longer part
 
 
+SHARED = Window("left", KEYS, 1)
+"""A left window over nearly the right one's keys (C4-B5 mirrored an octave up: G3-E5)."""
+
+
 def test_starts_closer_than_the_world_allows_are_moved_apart():
-    env = HandsEnv(
-        {"right": (Window("right", KEYS, 0), PHRASE), "left": (Window("left", KEYS, -1), PHRASE)},
-        {"right": CONFIG, "left": CONFIG},
-    )
+    env = HandsEnv({"right": (RIGHT, PHRASE), "left": (SHARED, PHRASE)}, {"right": CONFIG, "left": CONFIG})
     try:
-        for seed in range(6):
+        gap, width = env.world.min_separation, env.world.width
+        for right, left in ((0.5, 0.5), (0.5, 0.6), (0.0, 0.0), (width, width), (0.3, 0.25)):
+            high, low = env._apart(right, left)
+            assert high - low == pytest.approx(gap) and 0.0 <= low and high <= width, (right, left)
+        assert env._apart(0.6, 0.2) == (0.6, 0.2)  # far enough: left where they were
+        moved = 0
+        for seed in range(12):
+            drawn = [env.view(h).world_wrist(e.draw_start(seed)) for h, e in env.hands.items()]
+            moved += drawn[0] - drawn[1] < gap
             env.reset(seed=seed)
-            right, left = env.world.hand_state(0)[0], env.world.hand_state(1)[0]
-            assert right - left >= env.world.min_separation - 1e-9
-            assert 0.0 <= left and right <= env.world.width
+            assert env.world.hand_state(0)[0] - env.world.hand_state(1)[0] >= gap - 1e-6
+        assert moved  # (some of the starts drawn were too close)
     finally:
         env.close()
+
+
+def test_a_hand_is_not_rewarded_or_blamed_for_the_keys_the_other_hand_plays():
+    """Windows that share keys: the right hand holds C5, a key of the left hand's view too; the
+    left hand hears it, but its step info never has it pressed (so its reward neither pays nor
+    blames it), and no finger of the left hand is credited with it."""
+    part = Piece((Note(0.0, 60, 1.0, 80, 3),))  # the right hand's C4: the world's C5
+    left_part = Piece((Note(0.0, SHARED.inward(57), 1.0, 80, 3),))  # A3
+    env = HandsEnv({"right": (RIGHT, part), "left": (SHARED, left_part)}, {"right": CONFIG, "left": CONFIG})
+    c5 = env.view("left").pitch(RIGHT.outward(60))
+    assert c5 is not None  # C5 lies in both windows
+    try:
+        observations, _ = env.reset(seed=1)
+        players = {h: ScriptedPianist(CONFIG) for h in env.hands}
+        heard = sounded = 0
+        while True:
+            observations, _, _, truncated, info = env.step({h: p.act(observations[h]) for h, p in players.items()})
+            left, right = info["hands"]["left"], info["hands"]["right"]
+            heard += any(e.pitch == c5 and e.on for e in left["events"])
+            sounded += bool(right["pressed"][60 - KEYS.lowest])
+            assert not left["pressed"][c5 - KEYS.lowest] and c5 not in left["fingers"]
+            if truncated:
+                break
+        assert heard == 1 and sounded > 10  # the right hand held it for many steps
+    finally:
+        env.close()
+
+
+def test_hands_of_other_timelines_or_a_discrete_wrist_are_refused():
+    from dataclasses import replace
+
+    for left in (replace(CONFIG, lead_in=0.0), replace(CONFIG, tail=1.0)):
+        with pytest.raises(ValueError, match="lead-in and tail"):
+            HandsEnv({"right": (RIGHT, PHRASE), "left": (LEFT, PHRASE)}, {"right": CONFIG, "left": left})
+    discrete = replace(CONFIG, world=replace(CONFIG.world, discrete_wrist=True))
+    with pytest.raises(ValueError, match="discrete wrist"):
+        HandsEnv({"right": (RIGHT, PHRASE), "left": (LEFT, PHRASE)}, {"right": discrete, "left": discrete})
 
 
 def test_the_hands_must_share_their_physics():

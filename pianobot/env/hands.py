@@ -3,14 +3,17 @@
 :class:`HandsEnv` holds one world of two hands (:class:`~pianobot.sim.world.PianoWorld` with
 ``hands=("right", "left")``) over the keys both parts need, and one
 :class:`~pianobot.env.piano.PianoEnv` per hand built on a :class:`~pianobot.sim.frame.HandView`
-of it: each hand's observations, action and reward are exactly those of the one-hand
-environment (the left hand's mirrored), so every one-hand player (the scripted pianist, the
+of it: each hand's observations, action and reward are made as the one-hand environment makes
+them, in the hand's view (the left hand's mirrored), so every one-hand player (the scripted pianist, the
 general policy, phrase policies) plays either hand unchanged. ``step`` takes an action per hand,
 steps the world once with both, and gives each hand what it sees.
 
-What the hands share: the keys (a key struck by one sounds in the other's view too; its reward
-counts only its own fingers' strikes) and the space over the keyboard: the world keeps the right
-wrist at least ``PianoWorld.min_separation`` above the left one and the hands' links collide.
+What the hands share: the keys (a key struck by one moves in the other's view too, and its touch
+shows in the other's tactile images; each hand's reward counts only the keys it played itself)
+and the space over the keyboard: the world keeps the right wrist at least
+``PianoWorld.min_separation`` above the left one and the hands' links collide. Where a window
+reaches past A0 or C8 (a player's 24 keys around a part near the piano's end), the world has
+those keys too; no note is written on them.
 
 Spaces are dicts keyed by hand ('right', 'left'); the reward is the sum of the hands'
 (``info["rewards"]`` has each); ``info["hands"]`` holds each hand's step info, and ``info``
@@ -76,9 +79,18 @@ class HandsEnv(gym.Env):
         windows = [parts[h][0] for h in HANDS]
         if any(parts[h][0].hand != h for h in HANDS):
             raise ValueError("each hand's part needs that hand's window")
-        worlds = {replace(configs[h].world, keyboard=configs["right"].world.keyboard, gui=False) for h in HANDS}
+        worlds = {
+            replace(configs[h].world, keyboard=replace(configs[h].world.keyboard, spec=KeyboardSpec()), gui=False)
+            for h in HANDS
+        }
         if len(worlds) > 1:
-            raise ValueError("both hands' environments must share their physics (control, rates, hand, solver)")
+            raise ValueError("both hands' environments must share their physics (control, rates, hand, keys, solver)")
+        if len({(configs[h].lead_in, configs[h].tail) for h in HANDS}) > 1:
+            raise ValueError("both hands' environments must share their lead-in and tail (one timeline)")
+        if configs["right"].world.discrete_wrist:
+            raise ValueError(
+                "a discrete wrist picks among the world's keys, not a hand's view's: use a continuous wrist"
+            )
         base = configs["right"].world
         world_config = replace(base, keyboard=replace(base.keyboard, spec=keyboard or world_keyboard(windows)))
         self.world = PianoWorld(world_config, hands=HANDS)
@@ -108,6 +120,8 @@ class HandsEnv(gym.Env):
         wrists = {h: self.view(h).world_wrist(env.draw_start(seed)) for h, env in self.hands.items()}
         right, left = self._apart(wrists["right"], wrists["left"])
         self.world.reset([right, left], np.concatenate([self.hands[h].start_pose() for h in HANDS]))
+        self.holders: dict[int, str] = {}
+        """World pitch -> the hand whose strike sounds it now."""
         firsts = {h: env.begin() for h, env in self.hands.items()}
         return {h: obs for h, (obs, _) in firsts.items()}, {
             "pieces": {h: info["piece"] for h, (_, info) in firsts.items()}
@@ -133,15 +147,22 @@ class HandsEnv(gym.Env):
             ]
         )
         result = self.world.step(full)
-        observations, rewards, infos = {}, {}, {}
-        truncated = True
-        for hand, env in self.hands.items():
-            observations[hand], rewards[hand], _, done, infos[hand] = env.absorb(self.view(hand).result(result))
-            truncated = truncated and done
         struck = {pitch: HANDS[h] for pitch, h in result.hands.items()}
         for event in result.events:  # a strike no fingertip was touching: the nearer hand's
             if event.on and event.pitch not in struck:
                 struck[event.pitch] = self._nearer(event.pitch)
+        played = {**self.holders, **struck}  # who played each key that sounded in this step
+        for event in result.events:
+            if event.on:
+                self.holders[event.pitch] = struck[event.pitch]
+            else:
+                self.holders.pop(event.pitch, None)
+        observations, rewards, infos = {}, {}, {}
+        truncated = True
+        for hand, env in self.hands.items():
+            others = {pitch for pitch, by in played.items() if by != hand}
+            observations[hand], rewards[hand], _, done, infos[hand] = env.absorb(self.view(hand).result(result, others))
+            truncated = truncated and done
         info = {
             "hands": infos,
             "rewards": rewards,

@@ -330,12 +330,12 @@ def play_hands(
     keyboard = keyboard or (KeyboardSpec() if controller == "sac" else None)
     names = [h for h in HANDS if h in piece.hands]
     together = together and len(names) == 2
-    begin = piece.notes[0].onset if together else None  # (one timeline for both hands)
+    offset = piece.notes[0].onset if together else None  # (one timeline for both hands)
     parts = {}
     for name in names:
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", PianobotWarning)
-            prepared = prepare_part(piece, name, keyboard, fingers, begin)
+            prepared = prepare_part(piece, name, keyboard, fingers, offset)
         changes = tuple(str(w.message) for w in caught if issubclass(w.category, PianobotWarning))
         _warn_again(caught)
         parts[name] = (*prepared, changes)
@@ -399,8 +399,8 @@ def _play_together(
                 on_step(steps, env.horizon)
             if truncated:
                 break
-        begin = parts["right"][2]
-        sounded = recorder.piece(end=env.world.time, start=env.score_start, bpm=piece.bpm).shift(begin)
+        offset = parts["right"][2]  # (the piece's first onset: both parts start from it)
+        sounded = recorder.piece(end=env.world.time, start=env.score_start, bpm=piece.bpm).shift(offset)
     finally:
         env.close()
     done = []
@@ -416,7 +416,7 @@ def _play_together(
         rollout = Rollout(part, inward, rewards[h], steps, None, env.score_start)
         performance = Performance(plans[h], rollout, seed, plan.slowed_steps(controllers[h]))
         done.append(HandPerformance(h, window, part, start, left_out, performance, changes, own))
-    start = env.score_start - begin
+    start = env.score_start - offset
     return HandsPerformance(piece, tuple(done), seed, together=True, frames=frames, start=start)
 
 

@@ -8,7 +8,7 @@ octaves; for the left hand it also mirrors it about D, the one key whose mirror 
 so the left hand (built as the right hand's mirror image, :data:`~pianobot.sim.hand.SIDES`) is a
 right hand in the view, with the same joint angles. Both maps are exact: a piano's keys repeat
 every octave and are symmetric about D, and the left hand's links are the right's reflected
-(tests/test_sim_frame.py checks both).
+(tests/test_env_hands.py checks both).
 
 A view offers what the environment reads of a one-hand world (the wrist, the joints, fingertip
 points and forces, link poses, key angles, the keys' boxes and the keyboard's width), each in
@@ -123,10 +123,11 @@ class HandView:
         """A wrist position along the view's keyboard -> the world's."""
         return self.world_x(x)
 
-    def result(self, result: StepResult) -> StepResult:
-        """What a world step did, as the view sees it: its keys' events at the view's pitches, and
-        the fingers of the strikes of this hand only (a key the other hand struck sounds, but is
-        no finger's of this one)."""
+    def result(self, result: StepResult, others: set[int] = frozenset()) -> StepResult:
+        """What a world step did, as the view sees it: its keys' events at the view's pitches, the
+        fingers of the strikes of this hand only, and the keys it pressed: a key the other hand
+        played (``others``, world pitches) sounds, but is neither pressed by this hand nor any
+        finger's of it."""
         events = []
         fingers = {}
         for event in result.events:
@@ -136,4 +137,8 @@ class HandView:
             events.append(KeyEvent(event.time, q, event.on, event.velocity))
             if event.on and result.hands.get(event.pitch) == self.hand and event.pitch in result.fingers:
                 fingers[q] = result.fingers[event.pitch]
-        return StepResult(events, fingers, result.pressed[self.keys], result.pressed_velocity[self.keys])
+        pressed, velocity = result.pressed[self.keys].copy(), result.pressed_velocity[self.keys].copy()
+        lowest = self.world.config.keyboard.spec.lowest
+        theirs = np.isin(self.keys + lowest, list(others))
+        pressed[theirs], velocity[theirs] = False, 0
+        return StepResult(events, fingers, pressed, velocity)
