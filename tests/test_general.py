@@ -198,7 +198,7 @@ def test_play_uses_a_phrases_own_policy_then_the_general_policy_and_says_so(tmp_
 
     # own policy > general policy > scripted fallback: without the general policy, as before
     assert_one_line_error(
-        run(*args, "--no-general"), "phrase 1 (G4)", "--fallback scripted", "pianobot train --task melody"
+        run(*args, "--no-general"), "phrase 1 (G4)", "--fallback scripted", "pianobot train --task parts"
     )
     fallback = run(*args, "--no-general", "--fallback", "scripted")
     assert fallback.exit_code == 0, fallback.output
