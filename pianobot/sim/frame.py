@@ -137,8 +137,8 @@ class HandView:
             events.append(KeyEvent(event.time, q, event.on, event.velocity))
             if event.on and result.hands.get(event.pitch) == self.hand and event.pitch in result.fingers:
                 fingers[q] = result.fingers[event.pitch]
-        pressed, velocity = result.pressed[self.keys].copy(), result.pressed_velocity[self.keys].copy()
-        lowest = self.world.config.keyboard.spec.lowest
-        theirs = np.isin(self.keys + lowest, list(others))
-        pressed[theirs], velocity[theirs] = False, 0
+        pressed, velocity = result.pressed[self.keys], result.pressed_velocity[self.keys]  # (copies: fancy indexing)
+        if others:  # (mostly none: the hands seldom share a key)
+            theirs = np.isin(self.keys + self.world.config.keyboard.spec.lowest, list(others))
+            pressed[theirs], velocity[theirs] = False, 0
         return StepResult(events, fingers, pressed, velocity)
