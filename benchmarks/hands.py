@@ -1,8 +1,8 @@
 """Two-hand pieces played with both hands (pianobot/perform/hands.py): the general policy zero-shot,
 beside the scripted pianist, against the pieces as written.
 
-    python -m benchmarks.hands [--duets 50] [--seed 35] [--polyphonic 20] [--general DIR] [--apart]
-                               [--json out.json]
+    python -m benchmarks.hands [--duets 50] [--seed 35] [--polyphonic 20] [--general DIR]
+                               [--general-left DIR] [--apart] [--json out.json]
 
 (``python -m benchmarks.zeroshot --sets duets polyphonic`` plays the same sets beside the
 one-hand ones.)
@@ -18,8 +18,8 @@ Sets:
 
 Each piece is played once from hand start 0, both hands in one simulation as ``pianobot play``
 plays them (``--apart``: each hand in a simulation of its own), by the general policy (the
-packaged one: the model store is an empty folder; ``--general`` names another) and by the
-scripted pianist. Prints a
+packaged one: the model store is an empty folder; ``--general`` names another, ``--general-left``
+another for the left hand: one policy per hand) and by the scripted pianist. Prints a
 Markdown table per set: note F1 (whole piece, right hand, left hand), per-step key-press F1, note
 F1 with offsets, notes left outside the general policy's 24 keys, and the general policy's share
 of the scripted pianist's note F1.
@@ -113,6 +113,7 @@ def main() -> None:
     parser.add_argument("--polyphonic", type=int, default=20)
     parser.add_argument("--seed", type=int, default=35)
     parser.add_argument("--general", help="the general policy's folder (default: the packaged one)")
+    parser.add_argument("--general-left", help="the left hand's general policy (default: --general's)")
     parser.add_argument("--apart", action="store_true", help="each hand in a simulation of its own")
     parser.add_argument("--json", help="write every piece's figures here")
     args = parser.parse_args()
@@ -124,7 +125,10 @@ def main() -> None:
     results = {}
     started = time.perf_counter()
     for name, pieces in sets.items():
-        results[name] = play_set(pieces, args.general, not args.apart)
+        if not pieces:
+            continue
+        general = {"right": args.general, "left": args.general_left} if args.general_left else args.general
+        results[name] = play_set(pieces, general, not args.apart)
         print(table(name, results[name]), flush=True)
     print(f"{time.perf_counter() - started:.0f} s")
     if args.json:

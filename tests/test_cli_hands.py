@@ -286,3 +286,29 @@ def test_finger_writes_each_hands_fingering_one_track_each(tmp_path):
     assert [(n.pitch, n.hand) for n in fingered.notes] == [(n.pitch, n.hand) for n in load_hands(song).notes]
     text = " ".join(result.stdout.split())
     assert "left hand, fingers 2 (index), 3 (middle), 4 (ring): wrist travel" in text and "one track per hand" in text
+
+
+def test_the_left_hand_plays_the_packaged_left_policy_unless_left_policy_names_another(tmp_path):
+    """Both hands with the general policies: by default the right hand has the general policy
+    (`task-melody`) and the left the packaged left hand's (`task-parts`); --left-policy names the
+    left's; it is refused, in one line, where no general policy plays a left hand."""
+    from pianobot.agent.general import PACKAGED
+
+    song, models = _duet(tmp_path / "duet.mid"), tmp_path / "models"
+    models.mkdir()
+    result = run("play", song, "-o", tmp_path / "out.mid", "--models", models, "--json", tmp_path / "r.json", "-q")
+    assert result.exit_code == 0, result.output
+    hands = json.loads((tmp_path / "r.json").read_text())["hands"]
+    assert "task-melody-" in hands["right"]["performer"] and "task-parts-" in hands["left"]["performer"]
+    melody = next(PACKAGED.glob("task-melody-*"))
+    result = run(
+        "play", song, "-o", tmp_path / "two.mid", "--models", models, "--left-policy", melody, "--json", tmp_path / "two.json", "-q"
+    )
+    assert result.exit_code == 0, result.output
+    hands = json.loads((tmp_path / "two.json").read_text())["hands"]
+    assert "task-melody-" in hands["left"]["performer"] and "task-parts-" not in hands["left"]["performer"]
+    one_hand = midi_file(tmp_path / "one.mid", [("Right Hand", RIGHT)])
+    refused = run("play", one_hand, "-o", tmp_path / "x.mid", "--left-policy", melody)
+    assert_one_line_error(refused, "plays one hand")
+    refused = run("play", song, "-o", tmp_path / "x.mid", "--controller", "scripted", "--left-policy", melody)
+    assert_one_line_error(refused, "--controller scripted")

@@ -352,3 +352,20 @@ def test_a_parts_family_policy_is_a_general_policy_and_the_newest_comes_first(mo
     found = general_candidates(models)
     assert found[:2] == [parts, models / general.name]
     assert all(PACKAGED in f.resolve().parents for f in found[2:]) and len(found) > 2
+
+
+def test_the_packaged_left_hand_policy_plays_left_hands_only_while_the_store_has_no_general_policy(tmp_path, models):
+    """The packaged `task-parts` policy is the left hand's by default, never the general policy of
+    one hand; a general policy of the user's own plays both hands (none is offered then), and so
+    does the packaged general policy where the left hand's was trained on other keys."""
+    from pianobot.agent.general import LEFT_KEY, general_candidates, left_hand_policy
+    from pianobot.music.instrument import KeyboardSpec
+
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    left = left_hand_policy(empty)
+    assert left is not None and left.name.startswith(f"{LEFT_KEY}-") and PACKAGED in left.resolve().parents
+    assert [f.name.split("-")[1] for f in general_candidates(empty)] == ["melody"]  # the packaged general policy
+    assert left_hand_policy(empty, KeyboardSpec()) == left
+    assert left_hand_policy(empty, KeyboardSpec(lowest=36, count=36)) is None
+    assert left_hand_policy(models) is None  # the user's own general policy plays both hands

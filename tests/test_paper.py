@@ -78,7 +78,8 @@ def test_the_paper_setting_is_plain_sac_without_our_additions(tmp_path):
             assert config.explore != "scripted" and config.sac.demo_weight == 0  # no teacher
             assert config.env.reward.closeness_weight == 0  # no closeness bonus
             assert not config.env.target_observations and config.sac.score_input  # the paper's observation
-            assert config.sac.learning_rate == 1e-3 and config.sac.initial_alpha == 0.02  # its hyperparameters
+            if run.variant != "our-hyperparameters":  # (the diagnosis's arm that tries ours)
+                assert config.sac.learning_rate == 1e-3 and config.sac.initial_alpha == 0.02  # its hyperparameters
             assert config.sac.exploration_steps == 15_000
 
 
@@ -342,3 +343,24 @@ def test_the_idle_hand_presses_no_key_and_earns_between_random_and_scripted(tmp_
     assert played["random"]["return"] < played["idle"]["return"] < played["scripted"]["return"]
     assert played["scripted"]["f1"] == 1.0
     assert evaluation.baseline_figures("idle", "three-note", 0, opts) == played["idle"]  # cached
+
+
+def test_the_diagnosis_changes_one_thing_at_a_time_in_the_paper_setting(tmp_path):
+    """Experiment 9 is the paper setting on one-note without touch; its `paper` arm is experiment 1's
+    run (one folder), and each other arm differs from it in exactly the fields named."""
+    runs = expand("diagnosis", options(tmp_path, seeds=1))
+    assert {r.setting for r in runs} == {"paper"} and {r.task for r in runs} == {"one-note"}
+    arms = {r.variant: r for r in runs}
+    changed = {
+        "paper": set(),
+        "one-joint": {"env.actuated"},
+        "no-gate": {"env.reward.fingering_gate"},
+        "our-hyperparameters": {"sac.learning_rate", "sac.discount", "sac.target_entropy_scale"},
+    }
+    assert arms.keys() == changed.keys()
+    for name, fields in changed.items():
+        assert set(report.differences(arms[name].config, arms["paper"].config)) == fields, name
+    assert arms["one-joint"].config.env.actuated == ("mcp",)  # the paper's one action per finger
+    tasks = expand("tasks", options(tmp_path, seeds=1, settings=("paper",)))
+    without_touch = next(r for r in tasks if r.task == "one-note" and r.variant == "no-tactile")
+    assert arms["paper"].jobs[0].folder == without_touch.jobs[0].folder

@@ -22,7 +22,8 @@ def parse(argv: list[str] | None = None) -> tuple[argparse.Namespace, Options]:
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument(
-        "experiment", help="1-8 or tasks, rhythm-chord, rewards, exploration, control, fingering, compose, additions"
+        "experiment",
+        help="1-9 or tasks, rhythm-chord, rewards, exploration, control, fingering, compose, additions, diagnosis",
     )
     parser.add_argument("--setting", choices=(*SETTINGS, "both"), default="both")
     parser.add_argument("--seeds", type=int, default=Options.seeds, help="seeds 0 .. N-1 (the paper used 5)")

@@ -305,6 +305,39 @@ EXPERIMENTS = {
             "experiments 3-6's",
             baselines=BASELINES,
         ),
+        Experiment(
+            9,
+            "diagnosis",
+            "Why plain SAC does not learn here",
+            ("one-note",),
+            (
+                Variant("paper", lambda c: with_env(c, tactile=False), "", ("paper",)),
+                Variant("one-joint", lambda c: with_env(c, tactile=False, actuated=("mcp",)), "", ("paper",)),
+                Variant(
+                    "no-gate",
+                    lambda c: with_reward(with_env(c, tactile=False), fingering_gate=False),
+                    "",
+                    ("paper",),
+                ),
+                Variant(
+                    "our-hyperparameters",
+                    lambda c: replace(
+                        with_env(c, tactile=False),
+                        sac=replace(
+                            c.sac,
+                            learning_rate=SACConfig.learning_rate,
+                            discount=SACConfig.discount,
+                            target_entropy_scale=SACConfig.target_entropy_scale,
+                        ),
+                    ),
+                    "",
+                    ("paper",),
+                ),
+            ),
+            PAPER_TASK_STEPS,
+            "experiment 1's 2e5, run time-boxed (--stop-at)",
+            baselines=BASELINES,
+        ),
     )
 }
 

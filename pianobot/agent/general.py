@@ -41,7 +41,11 @@ GENERAL_KEYS = (GENERAL_KEY, store.task_key(PARTS))
 """The folders' keys of every general policy: the ``melody`` family's, and the ``parts`` family's
 (melody phrases and phrases of one hand of a two-hand piece: a general policy too)."""
 PACKAGED = Path(__file__).resolve().parent.parent / "policies"
-"""The policies that ship with pianobot (package data): the committed general policy."""
+"""The policies that ship with pianobot (package data): the committed general policy (a
+``task-melody`` folder) and the left hand's (:func:`left_hand_policy`, a ``task-parts`` folder)."""
+LEFT_KEY = store.task_key(PARTS)
+"""The packaged left hand's policy's key: the ``parts`` family's, which learnt hands' parts
+(chords, held notes under a moving voice) beside melodies."""
 
 NETWORK_FIELDS = ("hidden", "actor", "score_input", "score_features", "tactile_channels", "tactile_features")
 """The :class:`SACConfig` fields that shape the networks: a start policy's must be the run's."""
@@ -112,14 +116,31 @@ def explain(folder: Path, found: tuple[str, Any, Any], ours: str) -> str:
 
 def general_candidates(models: Path | None) -> list[Path]:
     """Every general policy there is: the newest first in ``models`` (the user's store), then the
-    packaged ones (:data:`PACKAGED`)."""
+    packaged general policy (:data:`PACKAGED`'s ``task-melody`` folder; its left hand's policy
+    plays only where :func:`left_hand_policy` gives it)."""
     found = _newest_first(models) if models is not None else []
-    packaged = [p for p in _newest_first(PACKAGED) if p.resolve() not in {f.resolve() for f in found}]
+    packaged = [p for p in _newest_first(PACKAGED, (GENERAL_KEY,)) if p.resolve() not in {f.resolve() for f in found}]
     return found + packaged
 
 
-def _newest_first(root: Path) -> list[Path]:
-    found = [folder for key in GENERAL_KEYS for folder in store.find_policies(root, key)]
+def left_hand_policy(models: Path | None, keyboard: Any = None, hand: Any = None) -> Path | None:
+    """The general policy that plays the left hand of a two-hand piece by default, where the right
+    hand has the general policy (:func:`general_candidates`): the packaged ``parts`` policy, when
+    the user's store holds no general policy of its own (that one plays both hands) and the
+    packaged one was trained on ``keyboard`` and ``hand`` (specs; None: any). None: the left hand
+    has the right hand's. Measured (docs/benchmarks.md, "Both hands"): the left hands of 50 random
+    two-hand pieces at note F1 0.915 against the melody policy's 0.861."""
+    if models is not None and _newest_first(Path(models)):
+        return None
+    for folder in _newest_first(PACKAGED, (LEFT_KEY,)):
+        world = policy_configs(folder)[0].world
+        if keyboard in (None, world.keyboard.spec) and hand in (None, world.hand.spec):
+            return folder
+    return None
+
+
+def _newest_first(root: Path, keys: tuple[str, ...] = GENERAL_KEYS) -> list[Path]:
+    found = [folder for key in keys for folder in store.find_policies(root, key)]
     return sorted(found, key=store.saved_at, reverse=True)
 
 

@@ -35,7 +35,8 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Callable
 
-from pianobot.errors import PianobotError, PianobotWarning
+from pianobot.agent.general import left_hand_policy
+from pianobot.errors import PianobotError, PianobotWarning, SettingError
 from pianobot.music import midi_io
 from pianobot.music.hand_scores import HandsReport, compare_hands
 from pianobot.music.instrument import HandSpec, KeyboardSpec
@@ -185,8 +186,11 @@ class HandPerformance:
 
     @property
     def performer(self) -> str:
-        """Who played this hand, in words ('general policy', 'scripted pianist', ...)."""
-        return self.performance.plan.performer
+        """Who played this hand, in words ('scripted pianist', 'general policy task-parts-...', ...):
+        the two hands may have different general policies."""
+        played = self.performance.plan
+        folders = dict.fromkeys(s.policy.name for s in played.stretches if s.player is plan.Player.GENERAL)
+        return " ".join([played.performer, *folders])
 
     def describe(self) -> str:
         """Where the simulated hand played the part: 'mirrored, moved up 1 octave onto C4-B5 (24 keys)'."""
@@ -321,7 +325,8 @@ def play_hands(
     range for 'scripted'); ``together``: both hands in one simulation (else hand by hand, each in
     a simulation of its own); ``on_step(done, total)`` reports progress; ``video``: keep the
     frames (both hands in one simulation only); ``options`` go to
-    :func:`~pianobot.perform.plan.plan_performance` (``general``, ``fallback``, ...)."""
+    :func:`~pianobot.perform.plan.plan_performance` (``general``, ``fallback``, ...), where
+    ``general_policy`` may also be a dict by hand (``{"left": folder}``: one policy per hand)."""
     if any(n.hand is None for n in piece.notes):
         raise PianobotError("every note needs a hand to play both hands: give the piece's notes a hand first")
     if controller not in ("sac", "scripted"):
@@ -330,6 +335,21 @@ def play_hands(
     keyboard = keyboard or (KeyboardSpec() if controller == "sac" else None)
     names = [h for h in HANDS if h in piece.hands]
     together = together and len(names) == 2
+    given = {name: _hand_options(options, name) for name in names}
+    by_hand = dict(given)
+    if controller == "sac" and "left" in by_hand:
+        by_hand["left"] = _left_default(given["left"], models, keyboard, fingers)
+
+    def planned(name: str, call: Callable, *args, **kwargs):
+        """``call`` with ``name``'s options; where the packaged left hand's policy does not fit the
+        phrase policies in ``models``, as if it had not been offered (so the packaged general policy is)."""
+        try:
+            return call(*args, **kwargs, **by_hand[name])
+        except SettingError:
+            if by_hand[name] is given[name]:
+                raise
+            return call(*args, **kwargs, **given[name])
+
     offset = piece.notes[0].onset if together else None  # (one timeline for both hands)
     parts = {}
     for name in names:
@@ -341,7 +361,7 @@ def play_hands(
         parts[name] = (*prepared, changes)
     if together:
         plans = {
-            name: plan.plan_performance(part, controller, models, keyboard=window.keyboard, hand=fingers, **options)
+            name: planned(name, plan.plan_performance, part, controller, models, keyboard=window.keyboard, hand=fingers)
             for name, (window, part, *_) in parts.items()
         }
         try:
@@ -354,11 +374,43 @@ def play_hands(
         raise PianobotError("a video of both hands needs them in one simulation: play one hand for it")
     done = []
     for name, (window, part, start, left_out, changes) in parts.items():
-        performance = plan.play(
-            part, controller, models, seed=seed, keyboard=window.keyboard, hand=fingers, on_step=on_step, **options
+        performance = planned(
+            name,
+            plan.play,
+            part,
+            controller,
+            models,
+            seed=seed,
+            keyboard=window.keyboard,
+            hand=fingers,
+            on_step=on_step,
         )
         done.append(HandPerformance(name, window, part, start, left_out, performance, changes))
     return HandsPerformance(piece, tuple(done), seed)
+
+
+def _hand_options(options: dict, hand: str) -> dict:
+    """``options`` for ``hand``'s plan: a ``general_policy`` given by hand (``{"right": ..., "left":
+    ...}``) becomes that hand's (a hand it leaves out gets the default)."""
+    policy = options.get("general_policy")
+    if not isinstance(policy, dict):
+        return options
+    unknown = set(policy) - set(HANDS)
+    if unknown:
+        raise PianobotError(
+            f"general policies by hand: {', '.join(sorted(unknown))} is not a hand; give right and/or left"
+        )
+    return {**options, "general_policy": policy.get(hand)}
+
+
+def _left_default(options: dict, models, keyboard: KeyboardSpec, fingers: HandSpec) -> dict:
+    """The left hand's options with the packaged left hand's policy
+    (:func:`~pianobot.agent.general.left_hand_policy`) where none was named for it (``general_policy``
+    for both hands, or by hand) and the general policy may play."""
+    if not options.get("general", True) or options.get("general_policy") is not None:
+        return options
+    policy = left_hand_policy(Path(models) if models is not None else plan.DEFAULT_MODELS, keyboard, fingers)
+    return options if policy is None else {**options, "general_policy": policy}
 
 
 class HandsApart(Exception):

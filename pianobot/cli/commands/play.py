@@ -71,6 +71,12 @@ def play(
         "melody` policy in --models, or --general-policy), when there is one.",
     ),
     general_policy: Optional[Path] = GeneralPolicy,
+    left_policy: Optional[Path] = typer.Option(
+        None,
+        "--left-policy",
+        help="On a two-hand file, the general policy that plays the left hand (default: --general-policy when given, "
+        "else the newest general policy in --models, else the packaged left hand's policy, a `--task parts` one).",
+    ),
     wrist_guard: bool = typer.Option(
         False,
         "--wrist-guard/--no-wrist-guard",
@@ -135,6 +141,21 @@ def play(
 
         torch.set_num_threads(1)  # batch-1 inference: more threads only spin against other work on the cores
     hands = both_hands(song, reading)
+    if left_policy is not None:
+        why = (
+            "plays one hand"
+            if hands is None
+            else f"is played by --controller {controller.value}"
+            if controller != "sac"
+            else "is played with --no-general"
+            if not use_general
+            else None
+        )
+        if why is not None:
+            raise PianobotError(
+                f"--left-policy {left_policy}: {song.name} {why}, so no general policy plays a left hand; "
+                "drop --left-policy (--general-policy names the policy of one hand)"
+            )
     if hands is not None:  # a two-hand file: both hands, in one simulation
         if gui:
             raise PianobotError(
@@ -152,7 +173,9 @@ def play(
             hand=reading.hand,
             options=dict(
                 general=use_general,
-                general_policy=general_policy,
+                general_policy=general_policy
+                if left_policy is None
+                else {"right": general_policy, "left": left_policy},
                 fallback=fallback is not None,
                 phrase_notes=phrase_notes,
                 wrist_guard=wrist_guard,
