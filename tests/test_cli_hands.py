@@ -301,9 +301,8 @@ def test_the_left_hand_plays_the_packaged_left_policy_unless_left_policy_names_a
     hands = json.loads((tmp_path / "r.json").read_text())["hands"]
     assert "task-melody-" in hands["right"]["performer"] and "task-parts-" in hands["left"]["performer"]
     melody = next(PACKAGED.glob("task-melody-*"))
-    result = run(
-        "play", song, "-o", tmp_path / "two.mid", "--models", models, "--left-policy", melody, "--json", tmp_path / "two.json", "-q"
-    )
+    named = ("--left-policy", melody, "--json", tmp_path / "two.json", "-q")
+    result = run("play", song, "-o", tmp_path / "two.mid", "--models", models, *named)
     assert result.exit_code == 0, result.output
     hands = json.loads((tmp_path / "two.json").read_text())["hands"]
     assert "task-melody-" in hands["left"]["performer"] and "task-parts-" not in hands["left"]["performer"]
