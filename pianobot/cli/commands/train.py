@@ -35,7 +35,7 @@ from pianobot.files import check_writable
 from pianobot.learn.config import MAX_ENVS, DaggerConfig, TrainConfig
 from pianobot.learn.explore import EXPLORATIONS
 from pianobot.music.phrases import DEFAULT_MAX_NOTES
-from pianobot.music.tasks import MELODY, TASKS
+from pianobot.music.tasks import MELODY, PARTS, TASKS
 from pianobot.sim.world import WorldConfig
 
 
@@ -47,7 +47,7 @@ def train(
         "--task",
         help=f"Train on a task family instead, a fresh random instance each episode: the paper's {', '.join(TASKS)}, "
         f"or {MELODY} (random one-hand phrases of up to {DEFAULT_MAX_NOTES} notes in every key, fingered by the "
-        "planner; docs/training.md).",
+        f"planner; docs/training.md) or {PARTS} (those and phrases of either hand of random two-hand pieces).",
     ),
     steps: int = typer.Option(
         TrainConfig.steps,
