@@ -75,7 +75,8 @@ def test_the_paper_setting_is_plain_sac_without_our_additions(tmp_path):
     for name in experiments.EXPERIMENTS:
         for run in expand(name, options(tmp_path, seeds=1, settings=("paper",))):
             config = run.config
-            assert config.explore != "scripted" and config.sac.demo_weight == 0  # no teacher
+            assert config.sac.demo_weight == 0  # no behaviour cloning
+            assert config.explore != "scripted" or run.variant == "scripted-exploration"  # no teacher (but in that arm)
             assert config.env.reward.closeness_weight == 0  # no closeness bonus
             assert not config.env.target_observations and config.sac.score_input  # the paper's observation
             if run.variant != "our-hyperparameters":  # (the diagnosis's arm that tries ours)
@@ -355,12 +356,14 @@ def test_the_diagnosis_changes_one_thing_at_a_time_in_the_paper_setting(tmp_path
         "paper": set(),
         "one-joint": {"env.actuated"},
         "no-gate": {"env.reward.fingering_gate"},
+        "scripted-exploration": {"explore"},
         "our-hyperparameters": {"sac.learning_rate", "sac.discount", "sac.target_entropy_scale"},
     }
     assert arms.keys() == changed.keys()
     for name, fields in changed.items():
         assert set(report.differences(arms[name].config, arms["paper"].config)) == fields, name
     assert arms["one-joint"].config.env.actuated == ("mcp",)  # the paper's one action per finger
+    assert arms["scripted-exploration"].config.sac.demo_weight == 0  # the teacher explores, no cloning
     tasks = expand("tasks", options(tmp_path, seeds=1, settings=("paper",)))
     without_touch = next(r for r in tasks if r.task == "one-note" and r.variant == "no-tactile")
     assert arms["paper"].jobs[0].folder == without_touch.jobs[0].folder

@@ -24,7 +24,8 @@ EXPERIMENT is a number or a name:
                     time (the teacher, the closeness bonus, the finger targets, its hyperparameters)
 9 ``diagnosis``     not the paper's: why plain SAC learns nothing here; the paper setting on
                     one-note without touch, with one difference at a time (one joint per finger,
-                    no fingering gate, our hyperparameters), time-boxed with ``--stop-at``
+                    no fingering gate, the scripted pianist's exploration without its labels, our
+                    hyperparameters), time-boxed with ``--stop-at``
 
 Settings: ``paper`` is the paper's recipe: plain SAC (no teacher), prior exploration, the linear
 reward without our closeness bonus, the score window as observation (no finger targets), the

@@ -320,6 +320,12 @@ EXPERIMENTS = {
                     ("paper",),
                 ),
                 Variant(
+                    "scripted-exploration",
+                    lambda c: replace(with_env(c, tactile=False), explore="scripted"),
+                    "",
+                    ("paper",),
+                ),
+                Variant(
                     "our-hyperparameters",
                     lambda c: replace(
                         with_env(c, tactile=False),
