@@ -81,6 +81,8 @@ def main() -> None:
         "| player | actions | training reward per episode | episodes with a note of the score | note F1 | notes sounded per episode |"
     )
     print("| --- | ---: | ---: | ---: | ---: | ---: |")
+    if joints != JOINT_KINDS and "scripted" in args.explore:
+        parser.error("--explore scripted moves every finger joint: leave out --joints")
     players = ("idle", *args.explore) + (("scripted",) if joints == JOINT_KINDS else ())  # (it moves every joint)
     for kind in dict.fromkeys(players):
         figures = play(args.task, kind, args.episodes, joints, args.seed)

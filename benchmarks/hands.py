@@ -18,8 +18,10 @@ Sets:
 
 Each piece is played once from hand start 0, both hands in one simulation as ``pianobot play``
 plays them (``--apart``: each hand in a simulation of its own), by the general policy (the
-packaged one: the model store is an empty folder; ``--general`` names another, ``--general-left``
-another for the left hand: one policy per hand) and by the scripted pianist. Prints a
+packaged ones, as ``pianobot play`` plays them: the melody policy on the right hand, the parts
+policy on the left; the model store is an empty folder; ``--general`` names the right hand's,
+and both hands' without ``--general-left``, which names the left's) and by the scripted pianist.
+The polyphonic parts are left hands: the left hand's policy plays them. Prints a
 Markdown table per set: note F1 (whole piece, right hand, left hand), per-step key-press F1, note
 F1 with offsets, notes left outside the general policy's 24 keys, and the general policy's share
 of the scripted pianist's note F1.
@@ -112,8 +114,11 @@ def main() -> None:
     parser.add_argument("--duets", type=int, default=50)
     parser.add_argument("--polyphonic", type=int, default=20)
     parser.add_argument("--seed", type=int, default=35)
-    parser.add_argument("--general", help="the general policy's folder (default: the packaged one)")
-    parser.add_argument("--general-left", help="the left hand's general policy (default: --general's)")
+    parser.add_argument("--general", help="the general policy's folder (default: the packaged ones, one per hand)")
+    parser.add_argument(
+        "--general-left",
+        help="the left hand's general policy (default: --general's when given, else the packaged left hand's)",
+    )
     parser.add_argument("--apart", action="store_true", help="each hand in a simulation of its own")
     parser.add_argument("--json", help="write every piece's figures here")
     args = parser.parse_args()

@@ -311,3 +311,5 @@ def test_the_left_hand_plays_the_packaged_left_policy_unless_left_policy_names_a
     assert_one_line_error(refused, "plays one hand")
     refused = run("play", song, "-o", tmp_path / "x.mid", "--controller", "scripted", "--left-policy", melody)
     assert_one_line_error(refused, "--controller scripted")
+    refused = run("play", song, "-o", tmp_path / "x.mid", "--left-policy", models)  # a folder without a policy
+    assert_one_line_error(refused, "--left-policy", "not a trained policy folder")

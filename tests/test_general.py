@@ -369,3 +369,9 @@ def test_the_packaged_left_hand_policy_plays_left_hands_only_while_the_store_has
     assert left_hand_policy(empty, KeyboardSpec()) == left
     assert left_hand_policy(empty, KeyboardSpec(lowest=36, count=36)) is None
     assert left_hand_policy(models) is None  # the user's own general policy plays both hands
+    # ... but not one trained for other keys: it plays neither hand here, so the left keeps its own
+    (mine,) = models.iterdir()
+    manifest = manifest_of(mine)
+    manifest["config"]["env"]["world"]["keyboard"]["spec"] = {"lowest": 36, "count": 36}
+    (mine / store.MANIFEST_FILE).write_text(json.dumps(manifest))
+    assert left_hand_policy(models, KeyboardSpec()) == left

@@ -146,7 +146,7 @@ def test_pianobot_play_plays_both_hands_of_a_piece_with_both_and_one_hand_as_bef
         pianobot.play(both, controller="scripted", video=True, together=False)
 
 
-def test_general_policies_may_be_given_by_hand():
+def test_general_policies_may_be_given_by_hand(tmp_path):
     """``general_policy`` as a dict names each hand's policy (one left out keeps its default); a
     key that is not a hand is refused before anything plays."""
     from pianobot.agent.general import PACKAGED
@@ -155,7 +155,7 @@ def test_general_policies_may_be_given_by_hand():
     piece = Piece((Note(0.0, 72, 0.5, hand="right"), Note(0.5, 74, 1.0, hand="right"), Note(0.0, 48, 1.0, hand="left")))
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", PianobotWarning)
-        performance = play_hands(piece, "sac", general_policy={"left": melody})
+        performance = play_hands(piece, "sac", tmp_path, general_policy={"left": melody})  # (an empty store)
     assert [h.performer for h in performance.hands] == [f"general policy {melody.name}"] * 2
     with pytest.raises(PianobotError, match="middle is not a hand"):
-        play_hands(piece, "sac", general_policy={"middle": melody})
+        play_hands(piece, "sac", tmp_path, general_policy={"middle": melody})

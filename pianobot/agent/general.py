@@ -126,17 +126,18 @@ def general_candidates(models: Path | None) -> list[Path]:
 def left_hand_policy(models: Path | None, keyboard: Any = None, hand: Any = None) -> Path | None:
     """The general policy that plays the left hand of a two-hand piece by default, where the right
     hand has the general policy (:func:`general_candidates`): the packaged ``parts`` policy, when
-    the user's store holds no general policy of its own (that one plays both hands) and the
-    packaged one was trained on ``keyboard`` and ``hand`` (specs; None: any). None: the left hand
-    has the right hand's. Measured (docs/benchmarks.md, "Both hands"): the left hands of 50 random
-    two-hand pieces at note F1 0.915 against the melody policy's 0.861."""
-    if models is not None and _newest_first(Path(models)):
-        return None
-    for folder in _newest_first(PACKAGED, (LEFT_KEY,)):
+    the user's store holds no general policy of its own for ``keyboard`` and ``hand`` (specs;
+    None: any; such a one plays both hands) and the packaged one was trained on them. None: the
+    left hand has the right hand's. Measured (docs/benchmarks.md, "Two hands"): the left hands of
+    50 random two-hand pieces at note F1 0.915 against the melody policy's 0.861."""
+
+    def fits(folder: Path) -> bool:
         world = policy_configs(folder)[0].world
-        if keyboard in (None, world.keyboard.spec) and hand in (None, world.hand.spec):
-            return folder
-    return None
+        return keyboard in (None, world.keyboard.spec) and hand in (None, world.hand.spec)
+
+    if models is not None and any(fits(folder) for folder in _newest_first(Path(models))):
+        return None
+    return next((folder for folder in _newest_first(PACKAGED, (LEFT_KEY,)) if fits(folder)), None)
 
 
 def _newest_first(root: Path, keys: tuple[str, ...] = GENERAL_KEYS) -> list[Path]:

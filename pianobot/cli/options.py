@@ -70,7 +70,8 @@ GeneralPolicy = typer.Option(
     None,
     "--general-policy",
     help="The general policy's folder (any trained policy; default: the newest `pianobot train --task melody` or `--task parts` "
-    "policy in --models whose environment fits).",
+    "policy in --models whose environment fits, else the packaged one). On a two-hand file it plays both hands "
+    "unless --left-policy names the left's (by default the left hand has the packaged left hand's policy).",
 )
 PlayPhraseNotes = typer.Option(
     None,

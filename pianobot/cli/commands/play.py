@@ -75,7 +75,8 @@ def play(
         None,
         "--left-policy",
         help="On a two-hand file, the general policy that plays the left hand (default: --general-policy when given, "
-        "else the newest general policy in --models, else the packaged left hand's policy, a `--task parts` one).",
+        "else the newest general policy in --models, else the packaged left hand's policy, a `--task parts` one; "
+        "the right hand and one-hand files have the general policy).",
     ),
     wrist_guard: bool = typer.Option(
         False,
@@ -142,6 +143,8 @@ def play(
         torch.set_num_threads(1)  # batch-1 inference: more threads only spin against other work on the cores
     hands = both_hands(song, reading)
     if left_policy is not None:
+        from pianobot.agent import store
+
         why = (
             "plays one hand"
             if hands is None
@@ -153,8 +156,12 @@ def play(
         )
         if why is not None:
             raise PianobotError(
-                f"--left-policy {left_policy}: {song.name} {why}, so no general policy plays a left hand; "
-                "drop --left-policy (--general-policy names the policy of one hand)"
+                f"--left-policy {left_policy}: {song.name} {why}, so no general policy plays a left hand; drop --left-policy"
+            )
+        if not store.is_trained(left_policy):
+            raise PianobotError(
+                f"--left-policy {left_policy}: not a trained policy folder (one holding {store.POLICY_FILE} and "
+                f"{store.MANIFEST_FILE}, e.g. a `pianobot train --task parts` folder in {models})"
             )
     if hands is not None:  # a two-hand file: both hands, in one simulation
         if gui:
