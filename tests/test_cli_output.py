@@ -65,6 +65,23 @@ def test_tables_written_to_a_pipe_keep_their_words_whole(monkeypatch):
     assert "velocity-aware note F1 (mir_eval)" in result.output  # one line, not folded at 80 columns
 
 
+def test_the_training_table_says_why_a_run_stored_no_policy():
+    """A phrase whose run kept its start is the general policy's to play; a task family trained on
+    from --general-policy that never beat it says so (the start is no general policy of the store's)."""
+    from pianobot.cli import display
+    from pianobot.cli.terminal import Terminal
+    from pianobot.learn.jobs import PhraseJob
+
+    kept = {"start": {"path": "x"}, "steps": 40000, "kept": "start", "evaluation": {"step": 0, "f1": 0.96}}
+    phrase = PhraseJob("0123456789abcdef", Piece((Note(0, 60, 1, 80, 1),)), Path("m") / "p", [0])
+    task = PhraseJob("task-melody", "melody", Path("m") / "task-melody-0", [0])
+    console = Terminal(file=io.StringIO())
+    console.print(display.training_table([(phrase, kept), (task, kept), (task, {**kept, "kept": "trained"})]))
+    text = console.file.getvalue()
+    assert "none: the general policy plays it" in text and "none: no evaluation beat its start policy" in text
+    assert text.count("none:") == 2 and str(Path("m") / "task-melody-0") in text
+
+
 def test_warnings_come_before_the_error_that_stopped_the_command(tmp_path):
     """A repaired overlap warns; a note below the keyboard stops the command: the error is the last line."""
     midi = mido.MidiFile(type=1)

@@ -129,8 +129,9 @@ def test_a_start_policy_that_already_plays_the_phrase_costs_one_evaluation(tmp_p
     assert (manifest["steps"] == 0) == (manifest["evaluations"][0]["f1"] > 0)  # stopped at once, or trained on
     if manifest["steps"] == 0:  # the start plays it: no copy of it is stored
         assert manifest["kept"] == "start" and not (tmp_path / "tuned").exists()
-    else:
-        assert manifest["kept"] == "trained" and store.is_trained(tmp_path / "tuned")
+    else:  # trained on: a policy is stored when an evaluation beat the start's
+        trained = manifest["evaluation"]["step"] > 0
+        assert (manifest["kept"] == "trained") == trained == store.is_trained(tmp_path / "tuned")
     # SAC fine-tunes from a cloned policy too: fresh Q heads, the cloned actor and encoder
     sac = replace(config, learner="sac", finetune_until_f1=1.0, steps=100)
     manifest = train_policy(PHRASE, sac, tmp_path / "sac", start=tmp_path / "general")

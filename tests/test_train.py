@@ -1,5 +1,6 @@
 """Training: real gradient updates with finite losses, save/load, exact resume, skip-if-trained."""
 
+import itertools
 import json
 from dataclasses import replace
 
@@ -301,8 +302,8 @@ def test_until_f1_stops_at_the_first_good_evaluation(tmp_path, monkeypatch):
 
 
 def test_fine_tuning_never_ends_worse_than_its_start_policy(tmp_path, monkeypatch):
-    """The start policy's evaluation at step 0 counts: when no later one beats it, the stored
-    policy and critic are the start's own; a later better one replaces it."""
+    """The start policy's evaluation at step 0 counts: when no later one beats it, nothing is
+    stored (the start plays best); a later better one is stored, policy and critic."""
     import pianobot.learn.train as train
 
     def scripted(scores, calls):
@@ -328,9 +329,12 @@ def test_fine_tuning_never_ends_worse_than_its_start_policy(tmp_path, monkeypatc
         )  # the start, before any update; one during training (at an episode end); the final
         assert [e["step"] for e in manifest["evaluations"]] == [0, 105, 200]
         assert manifest["evaluation"]["step"] == kept_step and manifest["steps"] == 200
+        assert manifest["kept"] == ("start" if kept_step == 0 else "trained")
+        if kept_step == 0:
+            assert not store.is_trained(folder)
+            continue
         kept = {**store.load_tensors(folder / store.POLICY_FILE), **store.load_tensors(folder / store.CRITIC_FILE)}
-        assert set(kept) == set(start)
-        assert all(torch.equal(kept[k], start[k]) for k in start) == (kept_step == 0)
+        assert set(kept) == set(start) and not all(torch.equal(kept[k], start[k]) for k in start)
 
 
 def test_a_start_policy_that_already_plays_the_phrase_stores_nothing(tmp_path, monkeypatch):
@@ -366,6 +370,37 @@ def test_a_start_policy_that_already_plays_the_phrase_stores_nothing(tmp_path, m
     (kept / "notes.txt").write_text("mine")
     assert train_policy(PHRASE, tuned, kept, start=tmp_path / "start")["kept"] == "start"
     assert sorted(p.name for p in kept.iterdir() if p.name != store.LOCK_FILE) == ["notes.txt"]
+
+
+def test_a_run_that_never_beats_its_start_stores_no_copy_of_it_and_keeps_its_log(tmp_path, monkeypatch):
+    """Training from a start policy whose step-0 evaluation no later one beats stores nothing
+    (the store would hold a copy of the start as a policy of its own): ``kept: start`` with the
+    steps trained, the log and its curves kept, the checkpoint gone. Both learners."""
+    import pianobot.learn.dagger as dagger
+    import pianobot.learn.train as train
+
+    config = small(steps=80)
+    train_policy(PHRASE, config, tmp_path / "start")
+    tuned = replace(config, from_general=True, steps=200, eval_every=100)
+    for learn, learner, module in ((train_policy, "sac", train), (dagger.dagger_policy, "dagger", dagger)):
+        scores = itertools.chain([0.8, 0.5], itertools.repeat(0.7))  # the start's (step 0), then worse ones
+        monkeypatch.setattr(
+            module, "evaluate", lambda *a, scores=scores: {"f1": next(scores), "velocity_mae": 1.0, "return": 0.0}
+        )
+        folder = tmp_path / f"tuned-{learner}"
+        run = replace(tuned, learner=learner, dagger=replace(tuned.dagger, round_steps=100))
+        manifest = learn(PHRASE, run, folder, start=tmp_path / "start")
+        assert manifest["kept"] == "start" and manifest["steps"] >= 200
+        assert manifest["evaluation"]["step"] == 0 and manifest["evaluation"]["f1"] == 0.8
+        assert len(manifest["evaluations"]) >= 3 and max(e["f1"] for e in manifest["evaluations"][1:]) < 0.8
+        assert not store.is_trained(folder) and not (folder / store.POLICY_FILE).exists()
+        assert (folder / LOG_FILE).exists() and store.load_checkpoint(folder) is None
+    # a run that does beat its start stores its policy
+    scores = itertools.chain([0.5, 0.9], itertools.repeat(0.6))
+    monkeypatch.setattr(train, "evaluate", lambda *a: {"f1": next(scores), "velocity_mae": 1.0, "return": 0.0})
+    manifest = train_policy(PHRASE, tuned, tmp_path / "better", start=tmp_path / "start")
+    assert manifest["kept"] == "trained" and manifest["evaluation"]["step"] == manifest["evaluations"][1]["step"] > 0
+    assert store.is_trained(tmp_path / "better")
 
 
 def test_the_best_evaluated_policy_is_kept_across_an_interruption(tmp_path, monkeypatch):

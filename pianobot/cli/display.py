@@ -194,6 +194,13 @@ def training_table(rows) -> Table:
             _opt(evaluation.get("f1"), ".3f"),
             _opt(evaluation.get("velocity_mae"), ".1f"),
             _opt(manifest.get("seconds", 0) / 60 if manifest.get("seconds") is not None else None, ".1f"),
-            str(job.folder) if manifest.get("kept") != "start" else "none: the general policy plays it",
+            str(job.folder) if manifest.get("kept") != "start" else _kept_start(job),
         )
     return table
+
+
+def _kept_start(job) -> str:
+    """The folder column of a run that stored nothing: its start played best."""
+    if isinstance(job.target, str):  # a task family, trained on from --general-policy
+        return "none: no evaluation beat its start policy"
+    return "none: the general policy plays it"

@@ -7,7 +7,8 @@ among them), inside the whole performance: its section, the hand-over to and fro
 neighbours. :func:`settle_piece`:
 
 1. records in the store's index (:func:`~pianobot.agent.store.general_plays`) every phrase whose
-   training stopped at step 0 because the general policy already played it: no folder is stored;
+   training kept its start, because the general policy already played it at step 0 or no later
+   evaluation beat it: no policy is stored;
 2. plays the piece with the general policy alone (``before``), then adds the piece's own phrase
    policies one at a time, in order, keeping one only when the piece then plays better on the
    mean of :data:`JUDGE_SEEDS` and no worse from any of them; a policy not kept is recorded in
@@ -94,8 +95,8 @@ def settle_piece(
     on_play: Callable[[str], None] = lambda what: None,
 ) -> Verdict:
     """Record and judge a piece's phrases after training (the module's steps). ``started``: the
-    folder names of the phrases whose runs stopped at step 0 (the general policy already played
-    them), each with the note F1 it played at. ``on_play(what)`` is told before each whole-piece play."""
+    folder names of the phrases whose runs kept their start (the general policy played them at
+    step 0 as well as any policy trained for them), each with the note F1 it played at. ``on_play(what)`` is told before each whole-piece play."""
     about = describe(general)  # its folder and the SHA-256 of its weights
     store.mark_general_plays(
         models,

@@ -19,8 +19,9 @@ to bottom; a :class:`Run` does the rest for them, in this order:
 - :meth:`Run.finish`: the manifest, and the policy stored with it. A run whose start policy
   already reaches :attr:`~pianobot.learn.config.TrainConfig.stop_f1` at step 0 stores nothing:
   its manifest says ``"kept": "start"`` (the start policy plays the target), and the run removes
-  its log, and its folder when nothing else is in it. Every other run stores its policy
-  (``"kept": "trained"``).
+  its log, and its folder when nothing else is in it. A run none of whose evaluations beat its
+  start's stores nothing either (``"kept": "start"``) and keeps its log. Every other run stores
+  its policy (``"kept": "trained"``).
 
 Beside it, what else both share: :func:`evaluate`, :func:`make_envs` and the checkpoint's
 environment generators, and the tensors a stored policy keeps.
@@ -173,8 +174,8 @@ def open_run(
     critic: bool,
 ) -> Iterator[Run]:
     """A :class:`Run` into ``folder``, holding it (a second run on it is refused) with its log and
-    environments open; when the run stored nothing (``"kept": "start"``), what it wrote goes once
-    they are closed. The arguments are the learners' and the :class:`Run`'s."""
+    environments open; when the start reached ``stop_f1`` at step 0 (nothing stored, nothing
+    trained), what it wrote goes once they are closed. The arguments are the learners' and the :class:`Run`'s."""
     if start is not None and not config.from_general:
         raise ValueError("a start policy was given to a run with from_general=False")
     with store.training_lock(folder), TrainingLog(folder) as log:
@@ -355,7 +356,11 @@ class Run:
     def finish(self, agent: SAC, step: int, final: dict, tensors: dict[str, torch.Tensor]) -> dict:
         """End the run after ``step`` steps: its manifest, with ``final`` the evaluation of the
         policy kept (``tensors``, stored with it), and draw the learning curves; the checkpoint
-        goes. The start policy kept at step 0 stores nothing (:func:`open_run` removes the log)."""
+        goes. When the policy kept is the start (``final`` is its step-0 evaluation) nothing is
+        stored: a copy of the start would play no better, and would stand in the store as a
+        policy of its own; the run that trained keeps its log (a start that reached ``stop_f1``
+        at step 0 does not: :func:`open_run` removes it)."""
+        start_kept = self.kept_start or (self.began is not None and final.get("step") == 0)
         manifest = {
             **(self.about or {}),
             "target": self.target if isinstance(self.target, str) else [asdict(note) for note in self.target.notes],
@@ -364,14 +369,15 @@ class Run:
             "seconds": round(self.seconds(), 1),  # across interruptions
             "device": self.device.type,
             "start": self.began,
-            "kept": "start" if self.kept_start else "trained",
+            "kept": "start" if start_kept else "trained",
             "evaluation": final,
             "evaluations": self.evaluations,
             "config": to_dict(self.config),
         }
-        if not self.kept_start:
+        if not start_kept:
             policy, critic = split_kept(tensors)
             store.save_policy(self.folder, policy, manifest, critic=critic)
+        if not self.kept_start:  # (a run that trained keeps its learning curves, also when it kept its start)
             store.drop_checkpoint(self.folder)
             self.log.plot()
         self.report(Progress(step, self.config.steps, finished=True))
