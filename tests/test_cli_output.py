@@ -78,7 +78,7 @@ def test_the_training_table_says_why_a_run_stored_no_policy():
     console = Terminal(file=io.StringIO())
     console.print(display.training_table([(phrase, kept), (task, kept), (task, {**kept, "kept": "trained"})]))
     text = console.file.getvalue()
-    assert "none: the general policy plays it" in text and "none: no evaluation beat its start policy" in text
+    assert "none: the general policy plays it" in text and "none: its start policy played best" in text
     assert text.count("none:") == 2 and str(Path("m") / "task-melody-0") in text
 
 

@@ -15,7 +15,7 @@ from pianobot.env.piano import EnvConfig
 from pianobot.errors import PianobotError
 from pianobot.learn.config import TrainConfig
 from pianobot.learn.explore import Explorer
-from pianobot.learn.jobs import phrase_jobs, plan_jobs
+from pianobot.learn.jobs import PhraseJob, phrase_jobs, plan_jobs
 from pianobot.learn.log import LOG_FILE, PLOT_FILE, TENSORBOARD_DIR
 from pianobot.learn.train import Progress, make_env, train_policy
 from pianobot.music.phrases import split_phrases
@@ -394,7 +394,11 @@ def test_a_run_that_never_beats_its_start_stores_no_copy_of_it_and_keeps_its_log
         assert manifest["evaluation"]["step"] == 0 and manifest["evaluation"]["f1"] == 0.8
         assert len(manifest["evaluations"]) >= 3 and max(e["f1"] for e in manifest["evaluations"][1:]) < 0.8
         assert not store.is_trained(folder) and not (folder / store.POLICY_FILE).exists()
-        assert (folder / LOG_FILE).exists() and store.load_checkpoint(folder) is None
+        assert store.kept_start(folder) and store.read_manifest(folder)["kept"] == "start"  # the run is done
+        assert (folder / LOG_FILE).exists() and (folder / PLOT_FILE).exists() and store.load_checkpoint(folder) is None
+        job = PhraseJob("k", PHRASE, folder, [0])
+        assert plan_jobs([job], force=False) == ([], [job])  # a second `train` skips it
+        assert plan_jobs([job], force=True) == ([job], []) and not store.kept_start(folder)  # --force trains anew
     # a run that does beat its start stores its policy
     scores = itertools.chain([0.5, 0.9], itertools.repeat(0.6))
     monkeypatch.setattr(train, "evaluate", lambda *a: {"f1": next(scores), "velocity_mae": 1.0, "return": 0.0})

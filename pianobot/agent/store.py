@@ -155,9 +155,27 @@ def save_policy(
         save_tensors(critic, folder / CRITIC_FILE, metadata={"format": str(FORMAT)})
     else:  # (a forced retrain must not leave an older run's critic beside the new policy)
         (folder / CRITIC_FILE).unlink(missing_ok=True)
+    save_manifest(folder, manifest)
+
+
+def save_manifest(folder: Path, manifest: dict) -> None:
+    """Write ``manifest`` (with the format, the time and the package versions) into ``folder``;
+    alone, it records a run that kept its start policy and stored none (:func:`kept_start`)."""
+    folder.mkdir(parents=True, exist_ok=True)
     saved = datetime.now(timezone.utc).isoformat(timespec="seconds")
     manifest = {"format": FORMAT, **manifest, "saved": saved, "versions": package_versions()}
     atomic_write(folder / MANIFEST_FILE, json.dumps(manifest, indent=2, default=str) + "\n")
+
+
+def kept_start(folder: Path) -> bool:
+    """Whether a finished run in ``folder`` kept its start policy: a manifest that says so
+    (``"kept": "start"``) and no policy file."""
+    if (folder / POLICY_FILE).exists():
+        return False
+    try:
+        return json.loads((folder / MANIFEST_FILE).read_text()).get("kept") == "start"
+    except (OSError, ValueError, AttributeError):
+        return False
 
 
 def upgrade_manifest(manifest: dict) -> dict:

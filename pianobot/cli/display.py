@@ -202,5 +202,5 @@ def training_table(rows) -> Table:
 def _kept_start(job) -> str:
     """The folder column of a run that stored nothing: its start played best."""
     if isinstance(job.target, str):  # a task family, trained on from --general-policy
-        return "none: no evaluation beat its start policy"
+        return "none: its start policy played best"
     return "none: the general policy plays it"

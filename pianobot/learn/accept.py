@@ -101,7 +101,10 @@ def settle_piece(
     store.mark_general_plays(
         models,
         {
-            name: {"why": f"it played at note F1 {f1:.3f} before any training step", **about}
+            name: {
+                "why": f"it played at note F1 {f1:.3f} before any training step, and no policy trained for it played better",
+                **about,
+            }
             for name, f1 in started.items()
         },
     )

@@ -119,13 +119,15 @@ def task_job(task: str, config: TrainConfig, root: Path) -> PhraseJob:
 
 
 def plan_jobs(jobs: list[PhraseJob], force: bool) -> tuple[list[PhraseJob], list[PhraseJob]]:
-    """(jobs to train, jobs already done: a stored policy, or the store's index says the general
-    policy plays the phrase); ``force`` removes stored policies and index entries, so that an
+    """(jobs to train, jobs already done: a stored policy, a run that kept its start policy, or the
+    store's index says the general policy plays the phrase); ``force`` removes stored policies,
+    manifests and index entries, so that an
     interrupted forced run is not taken for a finished one (its checkpoint is kept and resumed)."""
     todo, done = [], []
     for job in jobs:
         root = job.folder.parent
-        if (store.is_trained(job.folder) or job.folder.name in store.general_plays(root)) and not force:
+        finished = store.is_trained(job.folder) or store.kept_start(job.folder)
+        if (finished or job.folder.name in store.general_plays(root)) and not force:
             done.append(job)
         else:
             if force and job.folder.exists():

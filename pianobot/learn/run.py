@@ -20,8 +20,8 @@ to bottom; a :class:`Run` does the rest for them, in this order:
   already reaches :attr:`~pianobot.learn.config.TrainConfig.stop_f1` at step 0 stores nothing:
   its manifest says ``"kept": "start"`` (the start policy plays the target), and the run removes
   its log, and its folder when nothing else is in it. A run none of whose evaluations beat its
-  start's stores nothing either (``"kept": "start"``) and keeps its log. Every other run stores
-  its policy (``"kept": "trained"``).
+  start's stores no policy either (``"kept": "start"``): it keeps its log and writes its
+  manifest alone. Every other run stores its policy (``"kept": "trained"``).
 
 Beside it, what else both share: :func:`evaluate`, :func:`make_envs` and the checkpoint's
 environment generators, and the tensors a stored policy keeps.
@@ -358,8 +358,9 @@ class Run:
         policy kept (``tensors``, stored with it), and draw the learning curves; the checkpoint
         goes. When the policy kept is the start (``final`` is its step-0 evaluation) nothing is
         stored: a copy of the start would play no better, and would stand in the store as a
-        policy of its own; the run that trained keeps its log (a start that reached ``stop_f1``
-        at step 0 does not: :func:`open_run` removes it)."""
+        policy of its own; the run that trained keeps its log and writes its manifest alone
+        (:func:`~pianobot.agent.store.kept_start`), so that it is not trained again (a start that
+        reached ``stop_f1`` at step 0 leaves nothing: :func:`open_run` removes its log)."""
         start_kept = self.kept_start or (self.began is not None and final.get("step") == 0)
         manifest = {
             **(self.about or {}),
@@ -377,6 +378,8 @@ class Run:
         if not start_kept:
             policy, critic = split_kept(tensors)
             store.save_policy(self.folder, policy, manifest, critic=critic)
+        elif not self.kept_start:  # trained, and kept its start: the manifest alone says the run is done
+            store.save_manifest(self.folder, manifest)
         if not self.kept_start:  # (a run that trained keeps its learning curves, also when it kept its start)
             store.drop_checkpoint(self.folder)
             self.log.plot()

@@ -309,7 +309,7 @@ def train(
     def manifest(job) -> dict:  # what training left: a policy, or the store's word that the general policy plays it
         if job.key in results:
             return results[job.key]
-        if store.is_trained(job.folder):
+        if store.is_trained(job.folder) or store.kept_start(job.folder):
             return store.read_manifest(job.folder)
         return {"kept": "start", "start": store.general_plays(models).get(job.folder.name, {}), "steps": 0}
 
