@@ -10,9 +10,10 @@
           state.json            counters and generator states
           buffer/*.npy          the replay buffer (plain arrays, read without pickle)
         .lock                   held by the process training into the folder
-      general-plays.json        the phrases the general policy plays: no folder of their own (a
-                                phrase it already played when training began), or a folder whose
-                                policy made its piece play worse (:func:`general_plays`)
+      general-plays.json        the phrases the general policy plays: no policy of their own (a
+                                phrase whose training kept its start: the general policy played
+                                it as well as anything trained), or a folder whose policy made
+                                its piece play worse (:func:`general_plays`)
 
 Files are written to a temporary name and renamed into place, so a crash never leaves a half
 written model; loading never unpickles anything; a corrupt or foreign file is a one-line error.
@@ -52,8 +53,8 @@ reading (:func:`upgrade_manifest`), so every model a user has keeps playing.
   (unused without ``from_general``), ``config.envs`` and ``config.device`` (1, auto),
   ``config.sac.actor`` ('mlp'), ``saved`` (when the policy was stored: the manifest file's
   modification time stands in), ``kept`` ('trained': a stored policy; a run whose start policy
-  already played its phrase now stores none, returns ``kept: 'start'`` and is recorded in
-  :data:`GENERAL_INDEX`; before, it stored a copy of the start); the file
+  already played its phrase, or was never beaten, now stores none, says ``kept: 'start'`` and is
+  recorded in :data:`GENERAL_INDEX`; before, it stored a copy of the start); the file
   ``critic.safetensors`` (missing: the policy cannot pass its critic on to a fine-tuning run,
   which then begins with fresh Q heads).
 - 1: the agent's ``config.sac.tactile_resolution`` overrode ``config.env.tactile_pool``; the
@@ -264,8 +265,8 @@ GENERAL_INDEX = "general-plays.json"
 
 def general_plays(root: Path) -> dict[str, dict]:
     """The phrases the general policy plays, by folder name (``<phrase hash>-<config hash>``):
-    each with ``why`` (a phrase it played at the run's stopping note F1 before any training step,
-    so none was stored; or a policy of its own that made its piece play worse, and is not used)
+    each with ``why`` (a phrase whose training kept its start, the general policy, so none was
+    stored; or a policy of its own that made its piece play worse, and is not used)
     and the general policy's ``sha256``. A missing or unreadable index is an empty one: a phrase
     then is what its folder says."""
     try:

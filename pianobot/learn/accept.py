@@ -56,7 +56,7 @@ class Verdict:
     dropped: dict[int, str]
     """Phrase number -> why its own policy is not used."""
     general_plays: tuple[int, ...]
-    """Phrases the general policy already played when training began: no policy stored."""
+    """Phrases whose training kept its start, the general policy: no policy stored."""
 
     def to_dict(self) -> dict:
         return {

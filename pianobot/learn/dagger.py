@@ -24,7 +24,8 @@ steps, which is how the general policy is trained (docs/training.md).
 A round ends at the first episode end after its steps, so the last one may run past ``steps``
 by part of an episode. The run stops after its last round, or at an evaluation reaching ``TrainConfig.stop_f1``
 (fine-tuning from the general policy evaluates the start first, as SAC's loop does, and stores
-nothing when the start already reaches it). The stored policy is the best evaluated one, with
+nothing when the start already reaches it, and no policy when no round beats the start). The
+stored policy is the best evaluated one, with
 the files of a SAC policy (actor and encoder); it has no critic, so SAC fine-tuning from it
 begins with fresh Q heads. The run's set-up, beginning, start evaluation, best policy,
 checkpoints and manifest are SAC's too: :mod:`pianobot.learn.run`.

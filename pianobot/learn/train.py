@@ -8,8 +8,9 @@ buffer, random generators), so that running the same command again continues exa
 interrupted run stopped. The policy stored at the end is the best one evaluated.
 Given a ``start`` policy (fine-tuning from the general policy, :mod:`pianobot.agent.general`),
 the agent begins with its weights, evaluates them before the first step, and that evaluation
-counts: the stored policy is never worse than the start, and when the start already reaches
-:attr:`TrainConfig.stop_f1` the run stores nothing (its manifest says ``"kept": "start"``).
+counts: when the start already reaches :attr:`TrainConfig.stop_f1` the run stores nothing, and
+when no later evaluation beats the start's it stores no policy (either way its manifest says
+``"kept": "start"``): a stored policy played better than its start on the evaluation.
 Every episode is logged beside the policy (:mod:`pianobot.learn.log`: CSV, TensorBoard, a plot).
 With ``TrainConfig.envs`` > 1 the loop steps that many environments at once, in worker processes
 (:func:`make_envs`); with 1, the default, its one environment in this process.

@@ -12,8 +12,8 @@ say about who played. :func:`perform_plan` performs a plan in one continuous sim
     print(performance.plan.performer, performance.report().f1)
 
 Who plays a phrase, in order: its own policy, unless the store's index says the general policy
-plays it (:func:`pianobot.agent.store.general_plays`: the general policy already played it when
-training began, or the phrase's own policy made its piece play worse); else the general policy;
+plays it (:func:`pianobot.agent.store.general_plays`: the phrase's training kept its start, the
+general policy, or the phrase's own policy made its piece play worse); else the general policy;
 else, with ``fallback``, the scripted pianist. Consecutive phrases the general policy plays are
 one stretch: it plays them as one section, with no hand-over to itself at the phrase breaks.
 """
