@@ -125,6 +125,13 @@ class Planner:
         )
         self.pitch = keyboard.geometry.white_pitch
         self.grid = np.arange(0.0, keyboard_width(keyboard) + 1e-9, self.pitch / GRID)
+        self._move = self.grid[None, :] - self.grid[:, None]
+        """Wrist displacement between grid positions (rows: from, columns: to)."""
+        self._move_cost = np.abs(self._move) / self.pitch + MOVE_COST * (np.abs(self._move) > 1e-9)
+        """What moving the wrist costs, before the fingers are considered (read-only: every use copies)."""
+        self._distance = np.abs(self._move)
+        self._move.flags.writeable = self._move_cost.flags.writeable = self._distance.flags.writeable = False
+        self._in_reach: dict[tuple[int, int], np.ndarray] = {}
         world = WorldConfig(keyboard=keyboard, hand=hand)
         self.strikes = StrikePlanner(world, KeyLayout(world), tuning)
         """The scripted pianist's strike planning (``tuning``: its constants): how soon a finger can strike
@@ -148,14 +155,12 @@ class Planner:
         self, prev_keys: list[int], keys: list[int], fingers_prev: tuple, fingers: tuple, held: list[bool], time: float
     ) -> np.ndarray:
         """Cost (W_prev x W) of going from one state's fingers to the next's, for every pair of wrist positions."""
-        move = self.grid[None, :] - self.grid[:, None]  # wrist displacement, rows: from, columns: to
-        cost = np.abs(move) / self.pitch + MOVE_COST * (np.abs(move) > 1e-9)
+        move, cost = self._move, self._move_cost
         for key_p, finger_p, is_held in zip(prev_keys, fingers_prev, held):
             if is_held:  # still sounding at the next onset: finger busy, key kept in reach
                 if finger_p in fingers:
                     return np.full_like(cost, _INFEASIBLE)
-                offset = np.abs(self.key_x[key_p] - self.grid - FINGER_BASE_X[finger_p]) / self.reach[key_p]
-                cost = cost + np.where(offset <= 1.0, 0.0, _INFEASIBLE)[None, :]
+                cost = cost + np.where(self._reaches(key_p, finger_p), 0.0, _INFEASIBLE)[None, :]
             for key, finger in zip(keys, fingers):
                 if finger == finger_p:
                     easy = time >= HOP_TIME and not (self.black[key] or self.black[key_p])
@@ -190,13 +195,14 @@ class Planner:
         velocities = [n.velocity for n in sorted(chord, key=lambda n: n.pitch)]
         time = onset - prev_chord[0].onset
         slow = _INFEASIBLE if in_time else _TOO_FAST
-        move = np.abs(self.grid[None, :] - self.grid[:, None])
-        too_fast = np.where(self._wrist_too_fast(move, time, chord), slow, 0.0)
+        too_fast = np.where(self._wrist_too_fast(self._distance, time, chord), slow, 0.0)
+        # the slowest strike's lead from its ready height: a note out of reach is let go before it
+        lead = max(self.strikes.ready(Run(key, 0, 1, v))[1] for key, v in zip(keys, velocities))
         blocks = np.empty((len(p_assign), len(self.grid), len(assignments), len(self.grid)))
         for a_p, f_p in enumerate(p_assign):
             for a, f in enumerate(assignments):
                 hop = slow if self._fast_hop(p_keys, f_p, keys, f, time, velocities) else 0.0
-                legato = self._legato(prev_chord, onset, p_keys, f_p, keys, f, velocities)
+                legato = self._legato(prev_chord, onset, p_keys, f_p, keys, f, velocities, lead)
                 blocks[a_p, :, a, :] = self._transition(p_keys, keys, f_p, f, held, time) + too_fast + hop + legato
         step = before.cost[:, None] + blocks.reshape(len(before.cost), -1)
         best = np.argmin(step, axis=0)
@@ -211,10 +217,11 @@ class Planner:
         keys: list[int],
         fingers: tuple,
         velocities: Sequence[int],
+        lead: int,
     ) -> np.ndarray | float:
         """Cost (W, by the next wrist position, or one number) of the previous chord's notes that the
         scripted pianist must let go before their written end to play the next chord at ``onset`` with
-        ``fingers``: the share of each note's written length lost, times ``legato_cost``. A note is let
+        ``fingers`` (``lead``: the control steps of its slowest strike from the ready height): the share of each note's written length lost, times ``legato_cost``. A note is let
         go :meth:`~pianobot.pianist.strikes.StrikePlanner.release_steps` before a strike of its own
         finger or on its own key, and ``prepare_steps`` and the strike's lead before a strike from a wrist
         position where its key is out of its finger's reach (the hand slides only once it has risen)."""
@@ -230,13 +237,20 @@ class Planner:
                     before = max(before, strikes.release_steps(key_p, key, velocity) * strikes.dt)
             lost = float(np.clip((before - slack) / note.duration, 0.0, 1.0))
             # out of reach from the next wrist position: let go before the slowest strike's lead and the slide
-            lead = max(strikes.ready(Run(key, 0, 1, v))[1] for key, v in zip(keys, velocities))
             leap = (tuning.prepare_steps + lead) * strikes.dt
-            offset = np.abs(self.key_x[key_p] - self.grid - FINGER_BASE_X[finger_p]) / self.reach[key_p]
             leap_lost = float(np.clip((leap - slack) / note.duration, 0.0, 1.0))
-            lost_by_wrist = np.where(offset <= 1.0, lost, max(lost, leap_lost))
+            lost_by_wrist = np.where(self._reaches(key_p, finger_p), lost, max(lost, leap_lost))
             cost = cost + tuning.legato_cost * lost_by_wrist[None, :]
         return cost
+
+    def _reaches(self, key: int, finger: int) -> np.ndarray:
+        """Whether ``finger`` reaches ``key`` from each wrist position of the grid (read-only, cached)."""
+        reaches = self._in_reach.get((key, finger))
+        if reaches is None:
+            reaches = np.abs(self.key_x[key] - self.grid - FINGER_BASE_X[finger]) / self.reach[key] <= 1.0
+            reaches.flags.writeable = False
+            self._in_reach[key, finger] = reaches
+        return reaches
 
     def _wrist_too_fast(self, move: np.ndarray | float, time: float, chord: Sequence[Note]) -> np.ndarray:
         """Whether the wrist cannot move ``move`` (m) in the ``time`` s before ``chord``'s onset:

@@ -241,31 +241,63 @@ TILT_RANGE = (0.6, 1.57)
 """Tilts the IK considers: between them the fingertip, not a knuckle, is the finger's lowest point."""
 
 
+_TILT_OFFSETS = np.concatenate([[0.0], np.repeat(np.arange(1, 50) * 0.02, 2) * np.tile([1, -1], 49)])
+"""The tilts :func:`finger_ik` tries, as offsets from the preferred one, nearest first."""
+_SLACK = 1e-6
+"""How far (rad) the vectorized screen in :func:`finger_ik` lets a tilt stray outside the limits:
+it only has to keep every tilt the exact check would accept."""
+
+
+def _ik_at(geometry: FingerGeometry, reach: float, drop: float, phi: float) -> np.ndarray | None:
+    """MCP, PIP and DIP angles that put the fingertip's lowest point at (reach, drop) with the
+    distal link at ``phi`` below the horizontal, or None where the joint limits forbid it."""
+    centre_x, centre_z = reach, drop - geometry.tip_radius
+    l3 = geometry.distal - geometry.tip_radius
+    x = centre_x - l3 * math.cos(phi) - geometry.base_to_mcp
+    z = centre_z - l3 * math.sin(phi)
+    cosine = (x * x + z * z - geometry.proximal**2 - geometry.middle**2) / (2 * geometry.proximal * geometry.middle)
+    if abs(cosine) > 1:
+        return None
+    pip = math.acos(cosine)
+    mcp = math.atan2(z, x) - math.atan2(
+        geometry.middle * math.sin(pip), geometry.proximal + geometry.middle * math.cos(pip)
+    )
+    dip = phi - mcp - pip
+    (lo1, hi1), (lo2, hi2), (lo3, hi3) = geometry.flexion_limits
+    if lo1 <= mcp <= hi1 and lo2 <= pip <= hi2 and lo3 <= dip <= hi3:
+        return np.array([mcp, pip, dip])
+    return None
+
+
 def finger_ik(geometry: FingerGeometry, reach: float, drop: float, tilt: float = PREFERRED_TILT) -> np.ndarray | None:
     """MCP, PIP and DIP angles that put the fingertip's lowest point at (reach, drop).
 
     Three joints for two coordinates leave one freedom: the distal link's angle below the
     horizontal (``tilt``, rad). The tilt closest to the preferred one within [0.6, 1.57] that the
-    joint limits allow is used; between those bounds the fingertip, not a knuckle, is the
-    finger's lowest point. Returns None when the point is out of reach.
+    joint limits allow is used (tried in steps of 0.02 rad, nearer first, the larger first of
+    two equally near); between those bounds the fingertip, not a knuckle, is the finger's lowest
+    point. Returns None when the point is out of reach.
     """
-    limits = geometry.flexion_limits
-    for offset in np.concatenate([[0.0], np.repeat(np.arange(1, 50) * 0.02, 2) * np.tile([1, -1], 49)]):
-        phi = tilt + offset
-        if not TILT_RANGE[0] <= phi <= TILT_RANGE[1]:
-            continue
-        centre_x, centre_z = reach, drop - geometry.tip_radius
-        l3 = geometry.distal - geometry.tip_radius
-        x = centre_x - l3 * math.cos(phi) - geometry.base_to_mcp
-        z = centre_z - l3 * math.sin(phi)
-        cosine = (x * x + z * z - geometry.proximal**2 - geometry.middle**2) / (2 * geometry.proximal * geometry.middle)
-        if abs(cosine) > 1:
-            continue
-        pip = math.acos(cosine)
-        mcp = math.atan2(z, x) - math.atan2(
-            geometry.middle * math.sin(pip), geometry.proximal + geometry.middle * math.cos(pip)
-        )
-        q = np.array([mcp, pip, phi - mcp - pip])
-        if all(lo <= a <= hi for a, (lo, hi) in zip(q, limits)):
+    if TILT_RANGE[0] <= tilt <= TILT_RANGE[1]:
+        q = _ik_at(geometry, reach, drop, tilt)  # the usual case: the preferred tilt itself
+        if q is not None:
             return q
+    # every other tilt at once, screened loosely in NumPy; the exact check decides, in order
+    phi = tilt + _TILT_OFFSETS[1:]
+    l3 = geometry.distal - geometry.tip_radius
+    x = reach - l3 * np.cos(phi) - geometry.base_to_mcp
+    z = drop - geometry.tip_radius - l3 * np.sin(phi)
+    cosine = (x * x + z * z - geometry.proximal**2 - geometry.middle**2) / (2 * geometry.proximal * geometry.middle)
+    pip = np.arccos(np.clip(cosine, -1.0, 1.0))
+    mcp = np.arctan2(z, x) - np.arctan2(
+        geometry.middle * np.sin(pip), geometry.proximal + geometry.middle * np.cos(pip)
+    )
+    ok = (phi >= TILT_RANGE[0] - _SLACK) & (phi <= TILT_RANGE[1] + _SLACK) & (np.abs(cosine) <= 1.0 + _SLACK)
+    for angle, (lo, hi) in zip((mcp, pip, phi - mcp - pip), geometry.flexion_limits):
+        ok &= (angle >= lo - _SLACK) & (angle <= hi + _SLACK)
+    for candidate in phi[np.flatnonzero(ok)]:
+        if TILT_RANGE[0] <= candidate <= TILT_RANGE[1]:
+            q = _ik_at(geometry, reach, drop, float(candidate))
+            if q is not None:
+                return q
     return None

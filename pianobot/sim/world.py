@@ -464,7 +464,10 @@ class PianoWorld:
         if not torque:
             if self.config.control == "position":  # at the speed that reaches the target at the control step's end
                 command = np.clip((command - q) / (left * self.dt), -config.max_joint_speed, config.max_joint_speed)
-            self._finger_motors(body, p.VELOCITY_CONTROL, targetVelocities=np.clip(command, slowest, fastest))
+            # (np.minimum of np.maximum is np.clip, at a third of its cost on a few numbers)
+            self._finger_motors(
+                body, p.VELOCITY_CONTROL, targetVelocities=np.minimum(np.maximum(command, slowest), fastest)
+            )
             return
         # torque control, except for joints that would pass a limit within this step: a motor holds those at it
         velocity = np.array([s[1] for s in states])
