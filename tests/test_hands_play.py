@@ -108,7 +108,7 @@ def test_random_duets_are_seeded_and_keep_the_hands_apart():
         assert chords == {"block": 3, "voices": 2}.get(texture, 1), texture
 
 
-def test_the_parts_family_draws_fingered_hand_phrases_and_melodies_by_its_seed():
+def test_the_parts_family_draws_fingered_whole_hand_parts_by_its_seed():
     from pianobot.agent.tasks import task_sampler
     from pianobot.env.piano import EnvConfig
     from pianobot.music.tasks import FAMILIES, PARTS
@@ -120,8 +120,11 @@ def test_the_parts_family_draws_fingered_hand_phrases_and_melodies_by_its_seed()
     keys = KeyboardSpec()
     for piece in pieces:
         assert piece.has_fingering and all(n.pitch in keys and n.finger in (2, 3, 4) for n in piece.notes)
-        assert len(piece) <= 6 and piece.notes[0].onset == 0.0
+        assert piece.notes[0].onset == 0.0
         check_playable(piece, keys, HandSpec())  # no finger asked to play while it holds a note
+    # whole parts, as play gives a hand its part (a phrase is at most 6 notes): 4 bars of 4 beats
+    assert min(len(p) for p in pieces) >= 4 and sum(len(p) > 12 for p in pieces) >= 10
+    assert max(p.notes[-1].offset for p in pieces) > 6.0
     # held notes under a moving voice and three-note chords: what melodies alone seldom hold
     assert sum(p.max_polyphony()[0] >= 2 for p in pieces) >= 8
 

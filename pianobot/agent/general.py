@@ -1,5 +1,5 @@
 """The general policy: one policy trained on the ``melody`` task family (random one-hand phrases,
-docs/training.md) or the ``parts`` family (those and phrases of one hand of random two-hand
+docs/training.md) or the ``parts`` family (one hand's whole parts of random two-hand
 pieces), which plays the phrases that have no policy of their own and is where the
 training of a new phrase begins (fine-tuning).
 
@@ -39,7 +39,7 @@ GENERAL_KEY = store.task_key(GENERAL_TASK)
 """Its folders' key in the model store: ``task-melody-<config hash>``."""
 GENERAL_KEYS = (GENERAL_KEY, store.task_key(PARTS))
 """The folders' keys of every general policy: the ``melody`` family's, and the ``parts`` family's
-(melody phrases and phrases of one hand of a two-hand piece: a general policy too)."""
+(one hand's whole parts of random two-hand pieces: a general policy too)."""
 PACKAGED = Path(__file__).resolve().parent.parent / "policies"
 """The policies that ship with pianobot (package data): the committed general policy (a
 ``task-melody`` folder) and the left hand's (:func:`left_hand_policy`, a ``task-parts`` folder)."""

@@ -1,8 +1,7 @@
 """Task families by name, as the environment takes them: a sampler that draws a fingered piece.
 
 The paper's five families (:mod:`pianobot.music.tasks`) are fingered by construction. The
-``parts`` family (:func:`draw_part`) draws a hand's phrase of a random two-hand piece, or a melody
-phrase. The ``melody`` family draws a phrase with :func:`pianobot.music.melodies.random_phrase` and fingers it
+``parts`` family (:func:`draw_part`) draws one hand's whole part of a random two-hand piece. The ``melody`` family draws a phrase with :func:`pianobot.music.melodies.random_phrase` and fingers it
 with the fingering planner (:mod:`pianobot.pianist.fingering`); a phrase the planner says this
 hand cannot play (it reports problems, or raises an error) is drawn again, with the next draw of
 the same generator, so the environment's seed fixes every instance. The environment cannot do
@@ -22,7 +21,6 @@ from pianobot.errors import PianobotError
 from pianobot.music.duets import random_duet
 from pianobot.music.instrument import check_playable
 from pianobot.music.melodies import MelodyKey, random_phrase
-from pianobot.music.phrases import DEFAULT_MAX_NOTES, split_phrases
 from pianobot.music.piece import HANDS, Note, Piece
 from pianobot.music.tasks import FAMILIES, MELODY, PARTS, TASKS, make_task
 from pianobot.music.window import window_for
@@ -52,17 +50,20 @@ def draw_melody(rng: np.random.Generator, config: EnvConfig = EnvConfig(), key: 
     )
 
 
-PART_SHARE = 0.5
-"""The share of the ``parts`` family's instances that are a phrase of a two-hand piece's hand; the
-rest are ``melody`` instances, so a policy trained on it keeps playing melodies."""
+PART_SHARE = 1.0
+"""The share of the ``parts`` family's instances that are a hand's whole part of a two-hand piece;
+the rest are ``melody`` instances. The family's first version drew half of each, and a phrase of
+at most six notes of the part (docs/training.md, "The parts task family")."""
 
 
 def draw_part(rng: np.random.Generator, config: EnvConfig = EnvConfig()) -> Piece:
     """One instance of the ``parts`` family (:data:`~pianobot.music.tasks.PARTS`): with chance
-    :data:`PART_SHARE` a phrase of one hand of a :func:`~pianobot.music.duets.random_duet`, given to
-    this hand through its window (:mod:`pianobot.music.window`: the left hand's part mirrored, both
-    moved by octaves onto the keyboard; notes that still lie off it are left out), the first one the
-    planner fingers without problems; else a ``melody`` instance."""
+    :data:`PART_SHARE` one hand's whole part of a :func:`~pianobot.music.duets.random_duet`, given to
+    this hand through its window as ``pianobot play`` gives it (:mod:`pianobot.music.window`: the
+    left hand's part mirrored, both moved by octaves onto the keyboard; notes that still lie off it
+    are left out), starting at 0, the first one the planner fingers without problems; else a
+    ``melody`` instance. Whole parts, not phrases: the general policy plays a part as one stretch,
+    so it must learn to go on from where the last chord left the hand."""
     if rng.random() >= PART_SHARE:
         return draw_melody(rng, config)
     keyboard, hand = config.world.keyboard, config.world.hand
@@ -74,8 +75,7 @@ def draw_part(rng: np.random.Generator, config: EnvConfig = EnvConfig()) -> Piec
         inside = [n for n in inside if n.pitch in keyboard.spec]
         if not inside:
             continue
-        phrases = split_phrases(Piece(tuple(inside), bpm=part.bpm), DEFAULT_MAX_NOTES)
-        phrase = phrases[int(rng.integers(len(phrases)))].piece()
+        phrase = Piece(tuple(inside), bpm=part.bpm).shift(-inside[0].onset)
         try:
             check_playable(phrase, keyboard.spec, hand.spec)
             plan = plan_fingering(phrase, keyboard, hand)

@@ -31,10 +31,10 @@ MELODY = "melody"
 instances are fingered by the fingering planner, which lies above the environment, so they are
 drawn by :mod:`pianobot.agent.tasks` and handed to the environment as a sampler."""
 PARTS = "parts"
-"""Our family of one hand's phrases as two-hand music gives them: a melody phrase, or a phrase of
-a random two-hand piece's right or left hand (:mod:`pianobot.music.duets`: chords, a held note
-under a moving voice), the left hand's mirrored onto the right's keys. Drawn, like ``melody``, by
-:mod:`pianobot.agent.tasks`."""
+"""Our family of one hand's parts as two-hand music gives them: a random two-hand piece's right or
+left hand, whole (:mod:`pianobot.music.duets`: a melody, a bass line, broken or block chords, a
+held note under a moving voice), the left hand's mirrored onto the right's keys. Drawn, like
+``melody``, by :mod:`pianobot.agent.tasks`."""
 FAMILIES = TASKS + (MELODY, PARTS)
 """Every task family ``pianobot train --task`` trains on."""
 BPM = 60.0

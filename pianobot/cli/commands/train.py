@@ -47,7 +47,7 @@ def train(
         "--task",
         help=f"Train on a task family instead, a fresh random instance each episode: the paper's {', '.join(TASKS)}, "
         f"or {MELODY} (random one-hand phrases of up to {DEFAULT_MAX_NOTES} notes in every key, fingered by the "
-        f"planner; docs/training.md) or {PARTS} (those and phrases of either hand of random two-hand pieces).",
+        f"planner; docs/training.md) or {PARTS} (either hand's whole part of random two-hand pieces).",
     ),
     steps: int = typer.Option(
         TrainConfig.steps,
