@@ -227,8 +227,8 @@ def play_factor(path: Path) -> float:
 
 def play_hands_factor(path: Path) -> float:
     """Real-time factor of the scripted pianist playing both hands of ``path`` as `pianobot play
-    --controller scripted` does after start-up (the file read; its parts prepared, performed in
-    one simulation and scored)."""
+    --controller scripted` does after start-up: timed from after the file is read and its notes
+    given to the hands, its parts prepared, performed in one simulation and scored."""
     piece = read_hands(path).piece
     with tempfile.TemporaryDirectory() as models, warnings.catch_warnings():
         warnings.simplefilter("ignore", PianobotWarning)  # what the reduction left out: not a speed matter

@@ -340,7 +340,7 @@ def test_the_newest_general_policy_is_the_last_trained_not_the_last_checked_out(
 
 
 def test_a_parts_family_policy_is_a_general_policy_and_the_newest_comes_first(models, general):
-    """`train --task parts` policies (melodies and hand parts) are general policies too: the newest
+    """`train --task parts` policies (hands' parts of two-hand pieces) are general policies too: the newest
     of either family in the store is the one `play` and `train` take, before the packaged one."""
     from pianobot.agent.general import general_candidates
 

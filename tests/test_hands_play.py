@@ -122,11 +122,36 @@ def test_the_parts_family_draws_fingered_whole_hand_parts_by_its_seed():
         assert piece.has_fingering and all(n.pitch in keys and n.finger in (2, 3, 4) for n in piece.notes)
         assert piece.notes[0].onset == 0.0
         check_playable(piece, keys, HandSpec())  # no finger asked to play while it holds a note
-    # whole parts, as play gives a hand its part (a phrase is at most 6 notes): 4 bars of 4 beats
+    # whole parts, as play gives a hand its part (a phrase is at most 6 notes): bars of 4 beats
     assert min(len(p) for p in pieces) >= 4 and sum(len(p) > 12 for p in pieces) >= 10
     assert max(p.notes[-1].offset for p in pieces) > 6.0
     # held notes under a moving voice and three-note chords: what melodies alone seldom hold
     assert sum(p.max_polyphony()[0] >= 2 for p in pieces) >= 8
+
+
+def test_the_parts_familys_second_version_trains_into_folders_of_its_own(tmp_path):
+    from pianobot.agent import general, store
+    from pianobot.learn.config import TrainConfig
+    from pianobot.learn.jobs import plan_jobs, task_job
+    from pianobot.music.tasks import MELODY, PARTS
+
+    config = TrainConfig()
+    job = task_job(PARTS, config, tmp_path)
+    assert job.folder.name == f"task-parts-v2-{store.config_hash(config)}"
+    assert task_job(MELODY, config, tmp_path).folder.name.startswith("task-melody-")  # version 1: as before
+    # a first-version policy trained with the same options is not taken for this version's
+    first = tmp_path / f"task-parts-{store.config_hash(config)}"
+    first.mkdir()
+    (first / store.MANIFEST_FILE).write_text("{}")
+    (first / store.POLICY_FILE).write_bytes(b"")
+    todo, done = plan_jobs([job], force=False)
+    assert todo == [job] and not done
+    # and both versions' folders count as the parts family's (general policies, the left hand's key)
+    second = job.folder
+    second.mkdir()
+    (second / store.MANIFEST_FILE).write_text("{}")
+    (second / store.POLICY_FILE).write_bytes(b"")
+    assert set(store.find_policies(tmp_path, general.LEFT_KEY)) == {first, second}
 
 
 def test_pianobot_play_plays_both_hands_of_a_piece_with_both_and_one_hand_as_before():

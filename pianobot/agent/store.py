@@ -94,9 +94,11 @@ def model_dir(root: Path, key: str, config) -> Path:
     return Path(root) / f"{key}-{config_hash(config)}"
 
 
-def task_key(task: str) -> str:
-    """The key of a task family's policy folders (``task-<name>-<config hash>``)."""
-    return f"task-{task}"
+def task_key(task: str, version: int = 1) -> str:
+    """The key of a task family's policy folders (``task-<name>-<config hash>``; after the family's
+    first version ``task-<name>-v<version>-<config hash>``). A key is also the prefix of its later
+    versions' keys, so :func:`find_policies` with a version 1 key finds every version's folders."""
+    return f"task-{task}" if version == 1 else f"task-{task}-v{version}"
 
 
 def file_digest(path: Path) -> str:

@@ -22,6 +22,7 @@ from pianobot.learn.dagger import dagger_policy
 from pianobot.learn.train import Progress, TrainConfig, train_policy
 from pianobot.music.phrases import Phrase
 from pianobot.music.piece import Piece
+from pianobot.music.tasks import VERSIONS
 
 
 @dataclass
@@ -114,7 +115,7 @@ def phrase_jobs(phrases: list[Phrase], config: TrainConfig, root: Path, piece: s
 
 def task_job(task: str, config: TrainConfig, root: Path) -> PhraseJob:
     """The one job of a task family."""
-    key = store.task_key(task)
+    key = store.task_key(task, VERSIONS.get(task, 1))
     return PhraseJob(key, task, store.model_dir(root, key, config), [0], f"task {task}")
 
 

@@ -37,6 +37,11 @@ held note under a moving voice), the left hand's mirrored onto the right's keys.
 ``melody``, by :mod:`pianobot.agent.tasks`."""
 FAMILIES = TASKS + (MELODY, PARTS)
 """Every task family ``pianobot train --task`` trains on."""
+VERSIONS = {PARTS: 2}
+"""The version of each family whose instances changed meaning (a family not named is at version 1):
+``parts`` 2 draws one hand's whole part, where 1 drew a phrase of at most six notes of it or a
+melody phrase. A policy folder's key names a version after the first
+(:func:`pianobot.agent.store.task_key`), so that a store keeps each version's policies apart."""
 BPM = 60.0
 FINGERS = (2, 3, 4)
 MAX_SHIFT = 4
