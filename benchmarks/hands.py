@@ -2,7 +2,7 @@
 beside the scripted pianist, against the pieces as written.
 
     python -m benchmarks.hands [--duets 50] [--seed 35] [--polyphonic 20] [--general DIR]
-                               [--general-left DIR] [--apart] [--json out.json]
+                               [--general-left DIR] [--parts DIR] [--apart] [--json out.json]
 
 (``python -m benchmarks.zeroshot --sets duets polyphonic`` plays the same sets beside the
 one-hand ones.)
@@ -10,18 +10,19 @@ one-hand ones.)
 Sets:
 
 - ``duets``: ``--duets`` random two-hand pieces (:func:`pianobot.music.duets.duet_set`, seed
-  ``--seed``: a melody over a bass line, broken chords, block chords or two voices, 60-120 bpm,
-  every key); no training run draws from them;
-- ``polyphonic``: the left hand's part alone of ``--polyphonic`` further duets with block chords
-  or two voices (seed ``--seed`` + 1): one hand's polyphonic part, chords and a held note under a
-  moving voice.
+  ``--seed``: a melody over a bass line, broken chords, block chords or two voices, or a right
+  hand in two voices over a bass line; 60-120 bpm, every key); no training run draws from them;
+- ``polyphonic``: one hand's part alone of ``--polyphonic`` further duets (seed ``--seed`` + 1),
+  in turn the left hand's with block chords, the left hand's in two voices, the right hand's in
+  two voices: chords, and a held note under a moving voice.
 
 Each piece is played once from hand start 0, both hands in one simulation as ``pianobot play``
 plays them (``--apart``: each hand in a simulation of its own), by the general policy (the
 packaged ones, as ``pianobot play`` plays them: the melody policy on the right hand, the parts
-policy on the left; the model store is an empty folder; ``--general`` names the right hand's,
-and both hands' without ``--general-left``, which names the left's) and by the scripted pianist.
-The polyphonic parts are left hands: the left hand's policy plays them. Prints a
+policy on the left and on a polyphonic right hand; the model store is an empty folder;
+``--general`` names the right hand's, and both hands' without ``--general-left``, which names the
+left's; ``--parts`` the parts policy, in its place on the hands it plays) and by the scripted pianist.
+A polyphonic part is played by its hand's player (the left hand's policy plays the left hands). Prints a
 Markdown table per set: note F1 (whole piece, right hand, left hand), per-step key-press F1, note
 F1 with offsets, notes left outside the general policy's 24 keys, and the general policy's share
 of the scripted pianist's note F1.
@@ -40,9 +41,13 @@ import torch
 
 from pianobot.errors import PianobotWarning
 from pianobot.music.duets import duet_set, random_duet
-from pianobot.perform.hands import play_hands
+from pianobot.music.instrument import HandSpec, KeyboardSpec
+from pianobot.music.piece import HANDS
+from pianobot.perform.hands import play_hands, polyphonic, prepare_part
 
 PLAYERS = ("sac", "scripted")
+POLYPHONIC = ("block", "voices", "right-voices")
+"""The textures of the polyphonic parts, in turn (the right hand's part of ``right-voices``, else the left's)."""
 NAMES = {"sac": "general", "scripted": "scripted"}
 
 
@@ -67,8 +72,9 @@ def polyphonic_set(seed: int, count: int) -> list[tuple[str, object]]:
     rng = np.random.default_rng(seed)
     out = []
     for i in range(count):
-        texture = ("block", "voices")[i % 2]
-        out.append((f"left hand {seed}-{i} ({texture})", random_duet(rng, texture).part("left")))
+        texture = POLYPHONIC[i % len(POLYPHONIC)]
+        hand = "right" if texture == "right-voices" else "left"
+        out.append((f"{hand} hand {seed}-{i} ({texture})", random_duet(rng, texture).part(hand)))
     return out
 
 
@@ -96,14 +102,33 @@ def table(name: str, rows: list[dict]) -> str:
     return "\n".join(lines)
 
 
-def play_set(pieces, general=None, together: bool = True) -> list[dict]:
-    """Every piece of a set played by both players: one row of figures per piece."""
+def with_parts(piece, general, parts):
+    """The general policies by hand with ``parts`` on the hands ``play`` gives the parts policy: the
+    left, and the right where its part is polyphonic (:func:`pianobot.perform.hands.polyphonic`)."""
+    if parts is None:
+        return general
+    by_hand = dict(general) if isinstance(general, dict) else dict.fromkeys(HANDS, general)
+    for hand in piece.hands:
+        if hand == "left":
+            by_hand[hand] = parts
+        else:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", PianobotWarning)
+                part = prepare_part(piece, hand, KeyboardSpec(), HandSpec())[1]
+            by_hand[hand] = parts if polyphonic(part) else by_hand.get(hand)
+    return by_hand
+
+
+def play_set(pieces, general=None, together: bool = True, parts=None) -> list[dict]:
+    """Every piece of a set played by both players: one row of figures per piece (``parts``: the
+    parts policy, :func:`with_parts`)."""
     rows = []
     with tempfile.TemporaryDirectory() as models:
         for label, piece in pieces:
             piece = piece if piece.hands else piece.with_hands("left")
             row = {"piece": label, "notes": len(piece)}
-            row.update({player: figures(piece, player, models, general, together) for player in PLAYERS})
+            policies = with_parts(piece, general, parts)
+            row.update({player: figures(piece, player, models, policies, together) for player in PLAYERS})
             rows.append(row)
             print(f"{label}: general {row['sac']['f1']:.3f}, scripted {row['scripted']['f1']:.3f}", flush=True)
     return rows
@@ -119,6 +144,11 @@ def main() -> None:
         "--general-left",
         help="the left hand's general policy (default: --general's when given, else the packaged left hand's)",
     )
+    parser.add_argument(
+        "--parts",
+        help="the parts policy: the left hand's and a polyphonic right hand's, as play gives them the packaged "
+        "left hand's policy (overrides --general and --general-left for them)",
+    )
     parser.add_argument("--apart", action="store_true", help="each hand in a simulation of its own")
     parser.add_argument("--json", help="write every piece's figures here")
     args = parser.parse_args()
@@ -133,7 +163,7 @@ def main() -> None:
         if not pieces:
             continue
         general = {"right": args.general, "left": args.general_left} if args.general_left else args.general
-        results[name] = play_set(pieces, general, not args.apart)
+        results[name] = play_set(pieces, general, not args.apart, args.parts)
         print(table(name, results[name]), flush=True)
     print(f"{time.perf_counter() - started:.0f} s")
     if args.json:

@@ -27,8 +27,8 @@ offsets, notes left out):
 
 - ``duets``: ``--duets`` random two-hand pieces (:func:`pianobot.music.duets.duet_set`, seed
   ``--duet-seed``; no training run draws from them);
-- ``polyphonic``: ``--polyphonic`` left-hand parts with block chords or two voices (seed
-  ``--duet-seed`` + 1), alone: one hand's polyphonic part.
+- ``polyphonic``: ``--polyphonic`` hands' parts alone (seed ``--duet-seed`` + 1): left hands
+  with block chords or two voices, right hands in two voices (:func:`benchmarks.hands.polyphonic_set`).
 
 For each piece: note F1, velocity MAE (matched notes, MIDI units), per-step key-press F1 (the
 paper's frame-level measure), note F1 with offsets and the played/written duration ratio by note

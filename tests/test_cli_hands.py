@@ -290,7 +290,8 @@ def test_finger_writes_each_hands_fingering_one_track_each(tmp_path):
 
 def test_the_left_hand_plays_the_packaged_left_policy_unless_left_policy_names_another(tmp_path):
     """Both hands with the general policies: by default the right hand has the general policy
-    (`task-melody`) and the left the packaged left hand's (`task-parts`); --left-policy names the
+    (`task-melody`) and the left the packaged left hand's (`task-parts`), as has a right hand in two
+    voices; --left-policy names the
     left's; it is refused, in one line, where no general policy plays a left hand."""
     from pianobot.agent.general import PACKAGED
 
@@ -300,6 +301,12 @@ def test_the_left_hand_plays_the_packaged_left_policy_unless_left_policy_names_a
     assert result.exit_code == 0, result.output
     hands = json.loads((tmp_path / "r.json").read_text())["hands"]
     assert "task-melody-" in hands["right"]["performer"] and "task-parts-" in hands["left"]["performer"]
+    # a right hand in two voices (a note held under the melody) has the parts policy too
+    voices = _duet(tmp_path / "voices.mid", right=_track((67, 0, 4), (72, 0, 1), (74, 1, 2), (76, 2, 3), (74, 3, 4)))
+    result = run("play", voices, "-o", tmp_path / "v.mid", "--models", models, "--json", tmp_path / "v.json", "-q")
+    assert result.exit_code == 0, result.output
+    hands = json.loads((tmp_path / "v.json").read_text())["hands"]
+    assert "task-parts-" in hands["right"]["performer"] and "task-parts-" in hands["left"]["performer"]
     melody = next(PACKAGED.glob("task-melody-*"))
     named = ("--left-policy", melody, "--json", tmp_path / "two.json", "-q")
     result = run("play", song, "-o", tmp_path / "two.mid", "--models", models, *named)

@@ -97,6 +97,18 @@ def test_a_note_without_a_hand_is_refused():
         play_hands(Piece((Note(0.0, 60, 1.0, hand="right"), Note(0.0, 48, 1.0))), "scripted")
 
 
+def test_a_part_is_polyphonic_when_a_tenth_of_its_notes_sound_with_another():
+    from pianobot.perform.hands import polyphonic
+
+    melody = [Note(float(i), 60 + i, i + 1.0) for i in range(12)]  # legato: each ends as the next begins
+    assert not polyphonic(Piece(tuple(melody)))
+    assert polyphonic(Piece((*melody, Note(11.0, 64, 12.0))))  # a closing chord: 2 of 13 notes sound together
+    long = [Note(float(i), 60 + i % 12, i + 1.0) for i in range(30)]
+    assert not polyphonic(Piece((*long, Note(29.0, 48, 30.0))))  # the same chord closing 30 notes: 2 of 31
+    held = Piece((Note(0.0, 55, 4.0), *(Note(float(i), 60 + i, i + 0.9) for i in range(4))))  # a voice under the melody
+    assert polyphonic(held)
+
+
 def test_random_duets_are_seeded_and_keep_the_hands_apart():
     assert duet_set(3, 4) == duet_set(3, 4) and duet_set(3, 4) != duet_set(4, 4)
     for texture in TEXTURES:
@@ -106,6 +118,10 @@ def test_random_duets_are_seeded_and_keep_the_hands_apart():
         assert max(n.pitch for n in left.notes) < min(n.pitch for n in right.notes)
         chords = max(len(c) for c in left.chords())
         assert chords == {"block": 3, "voices": 2}.get(texture, 1), texture
+        # only a right hand in two voices holds a note while another sounds; its lower voice lies below
+        held = [(a, b) for a in right.notes for b in right.notes if a.onset < b.onset < a.offset]
+        assert bool(held) == (texture == "right-voices"), texture
+        assert all(a.pitch <= b.pitch - 3 or b.pitch <= a.pitch - 3 for a, b in held)
 
 
 def test_the_parts_family_draws_fingered_whole_hand_parts_by_its_seed():
@@ -129,29 +145,29 @@ def test_the_parts_family_draws_fingered_whole_hand_parts_by_its_seed():
     assert sum(p.max_polyphony()[0] >= 2 for p in pieces) >= 8
 
 
-def test_the_parts_familys_second_version_trains_into_folders_of_its_own(tmp_path):
+def test_the_parts_familys_versions_train_into_folders_of_their_own(tmp_path):
     from pianobot.agent import general, store
     from pianobot.learn.config import TrainConfig
     from pianobot.learn.jobs import plan_jobs, task_job
-    from pianobot.music.tasks import MELODY, PARTS
+    from pianobot.music.tasks import MELODY, PARTS, VERSIONS
 
     config = TrainConfig()
     job = task_job(PARTS, config, tmp_path)
-    assert job.folder.name == f"task-parts-v2-{store.config_hash(config)}"
+    assert VERSIONS[PARTS] == 3 and job.folder.name == f"task-parts-v3-{store.config_hash(config)}"
     assert task_job(MELODY, config, tmp_path).folder.name.startswith("task-melody-")  # version 1: as before
-    # a first-version policy trained with the same options is not taken for this version's
-    first = tmp_path / f"task-parts-{store.config_hash(config)}"
-    first.mkdir()
-    (first / store.MANIFEST_FILE).write_text("{}")
-    (first / store.POLICY_FILE).write_bytes(b"")
+    # earlier versions' policies trained with the same options are not taken for this version's
+    older = [tmp_path / f"task-parts-{store.config_hash(config)}", tmp_path / f"task-parts-v2-{store.config_hash(config)}"]
+    for folder in older:
+        folder.mkdir()
+        (folder / store.MANIFEST_FILE).write_text("{}")
+        (folder / store.POLICY_FILE).write_bytes(b"")
     todo, done = plan_jobs([job], force=False)
     assert todo == [job] and not done
-    # and both versions' folders count as the parts family's (general policies, the left hand's key)
-    second = job.folder
-    second.mkdir()
-    (second / store.MANIFEST_FILE).write_text("{}")
-    (second / store.POLICY_FILE).write_bytes(b"")
-    assert set(store.find_policies(tmp_path, general.LEFT_KEY)) == {first, second}
+    # and every version's folders count as the parts family's (general policies, the left hand's key)
+    job.folder.mkdir()
+    (job.folder / store.MANIFEST_FILE).write_text("{}")
+    (job.folder / store.POLICY_FILE).write_bytes(b"")
+    assert set(store.find_policies(tmp_path, general.LEFT_KEY)) == {*older, job.folder}
 
 
 def test_pianobot_play_plays_both_hands_of_a_piece_with_both_and_one_hand_as_before():

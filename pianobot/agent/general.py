@@ -40,7 +40,7 @@ GENERAL_KEY = store.task_key(GENERAL_TASK)
 GENERAL_KEYS = (GENERAL_KEY, store.task_key(PARTS))
 """The folders' keys of every general policy: the ``melody`` family's, and the ``parts`` family's
 (one hand's parts of random two-hand pieces: a general policy too; the key finds every version's
-folders, ``task-parts-`` and ``task-parts-v2-``)."""
+folders, ``task-parts-``, ``task-parts-v2-``, ``task-parts-v3-``)."""
 PACKAGED = Path(__file__).resolve().parent.parent / "policies"
 """The policies that ship with pianobot (package data): the committed general policy (a
 ``task-melody`` folder) and the left hand's (:func:`left_hand_policy`, a ``task-parts`` folder)."""
@@ -125,8 +125,9 @@ def general_candidates(models: Path | None) -> list[Path]:
 
 
 def left_hand_policy(models: Path | None, keyboard: Any = None, hand: Any = None) -> Path | None:
-    """The general policy that plays the left hand of a two-hand piece by default, where the right
-    hand has the general policy (:func:`general_candidates`): the packaged ``parts`` policy, when
+    """The general policy that plays the left hand of a two-hand piece by default (and a polyphonic
+    right hand's part, :func:`pianobot.perform.hands.polyphonic`), where the right hand has the
+    general policy (:func:`general_candidates`): the packaged ``parts`` policy, when
     the user's store holds no general policy of its own for ``keyboard`` and ``hand`` (specs;
     None: any; such a one plays both hands) and the packaged one was trained on them. None: the
     left hand has the right hand's. Measured (docs/benchmarks.md, "Two hands"): the left hands of

@@ -27,6 +27,7 @@ FLAGS = {
     "jobs.force": "--force",
     "train.device": "--device",
     "train.dagger.round_steps": "--round-steps",
+    "train.dagger.learning_rate": "--dagger-learning-rate",
     "store.models": "--models",
     "general.path": "--general-policy",
     "play.controller": "--controller",

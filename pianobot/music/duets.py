@@ -3,12 +3,18 @@ pure music, no physics).
 
 The right hand plays a random melody (:func:`pianobot.music.melodies.random_melody`) over C4–B5;
 the left hand accompanies it in the same key below C4 (from F#1 up), bar by bar, on
-a cadence (I, IV or ii, V, I, and again), in one of four textures drawn per piece:
+a cadence (I, IV or ii, V, I, and again), in one of five textures drawn per piece:
 
 - ``bass``: a bass line, one note a beat, on the chord's root, fifth or a step towards the next root;
 - ``broken``: the chord broken in eighths, root, fifth, third, fifth (an Alberti bass);
 - ``block``: the chord (root, third, fifth) held for two beats, on beats one and three;
-- ``voices``: a held root with a moving voice above it, a quarter a beat (two voices in one hand).
+- ``voices``: a held root with a moving voice above it, a quarter a beat (two voices in one hand);
+- ``right-voices``: the bass line under a right hand in two voices: each half bar, a tone of the
+  bar's chord held under the melody (:func:`_lower_voice`), where the melody stays within a sixth
+  above it.
+
+Textures were added at the end (``right-voices`` with the third version of the ``parts`` task
+family, :data:`pianobot.music.tasks.VERSIONS`); a seed draws other pieces than before once one was.
 
 Every note carries its hand; none carries a finger (the planner fingers each hand).
 """
@@ -21,12 +27,17 @@ from pianobot.music.instrument import KeyboardSpec
 from pianobot.music.melodies import MelodyKey, random_melody
 from pianobot.music.piece import Note, Piece
 
-TEXTURES = ("bass", "broken", "block", "voices")
+TEXTURES = ("bass", "broken", "block", "voices", "right-voices")
 RIGHT_KEYS = KeyboardSpec(60, 24)
 """Where the melody lies: C4–B5."""
 LEFT_KEYS = KeyboardSpec(36, 24)
 """The accompaniment's octaves: its tonic is the key's in C2's octave, or the octave below from F#."""
 OCTAVE = 12
+LOWER_VOICE = (3, 7)
+"""The right hand's lower voice lies at least a minor third below every melody note it sounds
+under, and the melody at most a major sixth above it (within the three fingers' reach)."""
+LOWER_VOICE_FLOOR = 55
+"""The lowest note of the right hand's lower voice (G3): the left hand's bass stays below."""
 BPM_RANGE = (60.0, 120.0)
 BEATS_PER_BAR = 4
 _CADENCES = ((0, 3, 4, 0), (0, 1, 4, 0), (0, 5, 3, 4))
@@ -60,6 +71,24 @@ def _bar(texture: str, chord: tuple[int, int, int], next_root: int, start: float
     return held + [Note(start + i * beat, p, start + (i + 0.95) * beat, velocity) for i, p in enumerate(voice)]
 
 
+def _lower_voice(melody: list[Note], chord: tuple[int, int, int], start: float, end: float, velocity: int):
+    """The right hand's lower voice from ``start`` to ``end`` (a half bar): the highest tone of
+    ``chord`` (any octave, not below :data:`LOWER_VOICE_FLOOR`) at least a minor third under every
+    melody note sounding then, held through, if the melody stays within a sixth above it; else none."""
+    above = [n.pitch for n in melody if n.onset < end and n.offset > start]
+    if not above:
+        return []
+    under, over = LOWER_VOICE
+    tones = [
+        p
+        for p in range(LOWER_VOICE_FLOOR, min(above) - under + 1)
+        if any((p - c) % OCTAVE == 0 for c in chord)
+    ]
+    if not tones or max(above) - tones[-1] > over:
+        return []
+    return [Note(start, tones[-1], start + 0.95 * (end - start), velocity)]
+
+
 def random_duet(rng: np.random.Generator, texture: str | None = None, bpm: float | None = None) -> Piece:
     """One random two-hand piece (the module's notes); ``texture`` and ``bpm`` are drawn when None."""
     key = MelodyKey(int(rng.integers(12)), bool(rng.random() < 0.3))
@@ -73,11 +102,17 @@ def random_duet(rng: np.random.Generator, texture: str | None = None, bpm: float
     cadence = _CADENCES[int(rng.integers(len(_CADENCES)))]
     velocity = int(rng.integers(40, 90))
     left: list[Note] = []
+    lower: list[Note] = []
+    half = BEATS_PER_BAR * beat / 2
     for bar in range(bars):
         chord = _triad(key, cadence[bar % len(cadence)])
         next_root = _triad(key, cadence[(bar + 1) % len(cadence)])[0]
-        left += _bar(texture, chord, next_root, bar * BEATS_PER_BAR * beat, beat, velocity)
-    right = [Note(n.onset, n.pitch, n.offset, n.velocity, hand="right") for n in melody.notes]
+        start = bar * BEATS_PER_BAR * beat
+        left += _bar("bass" if texture == "right-voices" else texture, chord, next_root, start, beat, velocity)
+        if texture == "right-voices":
+            for t in (start, start + half):
+                lower += _lower_voice(list(melody.notes), chord, t, t + half, velocity)
+    right = [Note(n.onset, n.pitch, n.offset, n.velocity, hand="right") for n in (*melody.notes, *lower)]
     return Piece(tuple(right + [Note(n.onset, n.pitch, n.offset, n.velocity, hand="left") for n in left]), bpm=bpm)
 
 

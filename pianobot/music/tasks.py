@@ -32,15 +32,15 @@ instances are fingered by the fingering planner, which lies above the environmen
 drawn by :mod:`pianobot.agent.tasks` and handed to the environment as a sampler."""
 PARTS = "parts"
 """Our family of one hand's parts as two-hand music gives them: a random two-hand piece's right or
-left hand, whole (:mod:`pianobot.music.duets`: a melody, a bass line, broken or block chords, a
-held note under a moving voice), the left hand's mirrored onto the right's keys. Drawn, like
+left hand, whole (:mod:`pianobot.music.duets`: a melody, a melody over a held lower voice, a bass
+line, broken or block chords, a held note under a moving voice), the left hand's mirrored onto the right's keys. Drawn, like
 ``melody``, by :mod:`pianobot.agent.tasks`."""
 FAMILIES = TASKS + (MELODY, PARTS)
 """Every task family ``pianobot train --task`` trains on."""
-VERSIONS = {PARTS: 2}
+VERSIONS = {PARTS: 3}
 """The version of each family whose instances changed meaning (a family not named is at version 1):
 ``parts`` 2 draws one hand's whole part, where 1 drew a phrase of at most six notes of it or a
-melody phrase. A policy folder's key names a version after the first
+melody phrase; 3 draws from five textures, the fifth a right hand in two voices (``right-voices``). A policy folder's key names a version after the first
 (:func:`pianobot.agent.store.task_key`), so that a store keeps each version's policies apart."""
 BPM = 60.0
 FINGERS = (2, 3, 4)

@@ -335,21 +335,6 @@ def play_hands(
     keyboard = keyboard or (KeyboardSpec() if controller == "sac" else None)
     names = [h for h in HANDS if h in piece.hands]
     together = together and len(names) == 2
-    given = {name: _hand_options(options, name) for name in names}
-    by_hand = dict(given)
-    if controller == "sac" and "left" in by_hand:
-        by_hand["left"] = _left_default(given["left"], models, keyboard, fingers)
-
-    def planned(name: str, call: Callable, *args, **kwargs):
-        """``call`` with ``name``'s options; where the packaged left hand's policy does not fit the
-        phrase policies in ``models``, as if it had not been offered (so the packaged general policy is)."""
-        try:
-            return call(*args, **kwargs, **by_hand[name])
-        except SettingError:
-            if by_hand[name] is given[name]:
-                raise
-            return call(*args, **kwargs, **given[name])
-
     offset = piece.notes[0].onset if together else None  # (one timeline for both hands)
     parts = {}
     for name in names:
@@ -359,6 +344,23 @@ def play_hands(
         changes = tuple(str(w.message) for w in caught if issubclass(w.category, PianobotWarning))
         _warn_again(caught)
         parts[name] = (*prepared, changes)
+    given = {name: _hand_options(options, name) for name in names}
+    by_hand = dict(given)
+    if controller == "sac":
+        for name in names:
+            if name == "left" or polyphonic(parts[name][1]):
+                by_hand[name] = _parts_default(given[name], models, keyboard, fingers)
+
+    def planned(name: str, call: Callable, *args, **kwargs):
+        """``call`` with ``name``'s options; where the packaged parts policy does not fit the
+        phrase policies in ``models``, as if it had not been offered (so the packaged general policy is)."""
+        try:
+            return call(*args, **kwargs, **by_hand[name])
+        except SettingError:
+            if by_hand[name] is given[name]:
+                raise
+            return call(*args, **kwargs, **given[name])
+
     if together:
         plans = {
             name: planned(name, plan.plan_performance, part, controller, models, keyboard=window.keyboard, hand=fingers)
@@ -403,9 +405,29 @@ def _hand_options(options: dict, hand: str) -> dict:
     return {**options, "general_policy": policy.get(hand)}
 
 
-def _left_default(options: dict, models, keyboard: KeyboardSpec, fingers: HandSpec) -> dict:
-    """The left hand's options with the packaged left hand's policy
-    (:func:`~pianobot.agent.general.left_hand_policy`) where none was named for it (``general_policy``
+POLYPHONIC_SHARE = 0.1
+"""A hand's part is polyphonic when at least this share of its notes sound together with another
+(chords, a note held under a moving voice): the right hand's is then played by the parts policy,
+as the left hand's always is (:func:`play_hands`). Chosen on the validation sets and the two-hand
+examples (docs/benchmarks.md, "Two hands"): right hands in two voices played by the parts policy
+at note F1 0.809 against the melody policy's 0.771; a melody with a closing chord stays the melody
+policy's."""
+
+
+def polyphonic(part: Piece) -> bool:
+    """Whether at least :data:`POLYPHONIC_SHARE` of ``part``'s notes sound together with another."""
+    notes = sorted(part.notes, key=lambda n: n.onset)
+    together, reach = 0, float("-inf")  # reach: the latest offset of the notes before
+    for i, note in enumerate(notes):
+        later = i + 1 < len(notes) and notes[i + 1].onset < note.offset
+        together += later or reach > note.onset
+        reach = max(reach, note.offset)
+    return together >= POLYPHONIC_SHARE * len(notes) > 0
+
+
+def _parts_default(options: dict, models, keyboard: KeyboardSpec, fingers: HandSpec) -> dict:
+    """A hand's options with the packaged parts policy (:func:`~pianobot.agent.general.left_hand_policy`:
+    the left hand's, and a polyphonic right hand's) where none was named for it (``general_policy``
     for both hands, or by hand) and the general policy may play."""
     if not options.get("general", True) or options.get("general_policy") is not None:
         return options

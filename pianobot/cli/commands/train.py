@@ -70,6 +70,13 @@ def train(
         help="With --learner dagger: environment steps gathered in a round, after which the policy learns from every "
         "step gathered so far and is evaluated (a round ends at the first episode end after them).",
     ),
+    dagger_learning_rate: float = typer.Option(
+        DaggerConfig.learning_rate,
+        "--dagger-learning-rate",
+        help="With --learner dagger: Adam's step size at the run's first step; it falls along a cosine to "
+        f"{DaggerConfig.final_learning_rate:g} (or to this, if lower) at the last. Lower it to go on gently from "
+        "a trained policy (--general-policy).",
+    ),
     until_f1: Optional[float] = typer.Option(
         TrainConfig.until_f1,
         "--until-f1",
@@ -211,7 +218,12 @@ def train(
             actuated=tuple(j.strip() for j in joints.split(",") if j.strip()),
         )
     with option("--round-steps", round_steps):
-        dagger = DaggerConfig(round_steps=round_steps)
+        DaggerConfig(round_steps=round_steps)
+    with option("--dagger-learning-rate", dagger_learning_rate):
+        if not dagger_learning_rate > 0:
+            raise ValueError("a step size must be above 0")
+        final = min(DaggerConfig.final_learning_rate, dagger_learning_rate)
+        dagger = DaggerConfig(round_steps=round_steps, learning_rate=dagger_learning_rate, final_learning_rate=final)
     with option("--exploration-steps", exploration_steps):
         sac = SACConfig(exploration_steps=exploration_steps, actor=value(actor) or SACConfig.actor)
     with option():
