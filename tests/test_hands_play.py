@@ -156,7 +156,10 @@ def test_the_parts_familys_versions_train_into_folders_of_their_own(tmp_path):
     assert VERSIONS[PARTS] == 3 and job.folder.name == f"task-parts-v3-{store.config_hash(config)}"
     assert task_job(MELODY, config, tmp_path).folder.name.startswith("task-melody-")  # version 1: as before
     # earlier versions' policies trained with the same options are not taken for this version's
-    older = [tmp_path / f"task-parts-{store.config_hash(config)}", tmp_path / f"task-parts-v2-{store.config_hash(config)}"]
+    older = [
+        tmp_path / f"task-parts-{store.config_hash(config)}",
+        tmp_path / f"task-parts-v2-{store.config_hash(config)}",
+    ]
     for folder in older:
         folder.mkdir()
         (folder / store.MANIFEST_FILE).write_text("{}")

@@ -79,11 +79,7 @@ def _lower_voice(melody: list[Note], chord: tuple[int, int, int], start: float, 
     if not above:
         return []
     under, over = LOWER_VOICE
-    tones = [
-        p
-        for p in range(LOWER_VOICE_FLOOR, min(above) - under + 1)
-        if any((p - c) % OCTAVE == 0 for c in chord)
-    ]
+    tones = [p for p in range(LOWER_VOICE_FLOOR, min(above) - under + 1) if any((p - c) % OCTAVE == 0 for c in chord)]
     if not tones or max(above) - tones[-1] > over:
         return []
     return [Note(start, tones[-1], start + 0.95 * (end - start), velocity)]
