@@ -22,7 +22,9 @@ packaged ones, as ``pianobot play`` plays them: the melody policy on the right h
 policy on the left and on a polyphonic right hand; the model store is an empty folder;
 ``--general`` names the right hand's, and both hands' without ``--general-left``, which names the
 left's; ``--parts`` the parts policy, in its place on the hands it plays) and by the scripted pianist.
-A polyphonic part is played by its hand's player (the left hand's policy plays the left hands). Prints a
+A polyphonic part is played as ``play`` plays that hand of a two-hand file: by the parts policy (the
+packaged left hand's), the left hands and the right hands alike (``pianobot play`` of a one-hand
+file gives the melody policy a right hand, polyphonic or not). Prints a
 Markdown table per set: note F1 (whole piece, right hand, left hand), per-step key-press F1, note
 F1 with offsets, notes left outside the general policy's 24 keys, and the general policy's share
 of the scripted pianist's note F1.

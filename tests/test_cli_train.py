@@ -126,6 +126,7 @@ def test_train_with_the_dagger_learner_in_rounds_of_round_steps(tmp_path):
         (("--learner", "ppo"), ("'--learner'", "'ppo'", "'sac', 'dagger'")),
         (("--learner", "dagger", "--round-steps", "0"), ("--round-steps 0",)),
         (("--learner", "dagger", "--dagger-learning-rate", "0"), ("--dagger-learning-rate 0", "above 0")),
+        (("--learner", "dagger", "--dagger-learning-rate", "inf"), ("--dagger-learning-rate inf", "above 0")),
         (("--learner", "dagger", "--control", "torque", "--explore", "prior"), ("velocity or position",)),
     ):
         result = run("train", song, *QUICK, *args, "--models", tmp_path / "bad")

@@ -1,6 +1,7 @@
 """Both hands of a piece played (pianobot/perform/hands.py): in one simulation and hand by hand, and the random two-hand
 pieces they are measured on (pianobot/music/duets.py)."""
 
+import itertools
 import warnings
 
 import numpy as np
@@ -113,15 +114,26 @@ def test_random_duets_are_seeded_and_keep_the_hands_apart():
     assert duet_set(3, 4) == duet_set(3, 4) and duet_set(3, 4) != duet_set(4, 4)
     for texture in TEXTURES:
         piece = random_duet(np.random.default_rng(1), texture)
+        chords = max(len(c) for c in piece.part("left").chords())
+        assert chords == {"block": 3, "voices": 2}.get(texture, 1), texture
+    voiced = 0
+    for seed, texture in itertools.product(range(200), TEXTURES):
+        piece = random_duet(np.random.default_rng(seed), texture)
         left, right = piece.part("left"), piece.part("right")
         assert len(left) + len(right) == len(piece) and left.notes and right.notes
-        assert max(n.pitch for n in left.notes) < min(n.pitch for n in right.notes)
-        chords = max(len(c) for c in left.chords())
-        assert chords == {"block": 3, "voices": 2}.get(texture, 1), texture
-        # only a right hand in two voices holds a note while another sounds; its lower voice lies below
-        held = [(a, b) for a in right.notes for b in right.notes if a.onset < b.onset < a.offset]
-        assert bool(held) == (texture == "right-voices"), texture
-        assert all(a.pitch <= b.pitch - 3 or b.pitch <= a.pitch - 3 for a, b in held)
+        assert max(n.pitch for n in left.notes) < min(n.pitch for n in right.notes), seed  # never a shared key
+        # only a right hand in two voices holds a note while another sounds: its lower voice, a
+        # minor third to a fifth under each melody note it sounds with
+        held = [
+            (a, b)
+            for a in right.notes
+            for b in right.notes
+            if a.onset < b.onset < a.offset or a.onset == b.onset < a.pitch - b.pitch
+        ]
+        assert bool(held) <= (texture == "right-voices"), seed
+        assert all(3 <= abs(a.pitch - b.pitch) <= 7 for a, b in held), seed
+        voiced += bool(held)
+    assert voiced >= 150  # of the 200 right hands in two voices
 
 
 def test_the_parts_family_draws_fingered_whole_hand_parts_by_its_seed():

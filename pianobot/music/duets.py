@@ -10,11 +10,13 @@ a cadence (I, IV or ii, V, I, and again), in one of five textures drawn per piec
 - ``block``: the chord (root, third, fifth) held for two beats, on beats one and three;
 - ``voices``: a held root with a moving voice above it, a quarter a beat (two voices in one hand);
 - ``right-voices``: the bass line under a right hand in two voices: each half bar, a tone of the
-  bar's chord held under the melody (:func:`_lower_voice`), where the melody stays within a sixth
-  above it.
+  bar's chord held under the melody (:func:`_lower_voice`), where the melody stays a minor third
+  to a fifth above it (where it does not, that half bar has none: about a sixth of these pieces
+  have no lower voice at all).
 
-Textures were added at the end (``right-voices`` with the third version of the ``parts`` task
-family, :data:`pianobot.music.tasks.VERSIONS`); a seed draws other pieces than before once one was.
+Adding a texture changes what every seed draws (the textures are drawn from, and taken in turn
+by, their number): ``right-voices`` came with the third version of the ``parts`` task family
+(:data:`pianobot.music.tasks.VERSIONS`), and seeds drew other pieces before it.
 
 Every note carries its hand; none carries a finger (the planner fingers each hand).
 """
@@ -35,9 +37,10 @@ LEFT_KEYS = KeyboardSpec(36, 24)
 OCTAVE = 12
 LOWER_VOICE = (3, 7)
 """The right hand's lower voice lies at least a minor third below every melody note it sounds
-under, and the melody at most a major sixth above it (within the three fingers' reach)."""
+under, and the melody at most a fifth above it (within the three fingers' reach)."""
 LOWER_VOICE_FLOOR = 55
-"""The lowest note of the right hand's lower voice (G3): the left hand's bass stays below."""
+"""The lowest note of the right hand's lower voice (G3), and always above the piece's bass: the
+hands never share a key or cross."""
 BPM_RANGE = (60.0, 120.0)
 BEATS_PER_BAR = 4
 _CADENCES = ((0, 3, 4, 0), (0, 1, 4, 0), (0, 5, 3, 4))
@@ -71,15 +74,17 @@ def _bar(texture: str, chord: tuple[int, int, int], next_root: int, start: float
     return held + [Note(start + i * beat, p, start + (i + 0.95) * beat, velocity) for i, p in enumerate(voice)]
 
 
-def _lower_voice(melody: list[Note], chord: tuple[int, int, int], start: float, end: float, velocity: int):
+def _lower_voice(
+    melody: list[Note], chord: tuple[int, int, int], start: float, end: float, velocity: int, floor: int
+) -> list[Note]:
     """The right hand's lower voice from ``start`` to ``end`` (a half bar): the highest tone of
-    ``chord`` (any octave, not below :data:`LOWER_VOICE_FLOOR`) at least a minor third under every
-    melody note sounding then, held through, if the melody stays within a sixth above it; else none."""
+    ``chord`` (any octave, not below ``floor``) at least a minor third under every melody note
+    sounding then, held through, if the melody stays within a fifth above it; else none."""
     above = [n.pitch for n in melody if n.onset < end and n.offset > start]
     if not above:
         return []
     under, over = LOWER_VOICE
-    tones = [p for p in range(LOWER_VOICE_FLOOR, min(above) - under + 1) if any((p - c) % OCTAVE == 0 for c in chord)]
+    tones = [p for p in range(floor, min(above) - under + 1) if any((p - c) % OCTAVE == 0 for c in chord)]
     if not tones or max(above) - tones[-1] > over:
         return []
     return [Note(start, tones[-1], start + 0.95 * (end - start), velocity)]
@@ -98,16 +103,17 @@ def random_duet(rng: np.random.Generator, texture: str | None = None, bpm: float
     cadence = _CADENCES[int(rng.integers(len(_CADENCES)))]
     velocity = int(rng.integers(40, 90))
     left: list[Note] = []
-    lower: list[Note] = []
-    half = BEATS_PER_BAR * beat / 2
+    chords = [_triad(key, cadence[bar % len(cadence)]) for bar in range(bars + 1)]
     for bar in range(bars):
-        chord = _triad(key, cadence[bar % len(cadence)])
-        next_root = _triad(key, cadence[(bar + 1) % len(cadence)])[0]
-        start = bar * BEATS_PER_BAR * beat
-        left += _bar("bass" if texture == "right-voices" else texture, chord, next_root, start, beat, velocity)
-        if texture == "right-voices":
-            for t in (start, start + half):
-                lower += _lower_voice(list(melody.notes), chord, t, t + half, velocity)
+        accompaniment = "bass" if texture == "right-voices" else texture
+        left += _bar(accompaniment, chords[bar], chords[bar + 1][0], bar * BEATS_PER_BAR * beat, beat, velocity)
+    lower: list[Note] = []
+    if texture == "right-voices":
+        floor = max(LOWER_VOICE_FLOOR, max(n.pitch for n in left) + 1)
+        half = BEATS_PER_BAR * beat / 2
+        for bar in range(bars):
+            for t in (2 * bar * half, (2 * bar + 1) * half):
+                lower += _lower_voice(list(melody.notes), chords[bar], t, t + half, velocity, floor)
     right = [Note(n.onset, n.pitch, n.offset, n.velocity, hand="right") for n in (*melody.notes, *lower)]
     return Piece(tuple(right + [Note(n.onset, n.pitch, n.offset, n.velocity, hand="left") for n in left]), bpm=bpm)
 

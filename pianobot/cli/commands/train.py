@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import os
 import warnings
 from pathlib import Path
@@ -74,8 +75,7 @@ def train(
         DaggerConfig.learning_rate,
         "--dagger-learning-rate",
         help="With --learner dagger: Adam's step size at the run's first step; it falls along a cosine to "
-        f"{DaggerConfig.final_learning_rate:g} (or to this, if lower) at the last. Lower it to go on gently from "
-        "a trained policy (--general-policy).",
+        f"{DaggerConfig.final_learning_rate:g} (or to this, if lower) at the last.",
     ),
     until_f1: Optional[float] = typer.Option(
         TrainConfig.until_f1,
@@ -220,8 +220,8 @@ def train(
     with option("--round-steps", round_steps):
         DaggerConfig(round_steps=round_steps)
     with option("--dagger-learning-rate", dagger_learning_rate):
-        if not dagger_learning_rate > 0:
-            raise ValueError("a step size must be above 0")
+        if not 0 < dagger_learning_rate < math.inf:
+            raise ValueError("a step size must be a number above 0")
         final = min(DaggerConfig.final_learning_rate, dagger_learning_rate)
         dagger = DaggerConfig(round_steps=round_steps, learning_rate=dagger_learning_rate, final_learning_rate=final)
     with option("--exploration-steps", exploration_steps):
