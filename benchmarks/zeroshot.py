@@ -21,7 +21,8 @@ wrist guard, :mod:`pianobot.perform.guard`, with ``--wrist-guard``):
   until the next one sounds; :data:`SLURS`), seeded ``[38, index, draw]``: how long notes are held;
 - ``tasks``: ``--per-task`` instances of each of the paper's task families (seeds 0, 1, ...).
 
-Two-hand sets, both hands in one simulation as ``pianobot play`` plays them (:mod:`benchmarks.hands`,
+Two-hand sets, both hands in one simulation as ``pianobot play`` plays them, by the packaged
+policies one per hand unless ``--general`` names one for both (:mod:`benchmarks.hands`,
 its own table: note F1 of the whole piece and each hand, per-step key-press F1, note F1 with
 offsets, notes left out):
 
@@ -290,7 +291,8 @@ def main() -> None:
         "polyphonic": lambda: polyphonic_set(args.duet_seed + 1, args.polyphonic),
     }
     for name in (n for n in HAND_SETS if n in args.sets):
-        results[name] = hands.play_set(drawn[name](), general)
+        # as `pianobot play` plays a two-hand file: the packaged policies by hand unless --general names one
+        results[name] = hands.play_set(drawn[name](), args.general)
     print(f"general policy: {general}{' (wrist guard)' * args.wrist_guard}\n")
     if any(name in results for name in SETS):
         print(table({name: rows for name, rows in results.items() if name in SETS}))
