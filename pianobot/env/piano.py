@@ -85,7 +85,8 @@ SPEED_BOUND = 5.0
 
 
 def _bounded(values) -> np.ndarray:
-    return np.clip(np.asarray(values, dtype=np.float32), -SPEED_BOUND, SPEED_BOUND)
+    # (np.minimum of np.maximum is np.clip, at a third of its cost on a few numbers)
+    return np.minimum(np.maximum(np.asarray(values, dtype=np.float32), -SPEED_BOUND), SPEED_BOUND)
 
 
 TARGET_SCALE = 0.1
@@ -133,7 +134,7 @@ def finger_targets(
             targets[i, 3] = 1.0 - rows[0] / steps
             if velocity:
                 targets[i, 4] = window[rows[0], keys[0], VELOCITY]
-    return np.clip(targets, -SPEED_BOUND, SPEED_BOUND)
+    return np.minimum(np.maximum(targets, -SPEED_BOUND), SPEED_BOUND)
 
 
 def actuated_indices(config: "EnvConfig") -> np.ndarray:

@@ -235,10 +235,10 @@ class Planner:
             for key, finger, velocity in zip(keys, fingers, velocities):
                 if finger == finger_p or key == key_p:
                     before = max(before, strikes.release_steps(key_p, key, velocity) * strikes.dt)
-            lost = float(np.clip((before - slack) / note.duration, 0.0, 1.0))
+            lost = min(max((before - slack) / note.duration, 0.0), 1.0)
             # out of reach from the next wrist position: let go before the slowest strike's lead and the slide
             leap = (tuning.prepare_steps + lead) * strikes.dt
-            leap_lost = float(np.clip((leap - slack) / note.duration, 0.0, 1.0))
+            leap_lost = min(max((leap - slack) / note.duration, 0.0), 1.0)
             lost_by_wrist = np.where(self._reaches(key_p, finger_p), lost, max(lost, leap_lost))
             cost = cost + tuning.legato_cost * lost_by_wrist[None, :]
         return cost

@@ -143,7 +143,7 @@ class StrikePlanner:
         strike speed for the rest of the step and must stop short of the key's bottom
         (``hold_depth_margin`` past the strike depth), or the step's speed would drop."""
         room = self.tuning.hold_depth_margin - self.overshoot(tip_speed)  # below the strike depth
-        return float(np.clip(1.0 - room / (tip_speed * self.dt), 0.5, 1.0))
+        return float(min(max(1.0 - room / (tip_speed * self.dt), 0.5), 1.0))
 
     def ready_steps(self, tip_speed: float, depth: float) -> int:
         """Control steps of constant-speed travel from the ready height before the onset's step."""
@@ -246,7 +246,9 @@ class StrikePlanner:
         else:
             goal = -depth - self.overshoot(speed) + speed * self.dt * (start - 1 + point)
         floor = -depth - self.tuning.hold_depth_margin
-        return Plan(key, "strike", height=height, goal=float(np.clip(goal, floor, tip_height)), start=start, lead=steps)
+        return Plan(
+            key, "strike", height=height, goal=float(min(max(goal, floor), tip_height)), start=start, lead=steps
+        )
 
     def strike_reach(self, key: int) -> float:
         """Farthest the wrist may be from straight over ``key`` for a finger to strike it (m)."""
