@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import torch
-from conftest import assert_one_line_error, run
+from conftest import assert_one_line_error, midi_file, off, on, run
 
 from pianobot.agent import store
 from pianobot.agent.general import GENERAL_KEY, PACKAGED, describe
@@ -209,6 +209,40 @@ def test_play_uses_a_phrases_own_policy_then_the_general_policy_and_says_so(tmp_
     # a general policy trained in another environment than the phrase policies is refused
     other = run(*args, "--general-policy", ONE_NOTE_POLICY)
     assert_one_line_error(other, f"the general policy {ONE_NOTE_POLICY} was trained with env.", "--no-general")
+
+
+def test_train_a_two_hand_file_trains_each_hands_part_and_play_plays_what_was_judged(tmp_path, models):
+    """`train` of a two-hand file trains each hand's part as `play` gives it to that hand (the
+    left mirrored onto the general policy's keys), from the general policy `play` gives the hand,
+    then judges the whole piece, both hands in one simulation: `play` from each judging hand
+    start then plays exactly the judged note F1, never below the general policies' alone."""
+    general = next(models.glob(f"{GENERAL_KEY}-*"))
+
+    def track(*notes):  # (pitch, start beat, end beat), 0.5 s a beat
+        return [event for p, a, b in notes for event in ((a * 480, on(p)), (b * 480, off(p)))]
+
+    right, left = track((72, 0, 1), (74, 1, 2), (76, 2, 3)), track((48, 0, 2), (55, 2, 3))
+    song = midi_file(tmp_path / "duet.mid", [("Right Hand", right), ("Left Hand", left)])
+    result = run("train", song, *QUICK, "--models", models, "--json", "-")
+    assert result.exit_code == 0, result.output
+    said = " ".join(result.stderr.split())
+    assert f"starting the right hand's phrases from the general policy {general}" in said
+    assert f"starting the left hand's phrases from the general policy {general}" in said
+    assert "playing duet.mid whole (both hands) from hand starts 0, 1, 2" in said
+    summary = json.loads(result.stdout)
+    phrases = sorted(p for policy in summary["policies"] for p in policy["phrases"])
+    assert phrases == ["left 0", "right 0"]  # (each hand's part is one phrase)
+    verdict = summary["piece"]
+    assert all(a >= b for a, b in zip(verdict["f1_after"], verdict["f1_before"]))
+    for seed, judged in zip(verdict["seeds"], verdict["f1_after"]):
+        played = run("play", song, "-o", tmp_path / "out.mid", "--models", models, "--seed", seed, "--json", "-")
+        assert played.exit_code == 0, played.output
+        assert json.loads(played.stdout)["f1"] == pytest.approx(judged, abs=1e-9)
+    used = {key.split()[0] for key in verdict["used"]}
+    plans = json.loads((tmp_path / "out.report.json").read_text())["hands"]
+    for hand in ("right", "left"):  # a hand whose own policy was kept plays it
+        phrase = plans[hand]["plan"]["phrases"]["0"]
+        assert phrase.startswith("own policy") == (hand in used), (hand, phrase)
 
 
 def test_play_with_only_the_general_policy_plays_every_phrase_in_its_environment(tmp_path, models):

@@ -25,7 +25,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable
+from typing import Callable, TypeVar
 
 import numpy as np
 
@@ -37,7 +37,11 @@ from pianobot.errors import PianobotError
 from pianobot.music.phrases import Phrase
 from pianobot.music.piece import Piece
 from pianobot.perform.compose import find_policy
+from pianobot.perform.hands import perform_hands
 from pianobot.perform.plan import PerformancePlan, perform_plan, stretches_for
+
+Key = TypeVar("Key", int, str)
+"""A phrase: its number in a one-hand piece, '<hand> <number>' in a two-hand one."""
 
 JUDGE_SEEDS = (0, 1, 2)
 """Hand starts a whole piece is judged from: ``play``'s, never the training evaluations'."""
@@ -51,11 +55,11 @@ class Verdict:
     """Note F1 from each of :data:`JUDGE_SEEDS` with the general policy playing every phrase."""
     after: tuple[float, ...]
     """The same with the policies kept (``used``)."""
-    used: dict[int, str]
-    """Phrase number -> the folder of its own policy that plays it."""
-    dropped: dict[int, str]
-    """Phrase number -> why its own policy is not used."""
-    general_plays: tuple[int, ...]
+    used: dict[int | str, str]
+    """Phrase (its number; '<hand> <number>' in a two-hand piece) -> the folder of its own policy that plays it."""
+    dropped: dict[int | str, str]
+    """Phrase -> why its own policy is not used."""
+    general_plays: tuple[int | str, ...]
     """Phrases whose training kept its start, the general policy: no policy stored."""
 
     def to_dict(self) -> dict:
@@ -85,6 +89,60 @@ def _f1s(plan: PerformancePlan, seeds: tuple[int, ...]) -> tuple[float, ...]:
     return tuple(perform_plan(plan, seed).report().f1 for seed in seeds)
 
 
+def _mark_started(models: Path, started: dict[str, float], about: dict) -> None:
+    """Record in the store's index the phrases whose training kept the general policy ``about`` describes."""
+    store.mark_general_plays(
+        models,
+        {
+            name: {
+                "why": f"it played at note F1 {f1:.3f} before any training step, and no policy trained for it played better",
+                **about,
+            }
+            for name, f1 in started.items()
+        },
+    )
+
+
+def _settle(
+    own: dict[Key, Path],
+    f1s: Callable[[dict[Key, Path]], tuple[float, ...]],
+    on_play: Callable[[str], None],
+    name: Callable[[Key], str],
+) -> tuple[tuple[float, ...], tuple[float, ...], dict[Key, Path], dict[Key, str]]:
+    """Step 2 of the module's: (F1s before, F1s after, policies kept, why each other was dropped).
+    ``own``: every phrase's own policy that may play, by phrase; ``f1s(kept)``: the piece's note
+    F1 from each judging hand start with those policies; ``name(key)``: a phrase in words."""
+    on_play("the general policy alone")
+    before = current = f1s({})
+    kept: dict[Key, Path] = {}
+    dropped: dict[Key, str] = {}
+    for key, folder in own.items():
+        if folder in kept.values() or key in dropped:  # a repeated phrase shares its policy: judged once
+            continue
+        same = {k: f for k, f in own.items() if f == folder}  # every phrase this policy plays
+        on_play(f"{name(key)}'s own policy")
+        trial = f1s({**kept, **same})
+        if all(t >= c for t, c in zip(trial, current)) and sum(trial) > sum(current):
+            kept.update(same)
+            current = trial
+        else:
+            why = f"the piece played at mean note F1 {np.mean(trial):.3f} with it, {np.mean(current):.3f} without"
+            dropped.update(dict.fromkeys(same, why))
+    return before, current, kept, dropped
+
+
+def _mark_judged(models: Path, kept: dict, dropped: dict, own: dict, about: Callable[[object], dict]) -> None:
+    """Record the verdict in the store's index: a kept policy plays its phrases, a dropped one does not."""
+    store.mark_general_plays(
+        models,
+        {folder.name: None for folder in kept.values()}
+        | {
+            own[k].name: {"why": f"its own policy made the piece play worse: {why}", **about(k)}
+            for k, why in dropped.items()
+        },
+    )
+
+
 def settle_piece(
     piece: Piece,
     phrases: list[Phrase],
@@ -98,61 +156,82 @@ def settle_piece(
     folder names of the phrases whose runs kept their start (the general policy played them at
     step 0 as well as any policy trained for them), each with the note F1 it played at. ``on_play(what)`` is told before each whole-piece play."""
     about = describe(general)  # its folder and the SHA-256 of its weights
-    store.mark_general_plays(
-        models,
-        {
-            name: {
-                "why": f"it played at note F1 {f1:.3f} before any training step, and no policy trained for it played better",
-                **about,
-            }
-            for name, f1 in started.items()
-        },
-    )
+    _mark_started(models, started, about)
     config = policy_configs(general)[0]
-    own: dict[int, Path] = {}  # every phrase policy of the piece that can play beside the general policy
+    own = _own_policies(models, phrases, config)
+    at_start = {p.index for p in phrases if p.index not in own and find_policy(models, p) is None}
+
+    def f1s(kept: dict[int, Path]) -> tuple[float, ...]:
+        plan = PerformancePlan(piece, config, stretches_for(phrases, kept, general))
+        return tuple(perform_plan(plan, seed).report().f1 for seed in seeds)
+
+    before, after, kept, dropped = _settle(own, f1s, on_play, lambda number: f"phrase {number}")
+    _mark_judged(models, kept, dropped, own, lambda number: about)
+    return Verdict(
+        before=before,
+        after=after,
+        used={i: f.name for i, f in kept.items()},
+        dropped=dropped,
+        general_plays=tuple(sorted(at_start)),
+    )
+
+
+def _own_policies(models: Path, phrases: list[Phrase], config: EnvConfig) -> dict[int, Path]:
+    """Every phrase policy in ``models`` for ``phrases`` that can play beside a general policy of ``config``."""
+    own: dict[int, Path] = {}
     for phrase in phrases:
         folder = find_policy(models, phrase)
         if folder is not None and policy_configs(folder)[0] == config:
             own[phrase.index] = folder
-    at_start = {p.index for p in phrases if p.index not in own and find_policy(models, p) is None}
+    return own
 
-    def plan(kept: dict[int, Path]) -> PerformancePlan:
-        return PerformancePlan(piece, config, stretches_for(phrases, kept, general))
 
-    on_play("the general policy alone")
-    before = current = _f1s(plan({}), seeds)
-    kept: dict[int, Path] = {}
-    dropped: dict[int, str] = {}
-    for number, folder in own.items():
-        if folder in kept.values() or number in dropped:  # a repeated phrase shares its policy: judged once
-            continue
-        same = {i: f for i, f in own.items() if f == folder}  # every phrase this policy plays
-        on_play(f"phrase {number}'s own policy")
-        trial = _f1s(plan({**kept, **same}), seeds)
-        if all(t >= c for t, c in zip(trial, current)) and sum(trial) > sum(current):
-            kept.update(same)
-            current = trial
-        else:
-            dropped.update(
-                {
-                    i: (
-                        f"the piece played at mean note F1 {np.mean(trial):.3f} with it, {np.mean(current):.3f} without"
-                    )
-                    for i in same
-                }
-            )
-    store.mark_general_plays(
-        models,
-        {folder.name: None for folder in kept.values()}
-        | {
-            own[i].name: {"why": f"its own policy made the piece play worse: {why}", **about}
-            for i, why in dropped.items()
-        },
-    )
+def settle_hands(
+    piece: Piece,
+    parts: dict[str, tuple],
+    phrases: dict[str, list[Phrase]],
+    models: Path,
+    generals: dict[str, Path],
+    started: dict[str, dict[str, float]],
+    seeds: tuple[int, ...] = JUDGE_SEEDS,
+    on_play: Callable[[str], None] = lambda what: None,
+) -> Verdict:
+    """:func:`settle_piece` for a two-hand piece: the whole piece, both hands as ``pianobot play``
+    plays them (:func:`~pianobot.perform.hands.perform_hands`), is judged against the piece as
+    written, each hand's phrase policies beside that hand's general policy (``generals``).
+    ``parts``: :func:`~pianobot.perform.hands.prepare_parts`'; ``phrases`` and ``started`` by
+    hand. A policy that plays phrases of both hands is judged once, for all of them. The
+    verdict's phrases are named '<hand> <number>'."""
+    abouts = {hand: describe(general) for hand, general in generals.items()}
+    configs = {hand: policy_configs(general)[0] for hand, general in generals.items()}
+    for hand in parts:
+        _mark_started(models, started.get(hand, {}), abouts[hand])
+    own: dict[str, Path] = {}
+    at_start = []
+    for hand in parts:
+        mine = _own_policies(models, phrases[hand], configs[hand])
+        own |= {f"{hand} {number}": folder for number, folder in mine.items()}
+        at_start += [
+            f"{hand} {p.index}" for p in phrases[hand] if p.index not in mine and find_policy(models, p) is None
+        ]
+
+    def f1s(kept: dict[str, Path]) -> tuple[float, ...]:
+        plans = {}
+        for hand, part in parts.items():
+            mine = {int(k.split()[1]): f for k, f in kept.items() if k.split()[0] == hand}
+            plans[hand] = PerformancePlan(part[1], configs[hand], stretches_for(phrases[hand], mine, generals[hand]))
+        return tuple(perform_hands(piece, parts, plans, seed).report().f1 for seed in seeds)
+
+    def name(key: str) -> str:
+        hand, number = key.split()
+        return f"the {hand} hand's phrase {number}"
+
+    before, after, kept, dropped = _settle(own, f1s, on_play, name)
+    _mark_judged(models, kept, dropped, own, lambda key: abouts[key.split()[0]])
     return Verdict(
         before=before,
-        after=current,
-        used={i: f.name for i, f in kept.items()},
+        after=after,
+        used={k: f.name for k, f in kept.items()},
         dropped=dropped,
-        general_plays=tuple(sorted(at_start)),
+        general_plays=tuple(at_start),
     )

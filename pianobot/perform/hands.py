@@ -333,39 +333,81 @@ def play_hands(
         raise PianobotError(f"controller {controller!r}: both hands are played by 'sac' or 'scripted'")
     fingers = hand or HandSpec()
     keyboard = keyboard or (KeyboardSpec() if controller == "sac" else None)
-    names = [h for h in HANDS if h in piece.hands]
-    together = together and len(names) == 2
-    given = {name: _hand_options(options, name) for name in names}
-    offset = piece.notes[0].onset if together else None  # (one timeline for both hands)
+    together = together and len(piece.hands) == 2
+    parts = prepare_parts(piece, keyboard, fingers, together)
+    plans = plan_hands(parts, controller, models, fingers, options)
+    return perform_hands(piece, parts, plans, seed, together, on_step, video)
+
+
+def prepare_parts(
+    piece: Piece, keyboard: KeyboardSpec | None, fingers: HandSpec, together: bool = True
+) -> dict[str, tuple]:
+    """Each hand's part as :func:`play_hands` gives it to its player, by hand (right first):
+    (window, part, start, notes left out, changes), :func:`prepare_part`'s with the lines it
+    warned (each said once more here). ``together``: both parts on one timeline, from the
+    piece's first note (else each from its own)."""
+    offset = piece.notes[0].onset if together else None
     parts = {}
-    for name in names:
+    for name in (h for h in HANDS if h in piece.hands):
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", PianobotWarning)
             prepared = prepare_part(piece, name, keyboard, fingers, offset)
         changes = tuple(str(w.message) for w in caught if issubclass(w.category, PianobotWarning))
         _warn_again(caught)
         parts[name] = (*prepared, changes)
-    by_hand = dict(given)
-    if controller == "sac":
-        for name in names:
-            if name == "left" or polyphonic(parts[name][1]):
-                by_hand[name] = _parts_default(given[name], models, keyboard, fingers)
+    return parts
 
-    def planned(name: str, call: Callable, *args, **kwargs):
-        """``call`` with ``name``'s options; where the packaged parts policy does not fit the
-        phrase policies in ``models``, as if it had not been offered (so the packaged general policy is)."""
+
+def hand_players(parts: dict[str, tuple], controller: str, models, fingers: HandSpec, options: dict) -> dict[str, dict]:
+    """Each hand's options for its plan (:func:`~pianobot.perform.plan.plan_performance`): those
+    given (``general_policy`` may be a dict by hand), and, for 'sac', the packaged parts policy
+    on the left hand and on a :func:`polyphonic` right hand where no general policy was named."""
+    given = {name: _hand_options(options, name) for name in parts}
+    if controller != "sac":
+        return given
+    by_hand = dict(given)
+    for name, (window, part, *_) in parts.items():
+        if name == "left" or polyphonic(part):
+            by_hand[name] = _parts_default(given[name], models, window.keyboard, fingers)
+    return by_hand
+
+
+def plan_hands(
+    parts: dict[str, tuple], controller: str, models, fingers: HandSpec, options: dict
+) -> dict[str, plan.PerformancePlan]:
+    """Each hand's plan for its part, with :func:`hand_players`' options; where the packaged parts
+    policy does not fit the phrase policies in ``models``, as if it had not been offered (so the
+    general policy is)."""
+    given = {name: _hand_options(options, name) for name in parts}
+    by_hand = hand_players(parts, controller, models, fingers, options)
+    plans = {}
+    for name, (window, part, *_) in parts.items():
         try:
-            return call(*args, **kwargs, **by_hand[name])
+            plans[name] = plan.plan_performance(
+                part, controller, models, keyboard=window.keyboard, hand=fingers, **by_hand[name]
+            )
         except SettingError:
             if by_hand[name] is given[name]:
                 raise
-            return call(*args, **kwargs, **given[name])
+            plans[name] = plan.plan_performance(
+                part, controller, models, keyboard=window.keyboard, hand=fingers, **given[name]
+            )
+    return plans
 
+
+def perform_hands(
+    piece: Piece,
+    parts: dict[str, tuple],
+    plans: dict[str, plan.PerformancePlan],
+    seed: int = 0,
+    together: bool = True,
+    on_step: Callable[[int, int], None] | None = None,
+    video: bool = False,
+) -> HandsPerformance:
+    """Play each hand's plan from hand start ``seed``: both in one simulation where ``together``
+    allows it (else, said in one warning line, each in a simulation of its own)."""
+    together = together and len(parts) == 2
     if together:
-        plans = {
-            name: planned(name, plan.plan_performance, part, controller, models, keyboard=window.keyboard, hand=fingers)
-            for name, (window, part, *_) in parts.items()
-        }
         try:
             return _play_together(piece, parts, plans, seed, on_step, video)
         except HandsApart as e:
@@ -376,17 +418,7 @@ def play_hands(
         raise PianobotError("a video of both hands needs them in one simulation: play one hand for it")
     done = []
     for name, (window, part, start, left_out, changes) in parts.items():
-        performance = planned(
-            name,
-            plan.play,
-            part,
-            controller,
-            models,
-            seed=seed,
-            keyboard=window.keyboard,
-            hand=fingers,
-            on_step=on_step,
-        )
+        performance = plan.perform_plan(plans[name], seed, on_step=on_step)
         done.append(HandPerformance(name, window, part, start, left_out, performance, changes))
     return HandsPerformance(piece, tuple(done), seed)
 

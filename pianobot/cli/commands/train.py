@@ -22,6 +22,7 @@ from pianobot.cli.options import (
     Reading,
     Reward,
     Task,
+    both_hands,
     option,
     read_song,
     reads,
@@ -168,11 +169,12 @@ def train(
     from pianobot.agent.general import find_general
     from pianobot.agent.sac import resolve_device
     from pianobot.cli import display
-    from pianobot.learn.accept import JUDGE_SEEDS, judge_for, settle_piece
+    from pianobot.learn.accept import JUDGE_SEEDS, judge_for, settle_hands, settle_piece
     from pianobot.learn.jobs import general_start, phrase_jobs, plan_jobs, run_jobs, run_jobs_on_ray, task_job
     from pianobot.learn.log import LOG_FILE, PLOT_FILE
     from pianobot.learn.train import TASK_EVAL_EPISODES
     from pianobot.music.phrases import split_phrases
+    from pianobot.perform.hands import hand_players, prepare_parts
     from pianobot.sim.hand import HandConfig
     from pianobot.sim.keyboard import KeyboardConfig
 
@@ -249,7 +251,10 @@ def train(
     if general_policy is not None:
         find_general(models, path=general_policy)  # a folder that holds no policy: said before any work
     # where the run begins, before its folders are named: a run from a policy takes its networks
+    base = config
     config, start = general_start(config, models, general_policy, networks_given=actor is not None)
+    hands = both_hands(song, reading) if song is not None else None
+    groups = []  # (hand or None, its config, the policy its phrases start from, its jobs)
     if task is not None:
         job = task_job(task.value, config, models)
         refuse_training_into(general_policy, [job])
@@ -257,25 +262,54 @@ def train(
         label = f"task {task}"
         if start is not None and todo and store.checkpoint_state(job.folder) is None:  # (else it resumes, and says so)
             console.print(f"continuing the policy {said(start)} on {said(label)}: evaluated first", soft_wrap=True)
+        groups = [(None, config, start, todo)]
     else:
-        piece = read_song(song, reading.options, keyboard, hand)
-        phrases = split_phrases(piece, phrase_notes)
-        jobs = phrase_jobs(phrases, config, models, piece=song.name)
-        refuse_training_into(general_policy, jobs)
-        label = f"{song.name}: {len(phrases)} phrases"
-        if force or not all(store.is_trained(job.folder) for job in jobs):  # (before --force removes a policy)
-            if start is not None:
-                console.print(
-                    f"starting every phrase from the general policy {said(start)}: evaluated first, a phrase stops at "
-                    f"note F1 {config.stop_f1} (--no-from-general trains from scratch)",
-                    soft_wrap=True,
+        if hands is None:
+            piece = read_song(song, reading.options, keyboard, hand)
+            phrases = {None: split_phrases(piece, phrase_notes)}
+            groups = [(None, config, start, phrase_jobs(phrases[None], config, models, piece=song.name))]
+            label = f"{song.name}: {len(phrases[None])} phrases"
+        else:  # each hand's part as `play` gives it to its player, from the general policy play gives that hand
+            piece = hands.piece
+            parts = prepare_parts(piece, keyboard, hand)
+            named = {"general_policy": general_policy} if general_policy is not None else {}
+            players = hand_players(parts, "sac", models, hand, named)
+            phrases, seen = {}, {}
+            for name, (_, part, *_) in parts.items():
+                phrases[name] = split_phrases(part, phrase_notes)
+                hand_config, hand_start = general_start(
+                    base, models, players[name].get("general_policy"), networks_given=actor is not None
                 )
-            elif from_general:
-                console.print(
-                    f"[dim]no general policy in {said(models)} (`pianobot train --task parts` trains one): "
-                    "training from scratch[/dim]"
-                )
-        todo, done = plan_jobs(jobs, force)
+                jobs = []
+                for job in phrase_jobs(phrases[name], hand_config, models, piece=f"{song.name} ({name} hand)"):
+                    job.phrases = [f"{name} {number}" for number in job.phrases]
+                    if job.key in seen:  # the other hand's phrase too: one policy plays both
+                        seen[job.key].phrases += job.phrases
+                    else:
+                        seen[job.key] = job
+                        jobs.append(job)
+                groups.append((name, hand_config, hand_start, jobs))
+            label = f"{song.name}: " + ", ".join(f"{len(p)} phrases of the {h} hand" for h, p in phrases.items())
+        every_job = [job for *_, jobs in groups for job in jobs]
+        refuse_training_into(general_policy, every_job)
+        if force or not all(store.is_trained(job.folder) for job in every_job):  # (before --force removes a policy)
+            for name, group_config, group_start, _ in groups:
+                whose = "every phrase" if name is None else f"the {name} hand's phrases"
+                if group_start is not None:
+                    console.print(
+                        f"starting {whose} from the general policy {said(group_start)}: evaluated first, a phrase "
+                        f"stops at note F1 {group_config.stop_f1} (--no-from-general trains from scratch)",
+                        soft_wrap=True,
+                    )
+                elif from_general:
+                    console.print(
+                        f"[dim]no general policy in {said(models)} for {whose} (`pianobot train --task parts` trains "
+                        "one): training from scratch[/dim]"
+                    )
+        planned = [(name, c, s, *plan_jobs(jobs, force)) for name, c, s, jobs in groups]
+        groups = [(name, c, s, todo) for name, c, s, todo, _ in planned]
+        todo = [job for *_, jobs in groups for job in jobs]
+        done = [job for *_, jobs in planned for job in jobs]
     models.mkdir(parents=True, exist_ok=True)
     for job in done:
         console.print(
@@ -313,10 +347,12 @@ def train(
                 status = f"return {returns[key]:.1f}" + (f" | {status.split(' | ')[-1]}" if "eval" in status else "")
             bar.update(rows[key], completed=progress.step, status=status)
 
-        if cluster == "ray":
-            results = run_jobs_on_ray(todo, config, on_progress, threads=threads, start=start)
-        else:
-            results = run_jobs(todo, config, workers, on_progress, threads=threads, start=start)
+        results = {}
+        for _, group_config, group_start, jobs in groups:  # (one group, or each hand's phrases in turn)
+            if cluster == "ray":
+                results |= run_jobs_on_ray(jobs, group_config, on_progress, threads=threads, start=group_start)
+            else:
+                results |= run_jobs(jobs, group_config, workers, on_progress, threads=threads, start=group_start)
 
     def manifest(job) -> dict:  # what training left: a policy, or the store's word that the general policy plays it
         if job.key in results:
@@ -329,20 +365,31 @@ def train(
     console.print(display.training_table(trained))
     console.print(f"learning curves: {LOG_FILE} and {PLOT_FILE} in each policy's folder")
     verdict = None
-    judge = judge_for(models, config.env, start) if task is None and todo else None
-    if judge is not None:  # the whole piece, as play performs it: no phrase policy trained now makes it worse
-        started = {
-            job.folder.name: m["evaluation"]["f1"] for job, m in trained if job in todo and m.get("kept") == "start"
-        }
+    judges = {}  # the general policy each hand's phrases are judged beside: the one they started from, else play's
+    if task is None and todo:
+        for name, group_config, group_start, _ in groups:
+            named = players[name].get("general_policy") if hands is not None else None
+            judges[name] = group_start or named or judge_for(models, group_config.env, None)
+    if judges and all(
+        judges.values()
+    ):  # the whole piece, as play performs it: no phrase policy trained now makes it worse
+        started = {name: {} for name in judges}
+        for job, m in trained:
+            if job in todo and m.get("kept") == "start":
+                started[next(name for name, *_, jobs in groups if job in jobs)][job.folder.name] = m["evaluation"]["f1"]
         seeds = ", ".join(map(str, JUDGE_SEEDS))
         console.print(
-            f"playing {said(song.name)} whole from hand starts {seeds}, as `pianobot play` does, to judge its phrase policies"
+            f"playing {said(song.name)} whole{' (both hands)' if hands is not None else ''} from hand starts {seeds}, "
+            "as `pianobot play` does, to judge its phrase policies"
         )
-        verdict = settle_piece(piece, phrases, models, judge, started)
+        if hands is None:
+            verdict = settle_piece(piece, phrases[None], models, judges[None], started[None])
+        else:
+            verdict = settle_hands(piece, parts, phrases, models, judges, started)
         before, after = sum(verdict.before) / len(JUDGE_SEEDS), sum(verdict.after) / len(JUDGE_SEEDS)
         console.print(
-            f"{said(song.name)}: note F1 {before:.3f} with the general policy alone, {after:.3f} as it plays now "
-            f"(own policies for phrases {', '.join(map(str, verdict.used)) or 'none'})"
+            f"{said(song.name)}: note F1 {before:.3f} with the general polic{'y' if hands is None else 'ies'} alone, "
+            f"{after:.3f} as it plays now (own policies for phrases {', '.join(map(str, verdict.used)) or 'none'})"
         )
         for number, why in verdict.dropped.items():
             console.print(f"[yellow]phrase {number}'s own policy is not used: {said(why)}[/yellow]")
