@@ -43,7 +43,10 @@ from pianobot.sim.world import WorldConfig
 
 @reads()
 def train(
-    song: Optional[Path] = typer.Argument(None, help="A .mid file with fingering; leave out with --task."),
+    song: Optional[Path] = typer.Argument(
+        None,
+        help="A .mid file with fingering (a two-hand file, as play plays it: each hand's part); leave out with --task.",
+    ),
     task: Optional[Task] = typer.Option(
         None,
         "--task",
@@ -162,7 +165,7 @@ def train(
     phrase_notes: int = PhraseNotes,
     reading: Reading = None,
 ):
-    """Train one Soft Actor-Critic policy per phrase of a piece (or one for a task family) and store them."""
+    """Train one Soft Actor-Critic policy per phrase of a piece (each hand's, for a two-hand file; or one for a task family) and store them."""
     from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 
     from pianobot.agent import store
