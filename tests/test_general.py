@@ -245,6 +245,21 @@ def test_train_a_two_hand_file_trains_each_hands_part_and_play_plays_what_was_ju
         assert phrase.startswith("own policy") == (hand in used), (hand, phrase)
 
 
+def test_train_a_two_hand_file_with_options_the_packaged_policies_lack_trains_from_scratch(tmp_path):
+    """With no general policy in the store, the left hand would start from the packaged parts
+    policy; a run whose options it lacks (no touch) passes it over, as play does and as the
+    right hand passes over the packaged melody policy: both hands train from scratch."""
+    right = [e for p, a in ((72, 0), (74, 1)) for e in ((a * 480, on(p)), ((a + 1) * 480, off(p)))]
+    song = midi_file(tmp_path / "duet.mid", [("Right Hand", right), ("Left Hand", [(0, on(48)), (960, off(48))])])
+    result = run("train", song, *QUICK, "--models", tmp_path / "models")
+    assert result.exit_code == 0, result.output
+    said = " ".join(result.output.split())
+    for hand in ("right", "left"):
+        assert f"no general policy in {tmp_path / 'models'} for the {hand} hand's phrases" in said
+    assert "task-parts" not in said and "judge" not in said  # (no general policy fits: nothing to judge against)
+    assert len(list((tmp_path / "models").glob("*-*"))) == 2  # one policy per hand's phrase
+
+
 def test_play_with_only_the_general_policy_plays_every_phrase_in_its_environment(tmp_path, models):
     general = next(models.glob(f"{GENERAL_KEY}-*"))
     result = run("play", EXAMPLES / "three-note.mid", "-o", tmp_path / "out.mid", "--models", models)

@@ -218,3 +218,34 @@ def test_general_policies_may_be_given_by_hand(tmp_path):
     assert [h.performer for h in performance.hands] == [f"general policy {melody.name}"] * 2
     with pytest.raises(PianobotError, match="middle is not a hand"):
         play_hands(piece, "sac", tmp_path, general_policy={"middle": melody})
+
+
+def test_judging_both_hands_after_training_says_a_warning_of_its_plays_once(tmp_path, monkeypatch):
+    """`train`'s judgement plays the piece from three hand starts, and again for each phrase
+    policy: a warning those plays give (hands that cannot share one simulation) is said once."""
+    from types import SimpleNamespace
+
+    import pianobot.learn.accept as accept
+    from pianobot.agent.general import GENERAL_KEY, PACKAGED
+    from pianobot.music.phrases import split_phrases
+    from pianobot.perform.hands import prepare_parts
+
+    general = next(PACKAGED.glob(f"{GENERAL_KEY}-*"))
+    right = [Note(float(i), 72 + 2 * i, i + 1.0, 80, hand="right") for i in range(3)]
+    piece = Piece((*right, Note(0.0, 48, 2.0, 70, hand="left")), bpm=120)
+    parts = prepare_parts(piece, KeyboardSpec(), HandSpec())
+    phrases = {hand: split_phrases(part[1], 6) for hand, part in parts.items()}
+    plays = []
+
+    def apart(piece, parts, plans, seed):
+        plays.append(seed)
+        warnings.warn(PianobotWarning("the hands play apart"))
+        return SimpleNamespace(report=lambda: SimpleNamespace(f1=0.5))
+
+    monkeypatch.setattr(accept, "perform_hands", apart)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        verdict = accept.settle_hands(piece, parts, phrases, tmp_path, dict.fromkeys(parts, general), {})
+    assert plays == list(accept.JUDGE_SEEDS) and verdict.before == verdict.after == (0.5, 0.5, 0.5)
+    assert [str(w.message) for w in caught] == ["the hands play apart"]
+    assert verdict.general_plays == ("right 0", "left 0") and not verdict.used

@@ -23,6 +23,7 @@ nothing is judged: there is no other player to fall back on.
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable, TypeVar
@@ -220,13 +221,22 @@ def settle_hands(
         for hand, part in parts.items():
             mine = {int(k.split()[1]): f for k, f in kept.items() if k.split()[0] == hand}
             plans[hand] = PerformancePlan(part[1], configs[hand], stretches_for(phrases[hand], mine, generals[hand]))
-        return tuple(perform_hands(piece, parts, plans, seed).report().f1 for seed in seeds)
+        with warnings.catch_warnings(record=True) as caught:  # (said once, below, not once a play)
+            warnings.simplefilter("always")
+            f1 = tuple(perform_hands(piece, parts, plans, seed).report().f1 for seed in seeds)
+        for w in caught:
+            said.setdefault((w.category, str(w.message)), w.message)
+        return f1
+
+    said: dict = {}
 
     def name(key: str) -> str:
         hand, number = key.split()
         return f"the {hand} hand's phrase {number}"
 
     before, after, kept, dropped = _settle(own, f1s, on_play, name)
+    for message in said.values():
+        warnings.warn(message)
     _mark_judged(models, kept, dropped, own, lambda key: abouts[key.split()[0]])
     return Verdict(
         before=before,

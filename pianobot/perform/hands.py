@@ -387,7 +387,7 @@ def plan_hands(
                 part, controller, models, keyboard=window.keyboard, hand=fingers, **by_hand[name]
             )
         except SettingError:
-            if by_hand[name] is given[name]:
+            if by_hand[name] == given[name]:  # (nothing was offered: the error is the given options')
                 raise
             plans[name] = plan.plan_performance(
                 part, controller, models, keyboard=window.keyboard, hand=fingers, **given[name]

@@ -32,7 +32,7 @@ from pianobot.cli.options import (
 from pianobot.cli.terminal import err, out, said, write_json
 from pianobot.env.piano import EnvConfig
 from pianobot.env.rewards import RewardConfig
-from pianobot.errors import PianobotError, PianobotWarning
+from pianobot.errors import PianobotError, PianobotWarning, SettingError
 from pianobot.files import check_writable
 from pianobot.learn.config import MAX_ENVS, DaggerConfig, TrainConfig
 from pianobot.learn.explore import EXPLORATIONS
@@ -277,16 +277,20 @@ def train(
             parts = prepare_parts(piece, keyboard, hand)
             named = {"general_policy": general_policy} if general_policy is not None else {}
             players = hand_players(parts, "sac", models, hand, named)
-            phrases, seen = {}, {}
+            phrases, seen, offered = {}, {}, {}
             for name, (_, part, *_) in parts.items():
                 phrases[name] = split_phrases(part, phrase_notes)
-                hand_config, hand_start = general_start(
-                    base, models, players[name].get("general_policy"), networks_given=actor is not None
-                )
+                offered[name] = players[name].get("general_policy")
+                if offered[name] != general_policy:  # the packaged parts policy, which play offers only where it fits
+                    try:
+                        find_general(models, base.env, base.sac if actor is not None else None, offered[name])
+                    except SettingError:
+                        offered[name] = general_policy
+                hand_config, hand_start = general_start(base, models, offered[name], networks_given=actor is not None)
                 jobs = []
                 for job in phrase_jobs(phrases[name], hand_config, models, piece=f"{song.name} ({name} hand)"):
                     job.phrases = [f"{name} {number}" for number in job.phrases]
-                    if job.key in seen:  # the other hand's phrase too: one policy plays both
+                    if job.key in seen:  # the other hand's phrase too: one policy (the right hand's start's) plays both
                         seen[job.key].phrases += job.phrases
                     else:
                         seen[job.key] = job
@@ -371,7 +375,7 @@ def train(
     judges = {}  # the general policy each hand's phrases are judged beside: the one they started from, else play's
     if task is None and todo:
         for name, group_config, group_start, _ in groups:
-            named = players[name].get("general_policy") if hands is not None else None
+            named = offered[name] if hands is not None else None
             judges[name] = group_start or named or judge_for(models, group_config.env, None)
     if judges and all(
         judges.values()
