@@ -177,7 +177,6 @@ def train(
     from pianobot.learn.log import LOG_FILE, PLOT_FILE
     from pianobot.learn.train import TASK_EVAL_EPISODES
     from pianobot.music.phrases import split_phrases
-    from pianobot.perform.hands import hand_players, prepare_parts
     from pianobot.sim.hand import HandConfig
     from pianobot.sim.keyboard import KeyboardConfig
 
@@ -274,28 +273,9 @@ def train(
             label = f"{song.name}: {len(phrases[None])} phrases"
         else:  # each hand's part as `play` gives it to its player, from the general policy play gives that hand
             piece = hands.piece
-            parts = prepare_parts(piece, keyboard, hand)
-            named = {"general_policy": general_policy} if general_policy is not None else {}
-            players = hand_players(parts, "sac", models, hand, named)
-            phrases, seen, offered = {}, {}, {}
-            for name, (_, part, *_) in parts.items():
-                phrases[name] = split_phrases(part, phrase_notes)
-                offered[name] = players[name].get("general_policy")
-                if offered[name] != general_policy:  # the packaged parts policy, which play offers only where it fits
-                    try:
-                        find_general(models, base.env, base.sac if actor is not None else None, offered[name])
-                    except SettingError:
-                        offered[name] = general_policy
-                hand_config, hand_start = general_start(base, models, offered[name], networks_given=actor is not None)
-                jobs = []
-                for job in phrase_jobs(phrases[name], hand_config, models, piece=f"{song.name} ({name} hand)"):
-                    job.phrases = [f"{name} {number}" for number in job.phrases]
-                    if job.key in seen:  # the other hand's phrase too: one policy (the right hand's start's) plays both
-                        seen[job.key].phrases += job.phrases
-                    else:
-                        seen[job.key] = job
-                        jobs.append(job)
-                groups.append((name, hand_config, hand_start, jobs))
+            parts, phrases, offered, groups = _hand_groups(
+                piece, song.name, models, base, general_policy, phrase_notes, keyboard, hand, actor is not None
+            )
             label = f"{song.name}: " + ", ".join(f"{len(p)} phrases of the {h} hand" for h, p in phrases.items())
         every_job = [job for *_, jobs in groups for job in jobs]
         refuse_training_into(general_policy, every_job)
@@ -414,3 +394,40 @@ def train(
             for job, manifest in trained
         ]
         write_json(json_path, {"policies": summary, **({"piece": verdict.to_dict()} if verdict else {})})
+
+
+def _hand_groups(
+    piece, name: str, models: Path, base, general_policy, phrase_notes, keyboard, hand, networks_given: bool
+):
+    """A two-hand piece's training, hand by hand: (each hand's part as ``play`` gives it to that hand
+    (:func:`~pianobot.perform.hands.prepare_parts`), its phrases, the general policy ``play`` gives
+    it, and the groups to train: (hand, config, start policy, jobs)). ``base``: the run's config
+    before a start policy was picked. A phrase both hands play is one job, in the right hand's group."""
+    from pianobot.agent.general import find_general
+    from pianobot.learn.jobs import general_start, phrase_jobs
+    from pianobot.music.phrases import split_phrases
+    from pianobot.perform.hands import hand_players, prepare_parts
+
+    parts = prepare_parts(piece, keyboard, hand)
+    named = {"general_policy": general_policy} if general_policy is not None else {}
+    players = hand_players(parts, "sac", models, hand, named)
+    phrases, offered, seen, groups = {}, {}, {}, []
+    for side, (_, part, *_) in parts.items():
+        phrases[side] = split_phrases(part, phrase_notes)
+        offered[side] = players[side].get("general_policy")
+        if offered[side] != general_policy:  # the packaged parts policy, which play offers only where it fits
+            try:
+                find_general(models, base.env, base.sac if networks_given else None, offered[side])
+            except SettingError:
+                offered[side] = general_policy
+        config, start = general_start(base, models, offered[side], networks_given=networks_given)
+        jobs = []
+        for job in phrase_jobs(phrases[side], config, models, piece=f"{name} ({side} hand)"):
+            job.phrases = [f"{side} {number}" for number in job.phrases]
+            if job.key in seen:  # the other hand's phrase too: one policy (from the right hand's start) plays both
+                seen[job.key].phrases += job.phrases
+            else:
+                seen[job.key] = job
+                jobs.append(job)
+        groups.append((side, config, start, jobs))
+    return parts, phrases, offered, groups
