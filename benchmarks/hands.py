@@ -2,7 +2,8 @@
 beside the scripted pianist, against the pieces as written.
 
     python -m benchmarks.hands [--duets 50] [--seed 35] [--polyphonic 20] [--general DIR]
-                               [--general-left DIR] [--parts DIR] [--apart] [--json out.json]
+                               [--general-left DIR] [--parts DIR] [--apart] [--no-hold-guard]
+                               [--examples [FOLDER]] [--json out.json]
 
 (``python -m benchmarks.zeroshot --sets duets polyphonic`` plays the same sets beside the
 one-hand ones.)
@@ -14,14 +15,17 @@ Sets:
   hand in two voices over a bass line; 60-120 bpm, every key); no training run draws from them;
 - ``polyphonic``: one hand's part alone of ``--polyphonic`` further duets (seed ``--seed`` + 1),
   in turn the left hand's with block chords, the left hand's in two voices, the right hand's in
-  two voices: chords, and a held note under a moving voice.
+  two voices: chords, and a held note under a moving voice;
+- with ``--examples``: the two-hand files of a folder (``examples/midi``), as ``pianobot play``
+  reads and plays them, against each file; the general policies from hand starts 0, 1 and 2.
 
 Each piece is played once from hand start 0, both hands in one simulation as ``pianobot play``
 plays them (``--apart``: each hand in a simulation of its own), by the general policy (the
 packaged ones, as ``pianobot play`` plays them: the melody policy on the right hand, the parts
 policy on the left and on a polyphonic right hand; the model store is an empty folder;
 ``--general`` names the right hand's, and both hands' without ``--general-left``, which names the
-left's; ``--parts`` the parts policy, in its place on the hands it plays) and by the scripted pianist.
+left's; ``--parts`` the parts policy, in its place on the hands it plays; through the hold guard,
+as ``play`` plays them, unless ``--no-hold-guard``) and by the scripted pianist.
 A polyphonic part is played as ``play`` plays that hand of a two-hand file: by the parts policy (the
 packaged left hand's), the left hands and the right hands alike (``pianobot play`` of a one-hand
 file gives the melody policy a right hand, polyphonic or not). Prints a
@@ -37,6 +41,7 @@ import json
 import tempfile
 import time
 import warnings
+from pathlib import Path
 
 import numpy as np
 import torch
@@ -44,20 +49,26 @@ import torch
 from pianobot.errors import PianobotWarning
 from pianobot.music.duets import duet_set, random_duet
 from pianobot.music.instrument import HandSpec, KeyboardSpec
+from pianobot.music.load import LoadOptions
 from pianobot.music.piece import HANDS
-from pianobot.perform.hands import play_hands, polyphonic, prepare_part
+from pianobot.perform.hands import play_hands, polyphonic, prepare_part, two_hands
 
 PLAYERS = ("sac", "scripted")
 POLYPHONIC = ("block", "voices", "right-voices")
 """The textures of the polyphonic parts, in turn (the right hand's part of ``right-voices``, else the left's)."""
 NAMES = {"sac": "general", "scripted": "scripted"}
+EXAMPLE_STARTS = (0, 1, 2)
+"""Hand starts (``pianobot play --seed``) the general policies play each two-hand example from."""
 
 
-def figures(piece, controller: str, models, general=None, together: bool = True) -> dict:
+def figures(
+    piece, controller: str, models, general=None, together: bool = True, hold_guard: bool | None = None, seed: int = 0
+) -> dict:
     options = {"general_policy": general} if controller == "sac" and general is not None else {}
+    options["hold_guard"] = hold_guard
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", PianobotWarning)  # the left-out counts are in the figures
-        performance = play_hands(piece, controller, models, together=together, **options)
+        performance = play_hands(piece, controller, models, seed=seed, together=together, **options)
     whole = performance.report()
     out = {
         "f1": whole.f1,
@@ -121,19 +132,65 @@ def with_parts(piece, general, parts):
     return by_hand
 
 
-def play_set(pieces, general=None, together: bool = True, parts=None) -> list[dict]:
+def play_set(pieces, general=None, together: bool = True, parts=None, hold_guard: bool | None = None) -> list[dict]:
     """Every piece of a set played by both players: one row of figures per piece (``parts``: the
-    parts policy, :func:`with_parts`)."""
+    parts policy, :func:`with_parts`; ``hold_guard``: the general policies through the hold guard,
+    as ``pianobot play`` plays them)."""
     rows = []
     with tempfile.TemporaryDirectory() as models:
         for label, piece in pieces:
             piece = piece if piece.hands else piece.with_hands("left")
             row = {"piece": label, "notes": len(piece)}
             policies = with_parts(piece, general, parts)
-            row.update({player: figures(piece, player, models, policies, together) for player in PLAYERS})
+            row.update({player: figures(piece, player, models, policies, together, hold_guard) for player in PLAYERS})
             rows.append(row)
             print(f"{label}: general {row['sac']['f1']:.3f}, scripted {row['scripted']['f1']:.3f}", flush=True)
     return rows
+
+
+def example_set(folder: Path) -> list[tuple[str, object]]:
+    """The files in ``folder`` that ``pianobot play`` plays with both hands, each as it reads them."""
+    out = []
+    for path in sorted(folder.glob("*.mid")):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", PianobotWarning)
+            reading = two_hands(path, LoadOptions())
+        if reading is not None:
+            out.append((path.stem, reading.piece))
+    return out
+
+
+def play_examples(pieces, general=None, hold_guard: bool | None = None, starts=EXAMPLE_STARTS) -> list[dict]:
+    """Each two-hand example as ``pianobot play`` plays it: the general policies from each of
+    ``starts`` (hand starts: ``--seed``), the scripted pianist from 0."""
+    rows = []
+    with tempfile.TemporaryDirectory() as models:
+        for label, piece in pieces:
+            general_f1 = [figures(piece, "sac", models, general, True, hold_guard, s)["f1"] for s in starts]
+            scripted = figures(piece, "scripted", models)["f1"]
+            rows.append({"piece": label, "notes": len(piece), "sac": general_f1, "scripted": scripted})
+            print(f"{label}: general {', '.join(f'{f:.3f}' for f in general_f1)}; scripted {scripted:.3f}", flush=True)
+    return rows
+
+
+def example_table(rows: list[dict], starts=EXAMPLE_STARTS) -> str:
+    lines = [
+        f"**two-hand examples** (against each file; the general policies from hand starts {', '.join(map(str, starts))})",
+        "",
+        "| example | notes | general policies | mean | scripted pianist |",
+        "| --- | ---: | --- | ---: | ---: |",
+    ]
+    for r in rows:
+        values = ", ".join(f"{f:.3f}" for f in r["sac"])
+        lines.append(f"| `{r['piece']}` | {r['notes']} | {values} | {np.mean(r['sac']):.3f} | {r['scripted']:.3f} |")
+    means = [np.mean(r["sac"]) for r in rows]
+    lines.append(
+        f"| mean | | | {np.mean(means):.3f} | {np.mean([r['scripted'] for r in rows]):.3f} |"
+        if rows
+        else "| (none) | | | | |"
+    )
+    lines += ["", f"examples whose mean is at least 0.9: {sum(m >= 0.9 for m in means)} of {len(rows)}", ""]
+    return "\n".join(lines)
 
 
 def main() -> None:
@@ -152,6 +209,20 @@ def main() -> None:
         "left hand's policy (overrides --general and --general-left for them)",
     )
     parser.add_argument("--apart", action="store_true", help="each hand in a simulation of its own")
+    parser.add_argument(
+        "--examples",
+        type=Path,
+        nargs="?",
+        const=Path("examples/midi"),
+        help="also play the two-hand files of this folder (default examples/midi) from hand starts 0-2, as "
+        "`pianobot play` plays them, against each file",
+    )
+    parser.add_argument(
+        "--hold-guard",
+        action=argparse.BooleanOptionalAction,
+        help="the general policies through the hold guard, or (--no-hold-guard) alone; default: as `pianobot play` "
+        "plays them (the parts policy through it, the melody policy alone)",
+    )
     parser.add_argument("--json", help="write every piece's figures here")
     args = parser.parse_args()
     torch.set_num_threads(1)
@@ -165,8 +236,12 @@ def main() -> None:
         if not pieces:
             continue
         general = {"right": args.general, "left": args.general_left} if args.general_left else args.general
-        results[name] = play_set(pieces, general, not args.apart, args.parts)
+        results[name] = play_set(pieces, general, not args.apart, args.parts, args.hold_guard)
         print(table(name, results[name]), flush=True)
+    if args.examples is not None:
+        general = {"right": args.general, "left": args.general_left} if args.general_left else args.general
+        results["examples"] = play_examples(example_set(args.examples), general, args.hold_guard)
+        print(example_table(results["examples"]), flush=True)
     print(f"{time.perf_counter() - started:.0f} s")
     if args.json:
         with open(args.json, "w") as f:

@@ -3,11 +3,12 @@
     python -m benchmarks.zeroshot [--general DIR] [--melodies 50] [--seed 2026] [--per-task 10]
                                   [--sets examples melodies articulation tasks duets polyphonic]
                                   [--duets 50] [--duet-seed 35] [--polyphonic 20] [--wrist-guard]
-                                  [--json out.json] [--plot docs/zeroshot.png]
+                                  [--hold-guard | --no-hold-guard] [--json out.json] [--plot docs/zeroshot.png]
 
 One-hand sets, each played in one continuous simulation per piece, from hand start 0, as
 ``pianobot play`` plays a piece no phrase policy was trained for (the general policy, through the
-wrist guard, :mod:`pianobot.perform.guard`, with ``--wrist-guard``):
+wrist guard, :mod:`pianobot.perform.guard`, with ``--wrist-guard``, and through the hold guard
+where ``play`` plays it through one, or as ``--hold-guard``/``--no-hold-guard`` say):
 
 - ``examples``: the one-hand example songs (their own fingering), split into phrases as
   ``pianobot play`` splits them, every phrase played by the general policy (no phrase policy is
@@ -66,7 +67,7 @@ from pianobot.music.piece import Piece
 from pianobot.music.tasks import TASKS, make_task
 from pianobot.perform.compose import CompositionalController
 from pianobot.perform.perform import PLAY_CONFIG, perform
-from pianobot.perform.plan import assign
+from pianobot.perform.plan import assign, guarded_family
 from pianobot.pianist.fingering import ensure_fingering
 
 EXAMPLES = ("c-major-scale", "mary", "ode-to-joy", "twinkle", "one-note", "three-note", "six-note", "rhythmic", "chord")
@@ -104,12 +105,14 @@ def placed_hits(phrases, rollout) -> list[tuple[int, int, bool]]:
     return out
 
 
-def play_both(piece: Piece, general: Path, empty: Path, guard: bool = False) -> dict:
-    """The general policy's and the scripted pianist's figures on ``piece``."""
+def play_both(piece: Piece, general: Path, empty: Path, guard: bool = False, hold: bool | None = None) -> dict:
+    """The general policy's and the scripted pianist's figures on ``piece`` (``guard``, ``hold``: the
+    general policy through the wrist guard, the hold guard; None: as ``pianobot play`` plays it)."""
+    hold = guarded_family(general) if hold is None else hold
     env_config, _ = policy_configs(general)
     phrases = split_phrases(piece, DEFAULT_MAX_NOTES)
     policy = perform(
-        piece, lambda env: CompositionalController(env, assign(phrases, empty, general), guard), env_config
+        piece, lambda env: CompositionalController(env, assign(phrases, empty, general), guard, hold), env_config
     )
     scripted = perform(piece, "scripted", PLAY_CONFIG)
     return {
@@ -269,6 +272,12 @@ def main() -> None:
     parser.add_argument("--duet-seed", type=int, default=35, help="their seed (the polyphonic parts': one more)")
     parser.add_argument("--polyphonic", type=int, default=20, help="one hand's polyphonic parts (default 20)")
     parser.add_argument("--wrist-guard", action="store_true", help="play the general policy through the wrist guard")
+    parser.add_argument(
+        "--hold-guard",
+        action=argparse.BooleanOptionalAction,
+        help="the general policies through the hold guard, or (--no-hold-guard) alone; default: as `pianobot play` "
+        "plays them (the parts policy through it, the melody policy alone)",
+    )
     parser.add_argument("--json", help="write every piece's figures here")
     parser.add_argument("--plot", help="draw every piece's note F1 to this PNG")
     args = parser.parse_args()
@@ -284,7 +293,8 @@ def main() -> None:
     with tempfile.TemporaryDirectory() as empty:
         for name, pieces in sets.items():
             results[name] = [
-                {"piece": label, **play_both(piece, general, Path(empty), args.wrist_guard)} for label, piece in pieces
+                {"piece": label, **play_both(piece, general, Path(empty), args.wrist_guard, args.hold_guard)}
+                for label, piece in pieces
             ]
     drawn = {
         "duets": lambda: duet_set(args.duet_seed, args.duets),
@@ -292,8 +302,10 @@ def main() -> None:
     }
     for name in (n for n in HAND_SETS if n in args.sets):
         # as `pianobot play` plays a two-hand file: the packaged policies by hand unless --general names one
-        results[name] = hands.play_set(drawn[name](), args.general)
-    print(f"general policy: {general}{' (wrist guard)' * args.wrist_guard}\n")
+        results[name] = hands.play_set(drawn[name](), args.general, hold_guard=args.hold_guard)
+    held = guarded_family(general) if args.hold_guard is None else args.hold_guard
+    guards = [name for name, on in (("wrist guard", args.wrist_guard), ("hold guard", held)) if on]
+    print(f"general policy: {general}" + (f" ({', '.join(guards)})" if guards else "") + "\n")
     if any(name in results for name in SETS):
         print(table({name: rows for name, rows in results.items() if name in SETS}))
     for name in (n for n in HAND_SETS if n in results):
@@ -306,7 +318,13 @@ def main() -> None:
     if args.json:
         with open(args.json, "w") as f:
             json.dump(
-                {"general": str(general), "wrist_guard": args.wrist_guard, "rejected": rejected, **results},
+                {
+                    "general": str(general),
+                    "wrist_guard": args.wrist_guard,
+                    "hold_guard": args.hold_guard,
+                    "rejected": rejected,
+                    **results,
+                },
                 f,
                 indent=1,
             )

@@ -320,3 +320,19 @@ def test_the_left_hand_plays_the_packaged_left_policy_unless_left_policy_names_a
     assert_one_line_error(refused, "--controller scripted")
     refused = run("play", song, "-o", tmp_path / "x.mid", "--left-policy", models)  # a folder without a policy
     assert_one_line_error(refused, "--left-policy", "not a trained policy folder")
+
+
+def test_the_left_hands_policy_plays_through_the_hold_guard_unless_told(tmp_path):
+    """By default the packaged left hand's policy (a `--task parts` one) plays through the hold guard
+    and the melody policy on the right hand alone; --hold-guard guards both, --no-hold-guard neither.
+    The left hand holds C3 and G3 for two beats each: the guard's teacher held them."""
+    song = _duet(tmp_path / "duet.mid")
+    expected = {(): (False, True), ("--hold-guard",): (True, True), ("--no-hold-guard",): (False, False)}
+    for flags, (right, left) in expected.items():
+        result = run("play", song, "-o", tmp_path / "out.mid", "--models", tmp_path / "empty", *flags)
+        assert result.exit_code == 0, result.output
+        hands = json.loads((tmp_path / "out.report.json").read_text())["hands"]
+        assert hands["right"]["performer"].startswith("general policy task-melody")
+        assert hands["left"]["performer"].startswith("general policy task-parts")
+        assert [hands[h]["hold_guard"]["on"] for h in ("right", "left")] == [right, left]
+        assert (hands["left"]["hold_guard"]["held_finger_steps"] > 10) is left

@@ -307,13 +307,17 @@ def test_the_general_policy_plays_its_consecutive_phrases_as_one_section(tmp_pat
 
     song = write_midi(piece, tmp_path / "song.mid")
     args = ("play", song, "-o", tmp_path / "out.mid", "--models", models, "--phrase-notes", "1")
-    for flag in ("--wrist-guard", "--no-wrist-guard"):
-        result = run(*args, flag)
+    for wrist, hold in (("--wrist-guard", "--no-hold-guard"), ("--no-wrist-guard", "--hold-guard")):
+        result = run(*args, wrist, hold)
         assert result.exit_code == 0, result.output
         report = json.loads((tmp_path / "out.report.json").read_text())
         assert [report["phrases"][k].split()[0] for k in "01234"] == ["general"] * 2 + ["own"] + ["general"] * 2
         guard = report["wrist_guard"]
-        assert guard == {"on": False, "slowed_steps": 0} if flag == "--no-wrist-guard" else guard["on"] is True
+        assert guard == {"on": False, "slowed_steps": 0} if wrist == "--no-wrist-guard" else guard["on"] is True
+        held = report["hold_guard"]
+        assert held == {"on": False, "held_finger_steps": 0} if hold == "--no-hold-guard" else held["on"] is True
+        if hold == "--hold-guard":  # C4 and G4 are held for a second and more: the guard held them
+            assert held["held_finger_steps"] > 20
 
 
 def test_the_options_default_to_the_training_configuration_and_say_what_they_do():
@@ -328,6 +332,9 @@ def test_the_options_default_to_the_training_configuration_and_say_what_they_do(
     assert "evaluate it before any training step" in train["from_general"].help
     play = {p.name: p.default for p in commands["play"].params}
     assert play["use_general"] is True and play["general_policy"] is None and play["wrist_guard"] is False
+    from pianobot.perform.plan import PerformancePlan
+
+    assert play["hold_guard"] is PerformancePlan.hold_guard is None
 
 
 def test_a_phrase_trained_from_the_general_policy_takes_its_actor(tmp_path):

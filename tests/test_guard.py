@@ -1,5 +1,6 @@
-"""The wrist guard (pianobot/perform/guard.py): a policy's wrist slides no faster than the scripted
-pianist's while a fingertip is low over the keys, and nothing else of its action changes."""
+"""The guards (pianobot/perform/guard.py). The wrist guard: a policy's wrist slides no faster than
+the scripted pianist's while a fingertip is low over the keys, and nothing else of its action
+changes. The hold guard: a finger that holds a note moves as the scripted pianist moves it."""
 
 from pathlib import Path
 
@@ -8,7 +9,8 @@ import pytest
 
 from pianobot.env.piano import EnvConfig, actuated_indices, idle_pose
 from pianobot.music.load import LoadOptions, load_piece
-from pianobot.perform.guard import WristGuard
+from pianobot.music.piece import Note, Piece
+from pianobot.perform.guard import HoldGuard, WristGuard
 from pianobot.perform.perform import PLAY_CONFIG, perform
 from pianobot.pianist.scripted import ScriptedPianist
 from pianobot.pianist.tuning import PianistTuning
@@ -104,3 +106,84 @@ def test_a_wrist_that_goes_to_keys_is_refused():
     config = EnvConfig(tactile=False, world=WorldConfig(discrete_wrist=True))
     with pytest.raises(ValueError, match="discrete_wrist"):
         WristGuard(Constant(np.zeros(17)), config)
+
+
+# -- the hold guard ------------------------------------------------------------------------------
+LEGATO = Piece(
+    (Note(0.0, 60, 1.0, 80, 2), Note(1.0, 62, 2.0, 80, 3), Note(2.0, 64, 3.0, 80, 4)), bpm=60
+)  # three one-second notes, each finger in turn
+
+
+class LetsGo:
+    """The scripted pianist, but a finger that holds a note lifts at once (a policy that lets go early)."""
+
+    def __init__(self, config):
+        self.inner = ScriptedPianist(config)
+        self.fingers = len(config.world.hand.spec.fingers)
+        self.steps: list[tuple[dict, np.ndarray]] = []  # (observation, action) of every step
+
+    def reset(self):
+        self.inner.reset()
+
+    def act(self, observation):
+        action = np.array(self.inner.act(observation), dtype=np.float32)
+        for slot in np.flatnonzero(observation["targets"][:, -1] > 0):
+            action[4 * slot + 1] = -1.0  # the MCP joint up at full speed
+        self.steps.append((observation, action.copy()))
+        return action
+
+
+def test_the_hold_guard_keeps_down_a_note_the_policy_lets_go():
+    """Alone the policy taps each one-second note for two control steps; through the hold guard
+    every note sounds for as long as it is written, struck when the policy struck it."""
+    lengths = {}
+    for guarded in (False, True):
+        made = []
+
+        def controller(env, guarded=guarded, made=made):
+            made.append(HoldGuard(LetsGo(env.config), env.config) if guarded else LetsGo(env.config))
+            return made[-1]
+
+        played = perform(LEGATO, controller, PLAY_CONFIG)
+        assert played.report().f1 == 1.0
+        lengths[guarded] = [n.offset - n.onset for n in played.played.notes]
+    assert max(lengths[False]) < 0.1
+    assert min(lengths[True]) > 0.95 and made[0].held > 3 * 15  # each note held for most of its 20 steps
+
+
+def test_the_hold_guard_changes_only_the_holding_fingers_joints():
+    """On every step the guard's action is the policy's but for the joints of the fingers that hold a
+    note, which are the scripted pianist's (told that the notes sounding now began earlier)."""
+    made = []
+
+    def controller(env):
+        made.append(HoldGuard(LetsGo(env.config), env.config))
+        return made[-1]
+
+    perform(LEGATO, controller, PLAY_CONFIG)
+    guard, teacher = made[0], ScriptedPianist(PLAY_CONFIG)
+    holds = 0
+    for observation, asked in guard.policy.steps:
+        teacher.previous_row = observation["score"][0]
+        taught = teacher.act(observation)
+        holding = set(np.flatnonzero(observation["targets"][:, -1] > 0))
+        guard.policy.act = lambda _, asked=asked: asked  # (replays the policy's action of this step)
+        acted = guard.act(observation)
+        for slot in range(3):
+            joints = slice(4 * slot, 4 * slot + 4)
+            assert np.array_equal(acted[joints], taught[joints] if slot in holding else asked[joints])
+        assert acted[-1] == asked[-1]  # the wrist is the policy's
+        holds += bool(holding)
+    assert holds > 40
+
+
+def test_the_hold_guard_needs_finger_targets_and_speed_or_angle_control():
+    assert HoldGuard.fits(CONFIG) and HoldGuard.fits(EnvConfig(tactile=False, world=WorldConfig(control="position")))
+    for config in (
+        EnvConfig(tactile=False, world=WorldConfig(control="torque")),
+        EnvConfig(tactile=False, target_onsets=False),
+        EnvConfig(tactile=False, target_observations=False),
+    ):
+        assert not HoldGuard.fits(config)
+        with pytest.raises(ValueError, match="target_observations, target_onsets"):
+            HoldGuard(Constant(np.zeros(13)), config)

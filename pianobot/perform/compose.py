@@ -16,7 +16,9 @@ sees that stretch's whole window, a note held over a phrase break and the next p
 included, with no hand-over to itself at the breaks. It was trained on single phrases, each
 alone in its window, so this is new to it; it plays better for it (docs/benchmarks.md, "What
 the wrist guard and one section change"). With ``guard``, the general policy plays through a
-:class:`~pianobot.perform.guard.WristGuard`. All of them play in one simulation, so the
+:class:`~pianobot.perform.guard.WristGuard`, with ``hold`` through a
+:class:`~pianobot.perform.guard.HoldGuard` (the scripted pianist moves the fingers that hold a
+note). All of them play in one simulation, so the
 policies must share one environment (the plan's).
 """
 
@@ -36,7 +38,7 @@ from pianobot.music.metrics import DEFAULT_ONSET_TOLERANCE
 from pianobot.music.phrases import DEFAULT_MAX_NOTES, Phrase, split_phrases
 from pianobot.music.piece import Piece
 from pianobot.music.tensor import score_tensor
-from pianobot.perform.guard import WristGuard
+from pianobot.perform.guard import HoldGuard, WristGuard
 from pianobot.perform.rollout import Controller
 from pianobot.pianist.scripted import ScriptedPianist
 
@@ -103,9 +105,11 @@ class CompositionalController:
     """Acts with the controller of the section the current step falls in. ``stretches`` say who
     plays what (:func:`pianobot.perform.plan.assign`): a phrase's own policy, the general policy
     (loaded once, shared by every stretch it plays), or the scripted pianist. ``guard``: the
-    general policy plays through a :class:`~pianobot.perform.guard.WristGuard`."""
+    general policy plays through a :class:`~pianobot.perform.guard.WristGuard`; ``hold``: through a
+    :class:`~pianobot.perform.guard.HoldGuard`, where its environment allows one (both: the hold
+    guard outside)."""
 
-    def __init__(self, env: PianoEnv, stretches, guard: bool = False):
+    def __init__(self, env: PianoEnv, stretches, guard: bool = False, hold: bool = False):
         from pianobot.perform.plan import Player  # (the plan module builds on this one)
 
         spec = env.spec_score
@@ -121,8 +125,9 @@ class CompositionalController:
             elif stretch.player is Player.GENERAL:
                 if general_agent is None:
                     agent = load_policy(stretch.policy, env)
-                    guarded = guard and not env.config.world.discrete_wrist  # (a wrist that goes to keys has no speed)
-                    general_agent = WristGuard(agent, env.config) if guarded else agent
+                    if guard and not env.config.world.discrete_wrist:  # (a wrist that goes to keys has no speed)
+                        agent = WristGuard(agent, env.config)
+                    general_agent = HoldGuard(agent, env.config) if hold and HoldGuard.fits(env.config) else agent
                 controller = general_agent
             elif stretch.player is Player.SCRIPTED:
                 controller = ScriptedPianist(env.config)

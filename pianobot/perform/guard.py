@@ -1,4 +1,17 @@
-"""The wrist guard: a learnt policy's wrist slides no faster than its teacher's while a fingertip is low.
+"""Guards: the scripted pianist's hand on a learnt policy's, where the policy is known to slip.
+
+The hold guard (:class:`HoldGuard`): a finger that holds a written note moves as the scripted
+pianist (the policy's teacher) would move it, and every other joint as the policy asks. A policy
+cloned from the teacher loses most of a hand's part with held notes there: while one voice holds
+a key and another moves, the holding finger slides onto the key beside it or strikes its own
+again (docs/benchmarks.md, "Two hands"). The teacher keeps a held key down, wherever the policy
+takes the wrist, for as long as the score says, and lets it go when its own plan would; the
+policy still strikes every note and moves the wrist. ``pianobot play`` plays a general policy of
+the families in :data:`HOLD_GUARD_FAMILIES` through it (the packaged left hand's policy), and
+any general policy with ``--hold-guard``; ``--no-hold-guard`` plays each alone. A phrase's own
+policy plays unguarded.
+
+The wrist guard (:class:`WristGuard`): a learnt policy's wrist slides no faster than its teacher's while a fingertip is low.
 
 A policy cloned from the scripted pianist learns its switch from "hold the key and ease the wrist
 along" to "let go, rise, then rush to the next position" blurred by a control step: it starts the
@@ -22,11 +35,66 @@ from __future__ import annotations
 
 import numpy as np
 
-from pianobot.env.piano import EnvConfig
+from pianobot.env.piano import JOINT_KINDS, EnvConfig, actuated_indices
 from pianobot.perform.rollout import Controller
 from pianobot.pianist.layout import KeyLayout
 from pianobot.pianist.motion import Motion
+from pianobot.pianist.scripted import ScriptedPianist
 from pianobot.pianist.tuning import PianistTuning
+
+HOLD_GUARD_FAMILIES = ("parts",)
+"""Task families whose general policies play through the hold guard unless told otherwise. Chosen on
+validation sets (docs/benchmarks.md, "Two hands"): the ``parts`` policy, which learnt from the
+teacher that holds its notes, played 21 polyphonic parts at note F1 0.954 through it against 0.881
+alone, and the left hands of 30 two-hand pieces at 0.973 against 0.945; the ``melody`` policy,
+which learnt from the teacher before it held its notes, played 40 melodies at 0.943 through it
+against 0.960 alone (and its right hands of the 30 pieces at 0.925 against 0.928)."""
+
+
+class HoldGuard:
+    """Wraps ``policy`` (a :class:`~pianobot.perform.rollout.Controller`): the joints of every finger
+    that holds a written note now (its finger target's last column, how much longer to hold, is
+    above 0) take the scripted pianist's action; the rest of the action is the policy's.
+
+    The hold is read from the observation's finger targets (``target_onsets``), which say it for
+    the section's own window, the note before it included, so the teacher is told that every note
+    sounding now began earlier: it holds, and never strikes, a key it is handed."""
+
+    def __init__(self, policy: Controller, config: EnvConfig, tuning: PianistTuning = PianistTuning()):
+        if not self.fits(config):
+            raise ValueError(
+                "the hold guard reads which finger holds a note from the finger targets and drives joint speeds or "
+                "angles: it needs target_observations, target_onsets and control 'velocity' or 'position'"
+            )
+        self.policy = policy
+        self.teacher = ScriptedPianist(config, tuning)
+        joints = actuated_indices(config)[:-1]  # (the last action is the wrist's)
+        fingers = len(config.world.hand.spec.fingers)
+        self.joints_of = [np.flatnonzero(joints // len(JOINT_KINDS) == i) for i in range(fingers)]
+        """Finger (its slot) -> where its actuated joints are in the action."""
+        self.held = 0
+        """Finger-steps the teacher moved, since the guard was made."""
+
+    @staticmethod
+    def fits(config: EnvConfig) -> bool:
+        """Whether a policy of ``config`` can be guarded: it observes its finger targets with their
+        holds, and its fingers are driven by speed or angle, as the scripted pianist drives them."""
+        return config.target_observations and config.target_onsets and config.world.control != "torque"
+
+    def reset(self) -> None:
+        self.policy.reset()
+        self.teacher.reset()
+
+    def act(self, observation: dict) -> np.ndarray:
+        action = np.array(self.policy.act(observation), dtype=np.float32)  # a copy: the policy's own is left alone
+        holding = np.flatnonzero(observation["targets"][:, -1] > 0)
+        if holding.size:
+            self.teacher.previous_row = observation["score"][0]  # every note sounding now began earlier: hold it
+            taught = self.teacher.act(observation)
+            for slot in holding:
+                action[self.joints_of[slot]] = taught[self.joints_of[slot]]
+            self.held += holding.size
+        return action
 
 
 class WristGuard:

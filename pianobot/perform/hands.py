@@ -262,6 +262,7 @@ class HandsPerformance:
                 "given_to_the_hand": len(h.part),
                 "left_out_or_reduced": list(h.changes),
                 "plan": h.performance.plan.to_dict(),
+                **h.performance.guards(),
                 **self.report(h.hand).summary(),
             }
         whole = self.report().to_dict()
@@ -519,7 +520,9 @@ def _play_together(
         ]
         inward = Piece(tuple(moved), bpm=piece.bpm)  # (what the hand's player saw itself play)
         rollout = Rollout(part, inward, rewards[h], steps, None, env.score_start)
-        performance = Performance(plans[h], rollout, seed, plan.slowed_steps(controllers[h]))
+        performance = Performance(
+            plans[h], rollout, seed, plan.slowed_steps(controllers[h]), plan.held_steps(controllers[h])
+        )
         done.append(HandPerformance(h, window, part, start, left_out, performance, changes, own))
     start = env.score_start - offset
     return HandsPerformance(piece, tuple(done), seed, together=True, frames=frames, start=start)

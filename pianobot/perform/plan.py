@@ -37,7 +37,7 @@ from pianobot.music.piece import Piece
 from pianobot.perform import perform as simulation  # (called through the module: tests replace simulation.perform)
 from pianobot.perform.compose import CompositionalController, find_policy, trained_split
 from pianobot.perform.controllers import CONTROLLERS, make_controller
-from pianobot.perform.guard import WristGuard
+from pianobot.perform.guard import HOLD_GUARD_FAMILIES, HoldGuard, WristGuard
 from pianobot.perform.perform import PLAY_CONFIG
 from pianobot.perform.rollout import Controller, Rollout
 from pianobot.sim.hand import HandConfig
@@ -93,6 +93,12 @@ class Stretch:
         }
 
 
+def guarded_family(general: Path | None) -> bool:
+    """Whether the general policy in ``general`` was trained on a task family whose policies play
+    through the hold guard unless told otherwise (:data:`~pianobot.perform.guard.HOLD_GUARD_FAMILIES`)."""
+    return general is not None and store.read_manifest(Path(general)).get("target") in HOLD_GUARD_FAMILIES
+
+
 @dataclass(frozen=True)
 class PerformancePlan:
     """A piece, the environment it is played in, and who plays each stretch of it, in order."""
@@ -102,10 +108,21 @@ class PerformancePlan:
     stretches: tuple[Stretch, ...]
     wrist_guard: bool = False
     """The general policy plays through a :class:`~pianobot.perform.guard.WristGuard`."""
+    hold_guard: bool | None = None
+    """The general policy plays through a :class:`~pianobot.perform.guard.HoldGuard`: the scripted
+    pianist moves the fingers that hold a written note (where the policy's environment allows it).
+    None: where the general policy was trained on a family of
+    :data:`~pianobot.perform.guard.HOLD_GUARD_FAMILIES` (:attr:`holds`)."""
 
     def __post_init__(self) -> None:
         if not self.stretches:
             raise ValueError("a plan has at least one stretch")
+
+    @property
+    def holds(self) -> bool:
+        """Whether the general policy plays through the hold guard: :attr:`hold_guard`, or where that
+        is None, whether it was trained on a family of :data:`~pianobot.perform.guard.HOLD_GUARD_FAMILIES`."""
+        return self.hold_guard if self.hold_guard is not None else guarded_family(self.general)
 
     @property
     def phrases(self) -> tuple[Phrase, ...]:
@@ -152,6 +169,8 @@ class Performance:
     seed: int
     slowed_steps: int | None = None
     """Steps at which the wrist guard slowed the general policy's wrist (None: no guard played)."""
+    held_steps: int | None = None
+    """Finger-steps the hold guard's scripted pianist moved a holding finger (None: no guard played)."""
 
     @property
     def played(self) -> Piece:
@@ -168,12 +187,19 @@ class Performance:
     def report(self) -> Report:
         return self.rollout.report()
 
+    def guards(self) -> dict:
+        """What each guard (:mod:`pianobot.perform.guard`) did to the general policy's actions; empty
+        when the general policy played nothing."""
+        if self.plan.general is None:
+            return {}
+        return {
+            "wrist_guard": {"on": self.slowed_steps is not None, "slowed_steps": self.slowed_steps or 0},
+            "hold_guard": {"on": self.held_steps is not None, "held_finger_steps": self.held_steps or 0},
+        }
+
     def to_dict(self) -> dict:
-        """The report's JSON: who played (the plan), the seed, and every figure."""
-        out = {"seed": self.seed, **self.plan.to_dict()}
-        if self.plan.general is not None:
-            out["wrist_guard"] = {"on": self.slowed_steps is not None, "slowed_steps": self.slowed_steps or 0}
-        return {**out, **self.report().to_dict()}
+        """The report's JSON: who played (the plan), the seed, what the guards did, and every figure."""
+        return {"seed": self.seed, **self.plan.to_dict(), **self.guards(), **self.report().to_dict()}
 
 
 def assign(
@@ -271,7 +297,8 @@ def plan_performance(
     general_policy: Path | str | None = None,
     fallback: bool = False,
     phrase_notes: int | None = None,
-    wrist_guard: bool = False,
+    wrist_guard: bool = PerformancePlan.wrist_guard,
+    hold_guard: bool = PerformancePlan.hold_guard,
     gui: bool = False,
 ) -> PerformancePlan:
     """Who plays each stretch of ``piece`` and in which environment (the module's rule).
@@ -282,8 +309,10 @@ def plan_performance(
     hand). ``general``: let the general policy play phrases without a policy of their own
     (``general_policy`` names one; default: the newest in ``models``, then the packaged one).
     ``fallback``: the scripted pianist plays what no policy plays. ``phrase_notes``: the phrase
-    split (default: the longest whose phrases all have a player in the store). ``gui``: show the
-    simulation."""
+    split (default: the longest whose phrases all have a player in the store). ``wrist_guard``,
+    ``hold_guard``: the general policy plays through them (:mod:`pianobot.perform.guard`; a
+    ``hold_guard`` of None: :attr:`PerformancePlan.holds`).
+    ``gui``: show the simulation."""
     if controller not in CONTROLLERS:
         raise SettingError(f"play.controller {controller!r}: choose one of {', '.join(CONTROLLERS)}", "play.controller")
     if general_policy is not None and not general:
@@ -315,7 +344,7 @@ def plan_performance(
             "play.fallback scripted needs policies trained with train.env.world.control velocity or position",
             "play.fallback",
         )
-    return PerformancePlan(piece, replace(env, world=replace(env.world, gui=gui)), stretches, wrist_guard)
+    return PerformancePlan(piece, replace(env, world=replace(env.world, gui=gui)), stretches, wrist_guard, hold_guard)
 
 
 def controller_for(plan: PerformancePlan, env: PianoEnv, seed: int = 0) -> Controller:
@@ -325,14 +354,30 @@ def controller_for(plan: PerformancePlan, env: PianoEnv, seed: int = 0) -> Contr
     (first, *others) = plan.stretches
     if not others and first.player in (Player.SCRIPTED, Player.RANDOM):
         return make_controller("scripted" if first.player is Player.SCRIPTED else "random", env, seed)
-    return CompositionalController(env, plan.stretches, plan.wrist_guard)
+    return CompositionalController(env, plan.stretches, plan.wrist_guard, plan.holds)
+
+
+def _guard(controller: Controller, kind: type):
+    """The guard of ``kind`` the general policy plays through in ``controller`` (None: none)."""
+    for section in controller.sections if isinstance(controller, CompositionalController) else []:
+        guard = section.controller
+        while isinstance(guard, (HoldGuard, WristGuard)):
+            if isinstance(guard, kind):
+                return guard
+            guard = guard.policy
+    return None
 
 
 def slowed_steps(controller: Controller) -> int | None:
     """Steps at which the wrist guard slowed the general policy's wrist in ``controller`` (None: no guard played)."""
-    sections = controller.sections if isinstance(controller, CompositionalController) else []
-    guards = [s.controller for s in sections if isinstance(s.controller, WristGuard)]
-    return guards[0].capped if guards else None
+    guard = _guard(controller, WristGuard)
+    return guard.capped if guard is not None else None
+
+
+def held_steps(controller: Controller) -> int | None:
+    """Finger-steps the hold guard moved a holding finger in ``controller`` (None: no guard played)."""
+    guard = _guard(controller, HoldGuard)
+    return guard.held if guard is not None else None
 
 
 def perform_plan(
@@ -347,7 +392,7 @@ def perform_plan(
         return made[0]
 
     played = simulation.perform(plan.piece, controller, plan.config, seed, video, on_step)
-    return Performance(plan, played, seed, slowed_steps(made[0]))
+    return Performance(plan, played, seed, slowed_steps(made[0]), held_steps(made[0]))
 
 
 def play(

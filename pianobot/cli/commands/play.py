@@ -86,6 +86,15 @@ def play(
         "pianist's does while holding a key (PianistTuning.hold_slide, 8 mm a step), so that a late release drags a "
         "finger across the keys less often (no effect on a policy trained with a discrete wrist).",
     ),
+    hold_guard: Optional[bool] = typer.Option(
+        None,  # PerformancePlan.hold_guard (a test holds them equal; the plan module is slow to import)
+        "--hold-guard/--no-hold-guard",
+        help="While a finger holds a written note, the scripted pianist moves that finger (it keeps the key down for "
+        "as long as the note is written) and the general policy the rest of the hand. Default: for a general policy "
+        "trained on hands' parts (`--task parts`: the packaged left hand's policy), not for a melody policy "
+        "(`--task melody`, which plays melodies better alone); --hold-guard: for every general policy; "
+        "--no-hold-guard: for none (no effect on a policy without finger targets or with torque control).",
+    ),
     phrase_notes: Optional[int] = PlayPhraseNotes,
     seed: int = typer.Option(
         0, "--seed", help="Seed of the simulation (the hand's start position) and of the random controller."
@@ -187,6 +196,7 @@ def play(
                 fallback=fallback is not None,
                 phrase_notes=phrase_notes,
                 wrist_guard=wrist_guard,
+                hold_guard=hold_guard,
             ),
             files=dict(report=report_path, json=json_path, wav=wav, soundfont=soundfont, html=html, video=video),
             shown=dict(console=console, notes=notes, every=every, quiet=quiet),
@@ -204,6 +214,7 @@ def play(
         fallback=fallback is not None,
         phrase_notes=phrase_notes,
         wrist_guard=wrist_guard,
+        hold_guard=hold_guard,
         gui=gui,
     )
     if (
