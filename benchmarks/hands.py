@@ -2,7 +2,7 @@
 beside the scripted pianist, against the pieces as written.
 
     python -m benchmarks.hands [--duets 50] [--seed 35] [--polyphonic 20] [--general DIR]
-                               [--general-left DIR] [--parts DIR] [--apart] [--no-hold-guard]
+                               [--general-left DIR] [--parts DIR] [--apart] [--hold-guard | --no-hold-guard]
                                [--examples [FOLDER]] [--json out.json]
 
 (``python -m benchmarks.zeroshot --sets duets polyphonic`` plays the same sets beside the

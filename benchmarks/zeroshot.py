@@ -321,7 +321,7 @@ def main() -> None:
                 {
                     "general": str(general),
                     "wrist_guard": args.wrist_guard,
-                    "hold_guard": args.hold_guard,
+                    "hold_guard": held,
                     "rejected": rejected,
                     **results,
                 },

@@ -2,6 +2,7 @@
 the scripted pianist's while a fingertip is low over the keys, and nothing else of its action
 changes. The hold guard: a finger that holds a note moves as the scripted pianist moves it."""
 
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -110,17 +111,29 @@ def test_a_wrist_that_goes_to_keys_is_refused():
 
 # -- the hold guard ------------------------------------------------------------------------------
 LEGATO = Piece(
-    (Note(0.0, 60, 1.0, 80, 2), Note(1.0, 62, 2.0, 80, 3), Note(2.0, 64, 3.0, 80, 4)), bpm=60
-)  # three one-second notes, each finger in turn
+    (
+        Note(0.0, 60, 1.0, 80, 2),
+        Note(1.0, 62, 2.0, 80, 2),  # the same finger again: it must let C4 go in time to strike D4
+        Note(2.0, 64, 3.0, 80, 3),
+        Note(2.5, 67, 3.0, 80, 4),  # struck while E4 is held
+    ),
+    bpm=60,
+)
+
+
+def joints_of(config: EnvConfig, slot: int) -> np.ndarray:
+    """Where finger ``slot``'s actuated joints are in the action."""
+    return np.flatnonzero(actuated_indices(config)[:-1] // 4 == slot)
 
 
 class LetsGo:
-    """The scripted pianist, but a finger that holds a note lifts at once (a policy that lets go early)."""
+    """The scripted pianist, but a finger that holds a note lifts at once (a policy that lets go
+    early); it records every step's observation."""
 
     def __init__(self, config):
         self.inner = ScriptedPianist(config)
-        self.fingers = len(config.world.hand.spec.fingers)
-        self.steps: list[tuple[dict, np.ndarray]] = []  # (observation, action) of every step
+        self.config = config
+        self.observations: list[dict] = []
 
     def reset(self):
         self.inner.reset()
@@ -128,53 +141,53 @@ class LetsGo:
     def act(self, observation):
         action = np.array(self.inner.act(observation), dtype=np.float32)
         for slot in np.flatnonzero(observation["targets"][:, -1] > 0):
-            action[4 * slot + 1] = -1.0  # the MCP joint up at full speed
-        self.steps.append((observation, action.copy()))
+            action[joints_of(self.config, slot)[1]] = -1.0  # the MCP joint up at full speed
+        self.observations.append(observation)
         return action
 
 
-def test_the_hold_guard_keeps_down_a_note_the_policy_lets_go():
-    """Alone the policy taps each one-second note for two control steps; through the hold guard
-    every note sounds for as long as it is written, struck when the policy struck it."""
-    lengths = {}
-    for guarded in (False, True):
-        made = []
-
-        def controller(env, guarded=guarded, made=made):
-            made.append(HoldGuard(LetsGo(env.config), env.config) if guarded else LetsGo(env.config))
-            return made[-1]
-
-        played = perform(LEGATO, controller, PLAY_CONFIG)
-        assert played.report().f1 == 1.0
-        lengths[guarded] = [n.offset - n.onset for n in played.played.notes]
-    assert max(lengths[False]) < 0.1
-    assert min(lengths[True]) > 0.95 and made[0].held > 3 * 15  # each note held for most of its 20 steps
+def _notes(rollout):
+    return [(n.pitch, n.onset, n.offset) for n in rollout.played.notes]
 
 
-def test_the_hold_guard_changes_only_the_holding_fingers_joints():
-    """On every step the guard's action is the policy's but for the joints of the fingers that hold a
-    note, which are the scripted pianist's (told that the notes sounding now began earlier)."""
+def test_through_the_hold_guard_a_policy_that_lets_go_plays_as_its_teacher():
+    """Alone the policy taps its notes for two control steps (and misses the same finger's next
+    one); through the hold guard the holding fingers are the teacher's, and the performance is the
+    scripted pianist's own, note for note: C4 let go in time for the same finger's D4, E4 held
+    while G4 is struck."""
     made = []
 
-    def controller(env):
+    def guarded(env):
         made.append(HoldGuard(LetsGo(env.config), env.config))
         return made[-1]
 
-    perform(LEGATO, controller, PLAY_CONFIG)
-    guard, teacher = made[0], ScriptedPianist(PLAY_CONFIG)
+    alone = perform(LEGATO, lambda env: LetsGo(env.config), PLAY_CONFIG)
+    assert max(n.offset - n.onset for n in alone.played.notes) < 0.1
+    teacher = perform(LEGATO, "scripted", PLAY_CONFIG)
+    held = perform(LEGATO, guarded, PLAY_CONFIG)
+    assert held.report().f1 == 1.0 and _notes(held) == _notes(teacher)
+    assert min(n.offset - n.onset for n in held.played.notes) > 0.45 and made[0].held > 40
+
+
+@pytest.mark.parametrize("actuated", [None, ("mcp", "pip")])
+def test_the_hold_guard_changes_only_the_holding_fingers_joints(actuated):
+    """On every step the guard's action is the policy's but for the actuated joints of the fingers
+    that hold a note, which are what the scripted pianist that played every step itself would do."""
+    config = PLAY_CONFIG if actuated is None else replace(PLAY_CONFIG, actuated=actuated)
+    recorder = LetsGo(config)
+    perform(LEGATO, lambda env: recorder, config)
+    asked = np.linspace(-0.9, 0.9, len(actuated_indices(config))).astype(np.float32)
+    guard, teacher = HoldGuard(Constant(asked), config), ScriptedPianist(config)
     holds = 0
-    for observation, asked in guard.policy.steps:
-        teacher.previous_row = observation["score"][0]
-        taught = teacher.act(observation)
-        holding = set(np.flatnonzero(observation["targets"][:, -1] > 0))
-        guard.policy.act = lambda _, asked=asked: asked  # (replays the policy's action of this step)
-        acted = guard.act(observation)
-        for slot in range(3):
-            joints = slice(4 * slot, 4 * slot + 4)
-            assert np.array_equal(acted[joints], taught[joints] if slot in holding else asked[joints])
-        assert acted[-1] == asked[-1]  # the wrist is the policy's
-        holds += bool(holding)
-    assert holds > 40
+    for observation in recorder.observations:
+        taught = teacher.act(observation)  # (it sees every step: it knows which notes began earlier)
+        holding = np.flatnonzero(observation["targets"][:, -1] > 0)
+        expected = asked.copy()
+        for slot in holding:
+            expected[joints_of(config, slot)] = taught[joints_of(config, slot)]
+        assert np.array_equal(guard.act(observation), expected)
+        holds += len(holding)
+    assert holds == guard.held > 40
 
 
 def test_the_hold_guard_needs_finger_targets_and_speed_or_angle_control():

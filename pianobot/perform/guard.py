@@ -36,6 +36,7 @@ from __future__ import annotations
 import numpy as np
 
 from pianobot.env.piano import JOINT_KINDS, EnvConfig, actuated_indices
+from pianobot.music.tensor import FINGER
 from pianobot.perform.rollout import Controller
 from pianobot.pianist.layout import KeyLayout
 from pianobot.pianist.motion import Motion
@@ -57,8 +58,10 @@ class HoldGuard:
     above 0) take the scripted pianist's action; the rest of the action is the policy's.
 
     The hold is read from the observation's finger targets (``target_onsets``), which say it for
-    the section's own window, the note before it included, so the teacher is told that every note
-    sounding now began earlier: it holds, and never strikes, a key it is handed."""
+    the section's own window, the note before it included; the teacher is told exactly that (the
+    holding fingers' notes began earlier, any other note sounding now begins now), so it plans the
+    hand as it would have, had it played the piece itself, and holds, never strikes, a key it is
+    handed."""
 
     def __init__(self, policy: Controller, config: EnvConfig, tuning: PianistTuning = PianistTuning()):
         if not self.fits(config):
@@ -75,6 +78,15 @@ class HoldGuard:
         self.held = 0
         """Finger-steps the teacher moved, since the guard was made."""
 
+    def _before(self, row: np.ndarray, holding: np.ndarray) -> np.ndarray:
+        """The score row the teacher is told came before ``row``: the notes the ``holding`` fingers hold
+        began earlier, and every other finger's note in ``row`` (if any) begins now. That is the
+        truth wherever the guard takes over (the finger targets say which notes began earlier)."""
+        before = row.copy()
+        striking = [slot for slot in range(len(self.joints_of)) if slot not in holding]
+        before[:, [FINGER + slot for slot in striking]] = 0.0
+        return before
+
     @staticmethod
     def fits(config: EnvConfig) -> bool:
         """Whether a policy of ``config`` can be guarded: it observes its finger targets with their
@@ -89,7 +101,7 @@ class HoldGuard:
         action = np.array(self.policy.act(observation), dtype=np.float32)  # a copy: the policy's own is left alone
         holding = np.flatnonzero(observation["targets"][:, -1] > 0)
         if holding.size:
-            self.teacher.previous_row = observation["score"][0]  # every note sounding now began earlier: hold it
+            self.teacher.previous_row = self._before(observation["score"][0], holding)
             taught = self.teacher.act(observation)
             for slot in holding:
                 action[self.joints_of[slot]] = taught[self.joints_of[slot]]

@@ -298,7 +298,7 @@ def plan_performance(
     fallback: bool = False,
     phrase_notes: int | None = None,
     wrist_guard: bool = PerformancePlan.wrist_guard,
-    hold_guard: bool = PerformancePlan.hold_guard,
+    hold_guard: bool | None = PerformancePlan.hold_guard,
     gui: bool = False,
 ) -> PerformancePlan:
     """Who plays each stretch of ``piece`` and in which environment (the module's rule).

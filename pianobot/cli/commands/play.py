@@ -89,11 +89,12 @@ def play(
     hold_guard: Optional[bool] = typer.Option(
         None,  # PerformancePlan.hold_guard (a test holds them equal; the plan module is slow to import)
         "--hold-guard/--no-hold-guard",
-        help="While a finger holds a written note, the scripted pianist moves that finger (it keeps the key down for "
-        "as long as the note is written) and the general policy the rest of the hand. Default: for a general policy "
-        "trained on hands' parts (`--task parts`: the packaged left hand's policy), not for a melody policy "
-        "(`--task melody`, which plays melodies better alone); --hold-guard: for every general policy; "
-        "--no-hold-guard: for none (no effect on a policy without finger targets or with torque control).",
+        help="While a finger holds a written note, the scripted pianist moves that finger (it keeps the key down until "
+        "the note ends, or until its own plan needs the finger for the next note) and the general policy the rest of "
+        "the hand. Default: for a general policy trained on hands' parts (`--task parts`: the packaged left hand's "
+        "policy), not for a melody policy (`--task melody`, which plays melodies better alone); --hold-guard: for "
+        "every general policy; --no-hold-guard: for none. Phrase policies always play alone; no effect on a policy "
+        "without finger targets or with torque control.",
     ),
     phrase_notes: Optional[int] = PlayPhraseNotes,
     seed: int = typer.Option(
