@@ -335,4 +335,5 @@ def test_the_left_hands_policy_plays_through_the_hold_guard_unless_told(tmp_path
         assert hands["right"]["performer"].startswith("general policy task-melody")
         assert hands["left"]["performer"].startswith("general policy task-parts")
         assert [hands[h]["hold_guard"]["on"] for h in ("right", "left")] == [right, left]
+        assert [hands[h]["performer"].endswith("through the hold guard") for h in ("right", "left")] == [right, left]
         assert (hands["left"]["hold_guard"]["held_finger_steps"] > 10) is left

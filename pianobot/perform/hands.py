@@ -186,11 +186,12 @@ class HandPerformance:
 
     @property
     def performer(self) -> str:
-        """Who played this hand, in words ('scripted pianist', 'general policy task-parts-...', ...):
-        the two hands may have different general policies."""
+        """Who played this hand, in words ('scripted pianist', 'general policy task-parts-... through the
+        hold guard', ...): the two hands may have different general policies."""
         played = self.performance.plan
         folders = dict.fromkeys(s.policy.name for s in played.stretches if s.player is plan.Player.GENERAL)
-        return " ".join([played.performer, *folders])
+        guarded = ["through the hold guard"] if self.performance.held_steps is not None else []
+        return " ".join([played.performer, *folders, *guarded])
 
     def describe(self) -> str:
         """Where the simulated hand played the part: 'mirrored, moved up 1 octave onto C4-B5 (24 keys)'."""
