@@ -162,34 +162,42 @@ def example_set(folder: Path) -> list[tuple[str, object]]:
 
 def play_examples(pieces, general=None, hold_guard: bool | None = None, starts=EXAMPLE_STARTS) -> list[dict]:
     """Each two-hand example as ``pianobot play`` plays it: the general policies from each of
-    ``starts`` (hand starts: ``--seed``), the scripted pianist from 0."""
+    ``starts`` (hand starts: ``--seed``), the scripted pianist from 0; each play's figures."""
     rows = []
     with tempfile.TemporaryDirectory() as models:
         for label, piece in pieces:
-            general_f1 = [figures(piece, "sac", models, general, True, hold_guard, s)["f1"] for s in starts]
-            scripted = figures(piece, "scripted", models)["f1"]
-            rows.append({"piece": label, "notes": len(piece), "sac": general_f1, "scripted": scripted})
-            print(f"{label}: general {', '.join(f'{f:.3f}' for f in general_f1)}; scripted {scripted:.3f}", flush=True)
+            general_figures = [figures(piece, "sac", models, general, True, hold_guard, s) for s in starts]
+            scripted = figures(piece, "scripted", models)
+            rows.append({"piece": label, "notes": len(piece), "sac": general_figures, "scripted": scripted})
+            f1s = ", ".join(f"{f['f1']:.3f}" for f in general_figures)
+            print(f"{label}: general {f1s}; scripted {scripted['f1']:.3f}", flush=True)
     return rows
 
 
 def example_table(rows: list[dict], starts=EXAMPLE_STARTS) -> str:
+    def mean(row: dict, key: str) -> float:
+        return float(np.mean([f[key] for f in row["sac"]]))
+
     lines = [
         f"**two-hand examples** (against each file; the general policies from hand starts {', '.join(map(str, starts))})",
         "",
-        "| example | notes | general policies | mean | scripted pianist |",
-        "| --- | ---: | --- | ---: | ---: |",
+        "| example | notes | note F1, general policies | mean | per-step F1, general (mean) | note F1, scripted pianist | per-step F1, scripted |",
+        "| --- | ---: | --- | ---: | ---: | ---: | ---: |",
     ]
     for r in rows:
-        values = ", ".join(f"{f:.3f}" for f in r["sac"])
-        lines.append(f"| `{r['piece']}` | {r['notes']} | {values} | {np.mean(r['sac']):.3f} | {r['scripted']:.3f} |")
-    means = [np.mean(r["sac"]) for r in rows]
-    lines.append(
-        f"| mean | | | {np.mean(means):.3f} | {np.mean([r['scripted'] for r in rows]):.3f} |"
-        if rows
-        else "| (none) | | | | |"
-    )
-    lines += ["", f"examples whose mean is at least 0.9: {sum(m >= 0.9 for m in means)} of {len(rows)}", ""]
+        values = ", ".join(f"{f['f1']:.3f}" for f in r["sac"])
+        lines.append(
+            f"| `{r['piece']}` | {r['notes']} | {values} | {mean(r, 'f1'):.3f} | {mean(r, 'step_f1'):.3f} | "
+            f"{r['scripted']['f1']:.3f} | {r['scripted']['step_f1']:.3f} |"
+        )
+    if rows:
+        means = [mean(r, "f1") for r in rows]
+        lines.append(
+            f"| mean | | | {np.mean(means):.3f} | {np.mean([mean(r, 'step_f1') for r in rows]):.3f} | "
+            f"{np.mean([r['scripted']['f1'] for r in rows]):.3f} | {np.mean([r['scripted']['step_f1'] for r in rows]):.3f} |"
+        )
+        every = sum(min(f["f1"] for f in r["sac"]) >= 0.9 for r in rows)
+        lines += ["", f"examples at note F1 0.9 or more from every hand start: {every} of {len(rows)}", ""]
     return "\n".join(lines)
 
 

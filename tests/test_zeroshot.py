@@ -64,3 +64,23 @@ def test_held_duration_is_one_median_over_every_note_of_the_set():
     assert s["scripted"]["held_medium"] != s["scripted"]["held_medium"]  # no medium notes: nan
     line = zeroshot.table({"melodies": rows}).splitlines()[-1]
     assert line.split("|")[-2].strip() == "0.55, nan, 1.00"
+
+
+def test_the_two_hand_examples_table_counts_an_example_only_if_every_hand_start_reaches_0_9():
+    """benchmarks/hands.py --examples: each start's note F1, their mean and per-step F1 beside the
+    scripted pianist's; an example whose mean passes 0.9 but one start does not is not counted."""
+    from benchmarks import hands
+
+    def play(f1, step=0.8):
+        return {"f1": f1, "step_f1": step}
+
+    rows = [
+        {"piece": "steady", "notes": 10, "sac": [play(0.95), play(0.93), play(0.94)], "scripted": play(1.0, 0.9)},
+        {"piece": "one-slip", "notes": 12, "sac": [play(0.99), play(0.85), play(0.99)], "scripted": play(0.98, 0.7)},
+    ]
+    lines = hands.example_table(rows).splitlines()
+    steady = [cell.strip() for cell in lines[4].split("|")[1:-1]]
+    assert steady == ["`steady`", "10", "0.950, 0.930, 0.940", "0.940", "0.800", "1.000", "0.900"]
+    mean = [cell.strip() for cell in lines[6].split("|")[1:-1]]
+    assert mean[3] == "0.942" and mean[5] == "0.990" and mean[6] == "0.800"  # one-slip's own mean is 0.943
+    assert lines[-1] == "examples at note F1 0.9 or more from every hand start: 1 of 2"
