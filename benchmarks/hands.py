@@ -21,8 +21,8 @@ Sets:
 
 Each piece is played once from hand start 0, both hands in one simulation as ``pianobot play``
 plays them (``--apart``: each hand in a simulation of its own), by the general policy (the
-packaged ones, as ``pianobot play`` plays them: the melody policy on the right hand, the parts
-policy on the left and on a polyphonic right hand; the model store is an empty folder;
+packaged one, as ``pianobot play`` plays them: the parts policy on both hands; the model store
+is an empty folder;
 ``--general`` names the right hand's, and both hands' without ``--general-left``, which names the
 left's; ``--parts`` the parts policy, in its place on the hands it plays; through the hold guard,
 as ``play`` plays them, unless ``--no-hold-guard``) and by the scripted pianist.
@@ -48,10 +48,8 @@ import torch
 
 from pianobot.errors import PianobotWarning
 from pianobot.music.duets import duet_set, random_duet
-from pianobot.music.instrument import HandSpec, KeyboardSpec
 from pianobot.music.load import LoadOptions
-from pianobot.music.piece import HANDS
-from pianobot.perform.hands import play_hands, polyphonic, prepare_part, two_hands
+from pianobot.perform.hands import play_hands, two_hands
 
 PLAYERS = ("sac", "scripted")
 POLYPHONIC = ("block", "voices", "right-voices")
@@ -116,20 +114,11 @@ def table(name: str, rows: list[dict]) -> str:
 
 
 def with_parts(piece, general, parts):
-    """The general policies by hand with ``parts`` on the hands ``play`` gives the parts policy: the
-    left, and the right where its part is polyphonic (:func:`pianobot.perform.hands.polyphonic`)."""
+    """The general policies by hand with ``parts`` on the hands ``play`` gives the parts policy: every
+    hand of a two-hand piece."""
     if parts is None:
         return general
-    by_hand = dict(general) if isinstance(general, dict) else dict.fromkeys(HANDS, general)
-    for hand in piece.hands:
-        if hand == "left":
-            by_hand[hand] = parts
-        else:
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore", PianobotWarning)
-                part = prepare_part(piece, hand, KeyboardSpec(), HandSpec())[1]
-            by_hand[hand] = parts if polyphonic(part) else by_hand.get(hand)
-    return by_hand
+    return dict.fromkeys(piece.hands, parts)
 
 
 def play_set(pieces, general=None, together: bool = True, parts=None, hold_guard: bool | None = None) -> list[dict]:
@@ -213,8 +202,8 @@ def main() -> None:
     )
     parser.add_argument(
         "--parts",
-        help="the parts policy: the left hand's and a polyphonic right hand's, as play gives them the packaged "
-        "left hand's policy (overrides --general and --general-left for them)",
+        help="the parts policy: both hands', as play gives them the packaged left hand's policy (overrides "
+        "--general and --general-left)",
     )
     parser.add_argument("--apart", action="store_true", help="each hand in a simulation of its own")
     parser.add_argument(

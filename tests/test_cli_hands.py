@@ -288,11 +288,10 @@ def test_finger_writes_each_hands_fingering_one_track_each(tmp_path):
     assert "left hand, fingers 2 (index), 3 (middle), 4 (ring): wrist travel" in text and "one track per hand" in text
 
 
-def test_the_left_hand_plays_the_packaged_left_policy_unless_left_policy_names_another(tmp_path):
-    """Both hands with the general policies: by default the right hand has the general policy
-    (`task-melody`) and the left the packaged left hand's (`task-parts`), as has a right hand in two
-    voices; --left-policy names the
-    left's; it is refused, in one line, where no general policy plays a left hand."""
+def test_both_hands_play_the_packaged_parts_policy_unless_left_policy_names_another(tmp_path):
+    """Both hands with the general policies: by default each hand has the packaged left hand's
+    policy (`task-parts`), a melody as a right hand in two voices; --left-policy names the left's;
+    it is refused, in one line, where no general policy plays a left hand."""
     from pianobot.agent.general import PACKAGED
 
     song, models = _duet(tmp_path / "duet.mid"), tmp_path / "models"
@@ -300,8 +299,8 @@ def test_the_left_hand_plays_the_packaged_left_policy_unless_left_policy_names_a
     result = run("play", song, "-o", tmp_path / "out.mid", "--models", models, "--json", tmp_path / "r.json", "-q")
     assert result.exit_code == 0, result.output
     hands = json.loads((tmp_path / "r.json").read_text())["hands"]
-    assert "task-melody-" in hands["right"]["performer"] and "task-parts-" in hands["left"]["performer"]
-    # a right hand in two voices (a note held under the melody) has the parts policy too
+    assert "task-parts-" in hands["right"]["performer"] and "task-parts-" in hands["left"]["performer"]
+    # a right hand in two voices (a note held under the melody) too
     voices = _duet(tmp_path / "voices.mid", right=_track((67, 0, 4), (72, 0, 1), (74, 1, 2), (76, 2, 3), (74, 3, 4)))
     result = run("play", voices, "-o", tmp_path / "v.mid", "--models", models, "--json", tmp_path / "v.json", "-q")
     assert result.exit_code == 0, result.output
@@ -313,6 +312,7 @@ def test_the_left_hand_plays_the_packaged_left_policy_unless_left_policy_names_a
     assert result.exit_code == 0, result.output
     hands = json.loads((tmp_path / "two.json").read_text())["hands"]
     assert "task-melody-" in hands["left"]["performer"] and "task-parts-" not in hands["left"]["performer"]
+    assert "task-parts-" in hands["right"]["performer"]
     one_hand = midi_file(tmp_path / "one.mid", [("Right Hand", RIGHT)])
     refused = run("play", one_hand, "-o", tmp_path / "x.mid", "--left-policy", melody)
     assert_one_line_error(refused, "plays one hand")
@@ -322,18 +322,27 @@ def test_the_left_hand_plays_the_packaged_left_policy_unless_left_policy_names_a
     assert_one_line_error(refused, "--left-policy", "not a trained policy folder")
 
 
-def test_the_left_hands_policy_plays_through_the_hold_guard_unless_told(tmp_path):
-    """By default the packaged left hand's policy (a `--task parts` one) plays through the hold guard
-    and the melody policy on the right hand alone; --hold-guard guards both, --no-hold-guard neither.
+def test_the_parts_policy_plays_through_the_hold_guard_unless_told(tmp_path):
+    """By default the packaged parts policy (a `--task parts` one) plays through the hold guard, a
+    melody policy named for the left hand alone; --hold-guard guards both, --no-hold-guard neither.
     The left hand holds C3 and G3 for two beats each: the guard's teacher held them."""
+    from pianobot.agent.general import PACKAGED
+
     song = _duet(tmp_path / "duet.mid")
-    expected = {(): (False, True), ("--hold-guard",): (True, True), ("--no-hold-guard",): (False, False)}
+    melody = ("--left-policy", next(PACKAGED.glob("task-melody-*")))
+    expected = {
+        (): (True, True),
+        melody: (True, False),
+        (*melody, "--hold-guard"): (True, True),
+        ("--no-hold-guard",): (False, False),
+    }
     for flags, (right, left) in expected.items():
         result = run("play", song, "-o", tmp_path / "out.mid", "--models", tmp_path / "empty", *flags)
         assert result.exit_code == 0, result.output
         hands = json.loads((tmp_path / "out.report.json").read_text())["hands"]
-        assert hands["right"]["performer"].startswith("general policy task-melody")
-        assert hands["left"]["performer"].startswith("general policy task-parts")
+        assert hands["right"]["performer"].startswith("general policy task-parts")
+        family = "task-melody" if melody[0] in flags else "task-parts"
+        assert hands["left"]["performer"].startswith(f"general policy {family}")
         assert [hands[h]["hold_guard"]["on"] for h in ("right", "left")] == [right, left]
         assert [hands[h]["performer"].endswith("through the hold guard") for h in ("right", "left")] == [right, left]
         assert (hands["left"]["hold_guard"]["held_finger_steps"] > 10) is left

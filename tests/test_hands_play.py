@@ -98,18 +98,6 @@ def test_a_note_without_a_hand_is_refused():
         play_hands(Piece((Note(0.0, 60, 1.0, hand="right"), Note(0.0, 48, 1.0))), "scripted")
 
 
-def test_a_part_is_polyphonic_when_a_tenth_of_its_notes_sound_with_another():
-    from pianobot.perform.hands import polyphonic
-
-    melody = [Note(float(i), 60 + i, i + 1.0) for i in range(12)]  # legato: each ends as the next begins
-    assert not polyphonic(Piece(tuple(melody)))
-    assert polyphonic(Piece((*melody, Note(11.0, 64, 12.0))))  # a closing chord: 2 of 13 notes sound together
-    long = [Note(float(i), 60 + i % 12, i + 1.0) for i in range(30)]
-    assert not polyphonic(Piece((*long, Note(29.0, 48, 30.0))))  # the same chord closing 30 notes: 2 of 31
-    held = Piece((Note(0.0, 55, 4.0), *(Note(float(i), 60 + i, i + 0.9) for i in range(4))))  # a voice under the melody
-    assert polyphonic(held)
-
-
 def test_random_duets_are_seeded_and_keep_the_hands_apart():
     assert duet_set(3, 4) == duet_set(3, 4) and duet_set(3, 4) != duet_set(4, 4)
     for texture in TEXTURES:
@@ -206,7 +194,8 @@ def test_pianobot_play_plays_both_hands_of_a_piece_with_both_and_one_hand_as_bef
 
 
 def test_general_policies_may_be_given_by_hand(tmp_path):
-    """``general_policy`` as a dict names each hand's policy (one left out keeps its default); a
+    """``general_policy`` as a dict names each hand's policy (one left out keeps its default, the
+    packaged parts policy); a
     key that is not a hand is refused before anything plays."""
     from pianobot.agent.general import PACKAGED
 
@@ -215,7 +204,8 @@ def test_general_policies_may_be_given_by_hand(tmp_path):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", PianobotWarning)
         performance = play_hands(piece, "sac", tmp_path, general_policy={"left": melody})  # (an empty store)
-    assert [h.performer for h in performance.hands] == [f"general policy {melody.name}"] * 2
+    right, left = (h.performer for h in performance.hands)
+    assert right.startswith("general policy task-parts-") and left == f"general policy {melody.name}"
     with pytest.raises(PianobotError, match="middle is not a hand"):
         play_hands(piece, "sac", tmp_path, general_policy={"middle": melody})
 

@@ -362,16 +362,13 @@ def prepare_parts(
 
 def hand_players(parts: dict[str, tuple], controller: str, models, fingers: HandSpec, options: dict) -> dict[str, dict]:
     """Each hand's options for its plan (:func:`~pianobot.perform.plan.plan_performance`): those
-    given (``general_policy`` may be a dict by hand), and, for 'sac', the packaged parts policy
-    on the left hand and on a :func:`polyphonic` right hand where no general policy was named."""
+    given (``general_policy`` may be a dict by hand), and, for 'sac', the packaged parts policy on
+    every hand no general policy was named for. (Through the hold guard it plays the right hands of
+    two-hand pieces better than the melody policy does: docs/benchmarks.md, "Two hands".)"""
     given = {name: _hand_options(options, name) for name in parts}
     if controller != "sac":
         return given
-    by_hand = dict(given)
-    for name, (window, part, *_) in parts.items():
-        if name == "left" or polyphonic(part):
-            by_hand[name] = _parts_default(given[name], models, window.keyboard, fingers)
-    return by_hand
+    return {name: _parts_default(given[name], models, window.keyboard, fingers) for name, (window, *_) in parts.items()}
 
 
 def plan_hands(
@@ -439,29 +436,10 @@ def _hand_options(options: dict, hand: str) -> dict:
     return {**options, "general_policy": policy.get(hand)}
 
 
-POLYPHONIC_SHARE = 0.1
-"""A hand's part is polyphonic when at least this share of its notes sound together with another
-(chords, a note held under a moving voice): the right hand's is then played by the parts policy,
-as the left hand's always is (:func:`play_hands`). The share was set, not tuned; a melody of more
-than about 20 notes with one closing chord stays the melody policy's. What the rule changes is
-small: docs/benchmarks.md, "Two hands"."""
-
-
-def polyphonic(part: Piece) -> bool:
-    """Whether at least :data:`POLYPHONIC_SHARE` of ``part``'s notes sound together with another."""
-    notes = sorted(part.notes, key=lambda n: n.onset)
-    together, reach = 0, float("-inf")  # reach: the latest offset of the notes before
-    for i, note in enumerate(notes):
-        later = i + 1 < len(notes) and notes[i + 1].onset < note.offset
-        together += later or reach > note.onset
-        reach = max(reach, note.offset)
-    return together >= POLYPHONIC_SHARE * len(notes) > 0
-
-
 def _parts_default(options: dict, models, keyboard: KeyboardSpec, fingers: HandSpec) -> dict:
     """A hand's options with the packaged parts policy (:func:`~pianobot.agent.general.left_hand_policy`:
-    the left hand's, and a polyphonic right hand's) where none was named for it (``general_policy``
-    for both hands, or by hand) and the general policy may play."""
+    each hand's of a two-hand piece) where none was named for it (``general_policy`` for both
+    hands, or by hand) and the general policy may play."""
     if not options.get("general", True) or options.get("general_policy") is not None:
         return options
     policy = left_hand_policy(Path(models) if models is not None else plan.DEFAULT_MODELS, keyboard, fingers)

@@ -76,8 +76,8 @@ def play(
         "--left-policy",
         help="On a two-hand file, the general policy that plays the left hand (default: --general-policy when given, "
         "else the newest general policy in --models, else the packaged left hand's policy, a `--task parts` one; "
-        "the right hand has the general policy, or the packaged left hand's policy where a tenth of its notes sound "
-        "with another; one-hand files have the general policy).",
+        "the right hand has --general-policy, or the newest general policy in --models, or the packaged left hand's "
+        "policy too; one-hand files have the general policy).",
     ),
     wrist_guard: bool = typer.Option(
         False,
