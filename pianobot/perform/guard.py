@@ -46,7 +46,7 @@ from pianobot.pianist.tuning import PianistTuning
 HOLD_GUARD_FAMILIES = ("parts",)
 """Task families whose general policies play through the hold guard unless told otherwise. Chosen on
 validation sets (docs/benchmarks.md, "Two hands"): the ``parts`` policy, which learnt from the
-teacher that holds its notes, played 21 polyphonic parts at note F1 0.954 through it against 0.881
+teacher that holds its notes, played 21 polyphonic parts at note F1 0.950 through it against 0.881
 alone, and the left hands of 30 two-hand pieces at 0.973 against 0.945; the ``melody`` policy,
 which learnt from the teacher before it held its notes, played 40 melodies at 0.943 through it
 against 0.960 alone (and its right hands of the 30 pieces at 0.925 against 0.928)."""
