@@ -3,7 +3,7 @@ beside the scripted pianist, against the pieces as written.
 
     python -m benchmarks.hands [--duets 50] [--seed 35] [--polyphonic 20] [--general DIR]
                                [--general-left DIR] [--parts DIR] [--apart] [--hold-guard | --no-hold-guard]
-                               [--examples [FOLDER]] [--json out.json]
+                               [--examples [FOLDER]] [--lowest-note C2 --keys 48] [--json out.json]
 
 (``python -m benchmarks.zeroshot --sets duets polyphonic`` plays the same sets beside the
 one-hand ones.)
@@ -25,12 +25,14 @@ packaged one, as ``pianobot play`` plays them: the parts policy on both hands; t
 is an empty folder;
 ``--general`` names the right hand's, and both hands' without ``--general-left``, which names the
 left's; ``--parts`` the parts policy, in its place on the hands it plays; through the hold guard,
-as ``play`` plays them, unless ``--no-hold-guard``) and by the scripted pianist.
+as ``play`` plays them, unless ``--no-hold-guard``) and by the scripted pianist; each part on
+the keys its player takes (the general policy's 24, or a wider part's own octaves; the scripted
+pianist's own), or with ``--lowest-note``/``--keys`` on those keys for both players.
 A polyphonic part is played as ``play`` plays that hand of a two-hand file: by the parts policy (the
 packaged left hand's), the left hands and the right hands alike (``pianobot play`` of a one-hand
 file gives the melody policy a right hand, polyphonic or not). Prints a
 Markdown table per set: note F1 (whole piece, right hand, left hand), per-step key-press F1, note
-F1 with offsets, notes left outside the general policy's 24 keys, and the general policy's share
+F1 with offsets, notes left outside the keys (only with ``--keys``), and the general policy's share
 of the scripted pianist's note F1.
 """
 
@@ -48,7 +50,9 @@ import torch
 
 from pianobot.errors import PianobotWarning
 from pianobot.music.duets import duet_set, random_duet
+from pianobot.music.instrument import KeyboardSpec
 from pianobot.music.load import LoadOptions
+from pianobot.music.piece import parse_pitch
 from pianobot.perform.hands import play_hands, two_hands
 
 PLAYERS = ("sac", "scripted")
@@ -60,13 +64,20 @@ EXAMPLE_STARTS = (0, 1, 2)
 
 
 def figures(
-    piece, controller: str, models, general=None, together: bool = True, hold_guard: bool | None = None, seed: int = 0
+    piece,
+    controller: str,
+    models,
+    general=None,
+    together: bool = True,
+    hold_guard: bool | None = None,
+    seed: int = 0,
+    keyboard: KeyboardSpec | None = None,
 ) -> dict:
     options = {"general_policy": general} if controller == "sac" and general is not None else {}
     options["hold_guard"] = hold_guard
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", PianobotWarning)  # the left-out counts are in the figures
-        performance = play_hands(piece, controller, models, seed=seed, together=together, **options)
+        performance = play_hands(piece, controller, models, seed=seed, together=together, keyboard=keyboard, **options)
     whole = performance.report()
     out = {
         "f1": whole.f1,
@@ -121,17 +132,30 @@ def with_parts(piece, general, parts):
     return dict.fromkeys(piece.hands, parts)
 
 
-def play_set(pieces, general=None, together: bool = True, parts=None, hold_guard: bool | None = None) -> list[dict]:
+def play_set(
+    pieces,
+    general=None,
+    together: bool = True,
+    parts=None,
+    hold_guard: bool | None = None,
+    keyboard: KeyboardSpec | None = None,
+) -> list[dict]:
     """Every piece of a set played by both players: one row of figures per piece (``parts``: the
     parts policy, :func:`with_parts`; ``hold_guard``: the general policies through the hold guard,
-    as ``pianobot play`` plays them)."""
+    as ``pianobot play`` plays them; ``keyboard``: every part on these keys, as ``pianobot play
+    --lowest-note/--keys`` plays it, else each player's own)."""
     rows = []
     with tempfile.TemporaryDirectory() as models:
         for label, piece in pieces:
             piece = piece if piece.hands else piece.with_hands("left")
             row = {"piece": label, "notes": len(piece)}
             policies = with_parts(piece, general, parts)
-            row.update({player: figures(piece, player, models, policies, together, hold_guard) for player in PLAYERS})
+            row.update(
+                {
+                    player: figures(piece, player, models, policies, together, hold_guard, 0, keyboard)
+                    for player in PLAYERS
+                }
+            )
             rows.append(row)
             print(f"{label}: general {row['sac']['f1']:.3f}, scripted {row['scripted']['f1']:.3f}", flush=True)
     return rows
@@ -220,8 +244,18 @@ def main() -> None:
         help="the general policies through the hold guard, or (--no-hold-guard) alone; default: as `pianobot play` "
         "plays them (the parts policy through it, the melody policy alone)",
     )
+    parser.add_argument(
+        "--lowest-note",
+        type=parse_pitch,
+        help="with --keys, play every part of the random sets on these keys (as `pianobot play --lowest-note "
+        "--keys`), notes outside them left out; default: each player's own",
+    )
+    parser.add_argument("--keys", type=int, help="how many keys, from --lowest-note")
     parser.add_argument("--json", help="write every piece's figures here")
     args = parser.parse_args()
+    if (args.lowest_note is None) != (args.keys is None):
+        parser.error("--lowest-note and --keys go together")
+    keyboard = KeyboardSpec(args.lowest_note, args.keys) if args.keys is not None else None
     torch.set_num_threads(1)
     sets = {
         "duets": duet_set(args.seed, args.duets),
@@ -233,7 +267,7 @@ def main() -> None:
         if not pieces:
             continue
         general = {"right": args.general, "left": args.general_left} if args.general_left else args.general
-        results[name] = play_set(pieces, general, not args.apart, args.parts, args.hold_guard)
+        results[name] = play_set(pieces, general, not args.apart, args.parts, args.hold_guard, keyboard)
         print(table(name, results[name]), flush=True)
     if args.examples is not None:
         general = {"right": args.general, "left": args.general_left} if args.general_left else args.general

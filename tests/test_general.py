@@ -413,7 +413,7 @@ def test_a_parts_family_policy_is_a_general_policy_and_the_newest_comes_first(mo
 def test_the_packaged_left_hand_policy_plays_left_hands_only_while_the_store_has_no_general_policy(tmp_path, models):
     """The packaged `task-parts` policy is the left hand's by default, never the general policy of
     one hand; a general policy of the user's own plays both hands (none is offered then), and so
-    does the packaged general policy where the left hand's was trained on other keys."""
+    does the packaged general policy where the left hand's cannot play the keys (fewer than its own)."""
     from pianobot.agent.general import LEFT_KEY, general_candidates, left_hand_policy
     from pianobot.music.instrument import KeyboardSpec
 
@@ -423,7 +423,8 @@ def test_the_packaged_left_hand_policy_plays_left_hands_only_while_the_store_has
     assert left is not None and left.name.startswith(f"{LEFT_KEY}-") and PACKAGED in left.resolve().parents
     assert [f.name.split("-")[1] for f in general_candidates(empty)] == ["melody"]  # the packaged general policy
     assert left_hand_policy(empty, KeyboardSpec()) == left
-    assert left_hand_policy(empty, KeyboardSpec(lowest=36, count=36)) is None
+    assert left_hand_policy(empty, KeyboardSpec(lowest=36, count=36)) == left  # it plays any wider keyboard
+    assert left_hand_policy(empty, KeyboardSpec(lowest=60, count=12)) is None  # not a narrower one
     assert left_hand_policy(models) is None  # the user's own general policy plays both hands
     # ... but not one trained for other keys: it plays neither hand here, so the left keeps its own
     (mine,) = models.iterdir()

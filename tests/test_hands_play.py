@@ -79,18 +79,71 @@ def test_parts_too_far_apart_for_one_keyboard_play_apart_and_say_so():
     assert not performance.together and performance.report().f1 == 1.0
 
 
-def test_notes_outside_the_window_are_said_and_count_as_missed():
+def test_notes_outside_the_keys_named_are_said_and_count_as_missed():
     notes = [Note(0.5 * i, p, 0.5 * i + 0.4, hand="right") for i, p in enumerate([36, 62, 64, 65, 67, 96])]
     piece = Piece(tuple(notes))
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        performance = play_hands(piece, "sac")
+        performance = play_hands(piece, "sac", keyboard=KeyboardSpec())  # (the keys named: --lowest-note/--keys)
     said = [str(w.message) for w in caught if issubclass(w.category, PianobotWarning)]
     assert any("left out 2 note(s)" in line for line in said), said
     (right,) = performance.hands
     assert right.left_out == 2 and len(right.part) == 4
     report = performance.report()
     assert report.reference_notes == 6 and report.recall <= 4 / 6
+
+
+def test_a_part_wider_than_the_policys_keys_is_played_whole_on_its_own_octaves():
+    """By default the general policy is given a part wider than its 24 keys on the part's own range
+    (it plays any keyboard of at least its keys): nothing is left out, and it plays the notes
+    beyond its 24 keys."""
+    pitches = [55, 62, 64, 65, 67, 72, 76, 79, 81]  # G3-A5: no 24 keys of whole octaves hold it
+    notes = [Note(0.6 * i, p, 0.6 * i + 0.5, 80, hand="right") for i, p in enumerate(pitches)]
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        performance = play_hands(Piece(tuple(notes), bpm=100), "sac")
+    assert not [w for w in caught if "left out" in str(w.message)]
+    (right,) = performance.hands
+    assert right.left_out == 0 and right.describe() == "on C3-B5 (36 keys)"
+    assert right.performance.plan.config.world.keyboard.spec == KeyboardSpec(48, 36)
+    assert right.performer.startswith("general policy task-parts-")
+    played = {n.pitch for n in performance.played.notes}
+    assert {55, 81} <= played and performance.report().f1 >= 0.85  # (G3 and A5: 26 keys apart)
+
+
+def test_a_policy_that_reads_no_key_count_plays_any_keyboard_of_at_least_its_keys(tmp_path):
+    from dataclasses import replace
+
+    from pianobot.agent.general import LEFT_KEY, PACKAGED, find_general, plays_keyboard
+    from pianobot.agent.policy import policy_configs
+
+    env, sac = policy_configs(next(PACKAGED.glob(f"{LEFT_KEY}-*")))
+    wide, narrow = KeyboardSpec(48, 36), KeyboardSpec(60, 12)
+    assert plays_keyboard(env, sac, wide) and not plays_keyboard(env, sac, narrow)
+    assert not plays_keyboard(env, replace(sac, score_input=True), wide)  # a score window's size is the keys'
+    assert not plays_keyboard(replace(env, key_observations=True), sac, wide)
+    assert plays_keyboard(env, replace(sac, score_input=True), env.world.keyboard.spec)
+    on_wide = replace(env, world=replace(env.world, keyboard=replace(env.world.keyboard, spec=wide)))
+    assert find_general(tmp_path, on_wide) is not None  # a run on 36 keys starts from the packaged policy
+    on_narrow = replace(env, world=replace(env.world, keyboard=replace(env.world.keyboard, spec=narrow)))
+    assert find_general(tmp_path, on_narrow) is None
+
+
+def test_train_gives_a_wide_part_its_own_keys_as_play_does(tmp_path):
+    from pianobot.cli.commands.train import _hand_groups
+    from pianobot.learn.config import TrainConfig
+
+    right = [Note(0.6 * i, p, 0.6 * i + 0.5, 80, hand="right") for i, p in enumerate([55, 62, 67, 72, 81])]
+    piece = Piece((*right, Note(0.0, 48, 1.0, 70, hand="left")), bpm=100)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", PianobotWarning)
+        parts, _, offered, groups = _hand_groups(
+            piece, "wide", tmp_path, TrainConfig(), None, 6, KeyboardSpec(), HandSpec(), False
+        )
+    keys = {side: config.env.world.keyboard.spec for side, config, _, _ in groups}
+    assert keys == {"right": KeyboardSpec(48, 36), "left": KeyboardSpec()}
+    assert {side: parts[side][0].keyboard for side in parts} == keys
+    assert all(start is not None and start.name.startswith("task-parts-") for _, _, start, _ in groups)
 
 
 def test_a_note_without_a_hand_is_refused():

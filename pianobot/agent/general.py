@@ -19,6 +19,7 @@ change, a general policy that does not fit.
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -91,6 +92,27 @@ def difference(
     return found
 
 
+def plays_keyboard(env: EnvConfig, sac: SACConfig, keyboard: Any) -> bool:
+    """Whether a policy trained with ``env`` and ``sac`` plays on ``keyboard`` (a spec): its own
+    keyboard, or one of at least as many keys where nothing its networks read has the number of
+    keys for its size (no score window, no keys' observations) and its wrist slides rather than
+    picks a key. Its fingers' targets are where their notes lie from them, its wrist's position a
+    share of the keyboard's width: the keys' shapes and the hand are the world's, not the
+    keyboard's. (Measured on parts wider than 24 keys: docs/play.md, "Both hands".)"""
+    own = env.world.keyboard.spec
+    if keyboard == own:
+        return True
+    wide = keyboard.count >= own.count
+    return wide and not sac.score_input and not env.key_observations and not env.world.discrete_wrist
+
+
+def on_keyboard(env: EnvConfig, sac: SACConfig, keyboard: Any) -> EnvConfig:
+    """``env`` on ``keyboard`` where its policy plays it (:func:`plays_keyboard`); else ``env``."""
+    if not plays_keyboard(env, sac, keyboard):
+        return env
+    return replace(env, world=replace(env.world, keyboard=replace(env.world.keyboard, spec=keyboard)))
+
+
 def setting_for(path: str) -> str:
     """The setting (``train.<dotted path>``) a differing field belongs to, else the field itself."""
     found = next((s for s in SETTINGS if path == s or path.startswith(s + ".")), path)
@@ -128,14 +150,14 @@ def left_hand_policy(models: Path | None, keyboard: Any = None, hand: Any = None
     """The general policy that plays both hands of a two-hand piece by default (one-hand pieces have
     the general policy, :func:`general_candidates`): the packaged ``parts`` policy, when the user's
     store holds no general policy of its own for ``keyboard`` and ``hand`` (specs; None: any; such
-    a one plays both hands) and the packaged one was trained on them. None: both hands have the
+    a one plays both hands) and the packaged one plays them (:func:`plays_keyboard`). None: both hands have the
     general policy. Measured (docs/benchmarks.md, "Two hands"): alone, the left hands of 50 random
     two-hand pieces at note F1 0.929 against the melody policy's 0.861; through the hold guard, the
     right hands at 0.933 against the melody policy's 0.923."""
 
     def fits(folder: Path) -> bool:
-        world = policy_configs(folder)[0].world
-        return keyboard in (None, world.keyboard.spec) and hand in (None, world.hand.spec)
+        env, sac = policy_configs(folder)
+        return (keyboard is None or plays_keyboard(env, sac, keyboard)) and hand in (None, env.world.hand.spec)
 
     if models is not None and any(fits(folder) for folder in _newest_first(Path(models))):
         return None
@@ -178,6 +200,7 @@ def find_general(
     first = None
     for folder in candidates:
         their_env, their_sac = policy_configs(folder)
+        their_env = on_keyboard(their_env, their_sac, env.world.keyboard.spec)
         found = difference(env, their_env, sac, their_sac if sac is not None else None)
         if found is None:
             return folder

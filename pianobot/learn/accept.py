@@ -31,10 +31,11 @@ from typing import Callable, TypeVar
 import numpy as np
 
 from pianobot.agent import store
-from pianobot.agent.general import describe, find_general
+from pianobot.agent.general import describe, find_general, on_keyboard
 from pianobot.agent.policy import policy_configs
 from pianobot.env.piano import EnvConfig
 from pianobot.errors import PianobotError
+from pianobot.music.instrument import KeyboardSpec
 from pianobot.music.phrases import Phrase
 from pianobot.music.piece import Piece
 from pianobot.perform.compose import find_policy
@@ -152,13 +153,17 @@ def settle_piece(
     started: dict[str, float],
     seeds: tuple[int, ...] = JUDGE_SEEDS,
     on_play: Callable[[str], None] = lambda what: None,
+    keyboard: KeyboardSpec | None = None,
 ) -> Verdict:
     """Record and judge a piece's phrases after training (the module's steps). ``started``: the
     folder names of the phrases whose runs kept their start (the general policy played them at
-    step 0 as well as any policy trained for them), each with the note F1 it played at. ``on_play(what)`` is told before each whole-piece play."""
+    step 0 as well as any policy trained for them), each with the note F1 it played at.
+    ``on_play(what)`` is told before each whole-piece play. ``keyboard``: the keys the piece was
+    read for (default: the general policy's own)."""
     about = describe(general)  # its folder and the SHA-256 of its weights
     _mark_started(models, started, about)
     config = policy_configs(general)[0]
+    config = on_keyboard(config, policy_configs(general)[1], keyboard or config.world.keyboard.spec)
     own = _own_policies(models, phrases, config)
     at_start = {p.index for p in phrases if p.index not in own and find_policy(models, p) is None}
 
@@ -204,7 +209,9 @@ def settle_hands(
     hand. A policy that plays phrases of both hands is judged once, for all of them. The
     verdict's phrases are named '<hand> <number>'."""
     abouts = {hand: describe(general) for hand, general in generals.items()}
-    configs = {hand: policy_configs(general)[0] for hand, general in generals.items()}
+    configs = {
+        hand: on_keyboard(*policy_configs(general), parts[hand][0].keyboard) for hand, general in generals.items()
+    }
     for hand in parts:
         _mark_started(models, started.get(hand, {}), abouts[hand])
     own: dict[str, Path] = {}

@@ -34,15 +34,21 @@ class Window:
         return mirror_pitch(moved) if self.hand == "left" else moved
 
 
-def window_for(part: Piece, hand: str, keyboard: KeyboardSpec | None) -> Window:
+def window_for(part: Piece, hand: str, keyboard: KeyboardSpec | None, grow: bool = False) -> Window:
     """The window for ``hand``'s ``part``: on ``keyboard`` (a policy's) the octave shift that keeps
     the most notes on it (the smallest shift on a tie); with ``keyboard`` None, the part's own range
-    rounded out to octaves (:func:`~pianobot.music.instrument.keyboard_for`: every note kept)."""
+    rounded out to octaves (:func:`~pianobot.music.instrument.keyboard_for`: every note kept).
+    ``grow``: a part that does not fit on ``keyboard`` gets its own range instead, for a player
+    that plays any keyboard of at least its own keys
+    (:func:`~pianobot.agent.general.plays_keyboard`)."""
+    own = Window(hand, keyboard_for(part.mirror() if hand == "left" else part), 0)
     if keyboard is None:
-        return Window(hand, keyboard_for(part.mirror() if hand == "left" else part), 0)
+        return own
     plain = Window(hand, KeyboardSpec(), 0)
     pitches = [plain.inward(n.pitch) for n in part.notes]
     spans = range(-10, 11)
     kept = {k: sum(p + OCTAVE * k in keyboard for p in pitches) for k in spans}
     best = max(spans, key=lambda k: (kept[k], -abs(k)))
+    if grow and kept[best] < len(pitches):
+        return own
     return Window(hand, keyboard, best)

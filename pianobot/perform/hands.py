@@ -7,10 +7,11 @@ between keys:
 1. the left hand's part is mirrored about D (:meth:`~pianobot.music.piece.Piece.mirror`): the
    mirror image of a left hand is a right hand with the same finger numbers;
 2. the part is moved by whole octaves onto the keyboard its player knows (:class:`Window`): the
-   general policy's 24 keys, or, for the scripted pianist, the part's own range rounded out to
-   octaves.
+   general policy's 24 keys, or, for the scripted pianist and for a part wider than 24 keys, the
+   part's own range rounded out to octaves (the general policies play any keyboard of at least
+   their own keys: :func:`~pianobot.agent.general.plays_keyboard`).
 
-Notes outside the window are left out, and the part is then reduced to what the hand can play
+Notes outside the window (only where ``--lowest-note``/``--keys`` name the keys) are left out, and the part is then reduced to what the hand can play
 (:func:`~pianobot.pianist.reduce.reduce_part`), each kind of change said in one warning line; the
 figures are always against the piece as written, so what was left out counts as missed.
 
@@ -281,13 +282,19 @@ class HandsPerformance:
 
 
 def prepare_part(
-    piece: Piece, hand: str, keyboard: KeyboardSpec | None, fingers: HandSpec, start: float | None = None
+    piece: Piece,
+    hand: str,
+    keyboard: KeyboardSpec | None,
+    fingers: HandSpec,
+    start: float | None = None,
+    grow: bool = False,
 ) -> tuple[Window, Piece, float, int]:
     """``hand``'s part of ``piece`` as the simulated hand is given it: (window, part, start, notes
-    left out), the part moved ``start`` seconds earlier (default: to its first note). Each kind of
-    change is one :class:`PianobotWarning`, worded for the written part."""
+    left out), the part moved ``start`` seconds earlier (default: to its first note); ``grow``: a
+    part wider than ``keyboard`` is given its own range instead (:func:`~pianobot.music.window.window_for`).
+    Each kind of change is one :class:`PianobotWarning`, worded for the written part."""
     part = piece.part(hand)
-    window = window_for(part, hand, keyboard)
+    window = window_for(part, hand, keyboard, grow)
     inside = [n for n in part.notes if window.inward(n.pitch) in window.keyboard]
     left_out = len(part) - len(inside)
     if left_out:
@@ -323,8 +330,9 @@ def play_hands(
     """Perform ``piece``, every note of which has a hand (the module's notes): ``controller``
     'sac' (the general policy, or policies trained for the part) or 'scripted', ``models`` the
     model store, ``seed`` the hand starts, ``hand`` each hand's fingers; ``keyboard`` the keys
-    every part is moved onto (default: the general policy's 24 keys for 'sac', each part's own
-    range for 'scripted'); ``together``: both hands in one simulation (else hand by hand, each in
+    every part is moved onto (default: for 'sac' the general policy's 24 keys, or a part's own
+    range, rounded out to octaves, where it is wider; for 'scripted' each part's own range);
+    ``together``: both hands in one simulation (else hand by hand, each in
     a simulation of its own); ``on_step(done, total)`` reports progress; ``video``: keep the
     frames (both hands in one simulation only); ``options`` go to
     :func:`~pianobot.perform.plan.plan_performance` (``general``, ``fallback``, ...), where
@@ -334,26 +342,27 @@ def play_hands(
     if controller not in ("sac", "scripted"):
         raise PianobotError(f"controller {controller!r}: both hands are played by 'sac' or 'scripted'")
     fingers = hand or HandSpec()
+    grow = keyboard is None and controller == "sac"  # (the policies' 24 keys, or a wider part's own)
     keyboard = keyboard or (KeyboardSpec() if controller == "sac" else None)
     together = together and len(piece.hands) == 2
-    parts = prepare_parts(piece, keyboard, fingers, together)
+    parts = prepare_parts(piece, keyboard, fingers, together, grow)
     plans = plan_hands(parts, controller, models, fingers, options)
     return perform_hands(piece, parts, plans, seed, together, on_step, video)
 
 
 def prepare_parts(
-    piece: Piece, keyboard: KeyboardSpec | None, fingers: HandSpec, together: bool = True
+    piece: Piece, keyboard: KeyboardSpec | None, fingers: HandSpec, together: bool = True, grow: bool = False
 ) -> dict[str, tuple]:
     """Each hand's part as :func:`play_hands` gives it to its player, by hand (right first):
     (window, part, start, notes left out, changes), :func:`prepare_part`'s with the lines it
     warned (each said once more here). ``together``: both parts on one timeline, from the
-    piece's first note (else each from its own)."""
+    piece's first note (else each from its own); ``grow``: as :func:`prepare_part`'s."""
     offset = piece.notes[0].onset if together else None
     parts = {}
     for name in (h for h in HANDS if h in piece.hands):
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", PianobotWarning)
-            prepared = prepare_part(piece, name, keyboard, fingers, offset)
+            prepared = prepare_part(piece, name, keyboard, fingers, offset, grow)
         changes = tuple(str(w.message) for w in caught if issubclass(w.category, PianobotWarning))
         _warn_again(caught)
         parts[name] = (*prepared, changes)

@@ -26,7 +26,7 @@ from pathlib import Path
 from typing import Callable
 
 from pianobot.agent import store
-from pianobot.agent.general import PACKAGED, describe, find_general, general_candidates
+from pianobot.agent.general import PACKAGED, describe, find_general, general_candidates, on_keyboard, plays_keyboard
 from pianobot.agent.policy import policy_configs
 from pianobot.env.piano import EnvConfig, PianoEnv
 from pianobot.errors import PianobotError, SettingError
@@ -270,11 +270,11 @@ def _general_for(
     if path is not None:
         find_general(models, path=path)  # a folder that holds no policy: one line
     for folder in candidates:
-        world = policy_configs(folder)[0].world
-        if world.keyboard.spec == keyboard and world.hand.spec == hand:
+        their_env, their_sac = policy_configs(folder)
+        if plays_keyboard(their_env, their_sac, keyboard) and their_env.world.hand.spec == hand:
             return folder
     theirs = [f for f in candidates if path is not None or PACKAGED not in f.resolve().parents]
-    if not theirs:  # (the packaged policy plays its own keyboard and hand only)
+    if not theirs:  # (no packaged policy plays this keyboard and hand)
         return None
     world = policy_configs(theirs[0])[0].world
     raise SettingError(
@@ -330,7 +330,7 @@ def plan_performance(
     folder = _general_for(models, env, keyboard, hand, general_policy) if general else None
     stretches = assign(phrases, models, folder, fallback)
     if env is None and folder is not None:
-        env = policy_configs(folder)[0]
+        env = on_keyboard(*policy_configs(folder), keyboard)
     if env is None:  # the scripted pianist plays every phrase
         env = replace(PLAY_CONFIG, world=world)
     if env.world.keyboard.spec != keyboard or env.world.hand.spec != hand:

@@ -370,7 +370,7 @@ def train(
             "as `pianobot play` does, to judge its phrase policies"
         )
         if hands is None:
-            verdict = settle_piece(piece, phrases[None], models, judges[None], started[None])
+            verdict = settle_piece(piece, phrases[None], models, judges[None], started[None], keyboard=keyboard)
         else:
             verdict = settle_hands(piece, parts, phrases, models, judges, started)
         before, after = sum(verdict.before) / len(JUDGE_SEEDS), sum(verdict.after) / len(JUDGE_SEEDS)
@@ -403,24 +403,29 @@ def _hand_groups(
     (:func:`~pianobot.perform.hands.prepare_parts`), its phrases, the general policy ``play`` gives
     it, and the groups to train: (hand, config, start policy, jobs)). ``base``: the run's config
     before a start policy was picked. A phrase both hands play is one job, in the right hand's group."""
+    from dataclasses import replace
+
     from pianobot.agent.general import find_general
     from pianobot.learn.jobs import general_start, phrase_jobs
+    from pianobot.music.instrument import KeyboardSpec
     from pianobot.music.phrases import split_phrases
     from pianobot.perform.hands import hand_players, prepare_parts
 
-    parts = prepare_parts(piece, keyboard, hand)
+    parts = prepare_parts(piece, keyboard, hand, grow=keyboard == KeyboardSpec())  # (as play's default)
     named = {"general_policy": general_policy} if general_policy is not None else {}
     players = hand_players(parts, "sac", models, hand, named)
     phrases, offered, seen, groups = {}, {}, {}, []
-    for side, (_, part, *_) in parts.items():
+    for side, (window, part, *_) in parts.items():
         phrases[side] = split_phrases(part, phrase_notes)
         offered[side] = players[side].get("general_policy")
+        world = replace(base.env.world, keyboard=replace(base.env.world.keyboard, spec=window.keyboard))
+        side_base = replace(base, env=replace(base.env, world=world))  # (a part wider than 24 keys: its own)
         if offered[side] != general_policy:  # the packaged parts policy, which play offers only where it fits
             try:
-                find_general(models, base.env, base.sac if networks_given else None, offered[side])
+                find_general(models, side_base.env, base.sac if networks_given else None, offered[side])
             except SettingError:
                 offered[side] = general_policy
-        config, start = general_start(base, models, offered[side], networks_given=networks_given)
+        config, start = general_start(side_base, models, offered[side], networks_given=networks_given)
         jobs = []
         for job in phrase_jobs(phrases[side], config, models, piece=f"{name} ({side} hand)"):
             job.phrases = [f"{side} {number}" for number in job.phrases]
