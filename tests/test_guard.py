@@ -11,7 +11,7 @@ import pytest
 from pianobot.env.piano import EnvConfig, actuated_indices, idle_pose
 from pianobot.music.load import LoadOptions, load_piece
 from pianobot.music.piece import Note, Piece
-from pianobot.perform.guard import HoldGuard, WristGuard
+from pianobot.perform.guard import QUIET_STEPS, HoldGuard, WristGuard
 from pianobot.perform.perform import PLAY_CONFIG, perform
 from pianobot.pianist.scripted import ScriptedPianist
 from pianobot.pianist.tuning import PianistTuning
@@ -172,22 +172,32 @@ def test_through_the_hold_guard_a_policy_that_lets_go_plays_as_its_teacher():
 @pytest.mark.parametrize("actuated", [None, ("mcp", "pip")])
 def test_the_hold_guard_changes_only_the_holding_fingers_joints(actuated):
     """On every step the guard's action is the policy's but for the actuated joints of the fingers
-    that hold a note, which are what the scripted pianist that played every step itself would do."""
+    that hold a note, and the wrist while they hold and no note starts within QUIET_STEPS: those are
+    what the scripted pianist that played every step itself would do."""
     config = PLAY_CONFIG if actuated is None else replace(PLAY_CONFIG, actuated=actuated)
     recorder = LetsGo(config)
     perform(LEGATO, lambda env: recorder, config)
     asked = np.linspace(-0.9, 0.9, len(actuated_indices(config))).astype(np.float32)
     guard, teacher = HoldGuard(Constant(asked), config), ScriptedPianist(config)
-    holds = 0
+    holds, quiet, busy = 0, 0, 0
     for observation in recorder.observations:
         taught = teacher.act(observation)  # (it sees every step: it knows which notes began earlier)
         holding = np.flatnonzero(observation["targets"][:, -1] > 0)
         expected = asked.copy()
         for slot in holding:
             expected[joints_of(config, slot)] = taught[joints_of(config, slot)]
+        rows_to_next = [
+            round((1 - t[3]) * len(observation["score"])) for t in observation["targets"] if t[3] > 0
+        ]  # control steps until each finger's next note starts
+        if holding.size and min(rows_to_next, default=len(observation["score"])) > QUIET_STEPS:
+            expected[-1] = taught[-1]
+            quiet += 1
+        elif holding.size:
+            busy += 1
         assert np.array_equal(guard.act(observation), expected)
         holds += len(holding)
     assert holds == guard.held > 40
+    assert quiet == guard.wrist > 10 and busy > 5  # (E4 held after G4 is struck; C4 and E4 before a strike)
 
 
 def test_the_hold_guard_needs_finger_targets_and_speed_or_angle_control():

@@ -509,7 +509,12 @@ def _play_together(
         inward = Piece(tuple(moved), bpm=piece.bpm)  # (what the hand's player saw itself play)
         rollout = Rollout(part, inward, rewards[h], steps, None, env.score_start)
         performance = Performance(
-            plans[h], rollout, seed, plan.slowed_steps(controllers[h]), plan.held_steps(controllers[h])
+            plans[h],
+            rollout,
+            seed,
+            plan.slowed_steps(controllers[h]),
+            plan.held_steps(controllers[h]),
+            plan.wrist_steps(controllers[h]),
         )
         done.append(HandPerformance(h, window, part, start, left_out, performance, changes, own))
     start = env.score_start - offset

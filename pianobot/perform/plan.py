@@ -171,6 +171,9 @@ class Performance:
     """Steps at which the wrist guard slowed the general policy's wrist (None: no guard played)."""
     held_steps: int | None = None
     """Finger-steps the hold guard's scripted pianist moved a holding finger (None: no guard played)."""
+    wrist_steps: int = 0
+    """Control steps in which the hold guard's scripted pianist moved the wrist (a finger held, and no
+    note was to start soon)."""
 
     @property
     def played(self) -> Piece:
@@ -194,7 +197,11 @@ class Performance:
             return {}
         return {
             "wrist_guard": {"on": self.slowed_steps is not None, "slowed_steps": self.slowed_steps or 0},
-            "hold_guard": {"on": self.held_steps is not None, "held_finger_steps": self.held_steps or 0},
+            "hold_guard": {
+                "on": self.held_steps is not None,
+                "held_finger_steps": self.held_steps or 0,
+                "wrist_steps": self.wrist_steps,
+            },
         }
 
     def to_dict(self) -> dict:
@@ -380,6 +387,12 @@ def held_steps(controller: Controller) -> int | None:
     return guard.held if guard is not None else None
 
 
+def wrist_steps(controller: Controller) -> int:
+    """Control steps in which the hold guard moved the wrist in ``controller`` (0: none, or no guard)."""
+    guard = _guard(controller, HoldGuard)
+    return guard.wrist if guard is not None else 0
+
+
 def perform_plan(
     plan: PerformancePlan, seed: int = 0, video: bool = False, on_step: Callable[[int, int], None] | None = None
 ) -> Performance:
@@ -392,7 +405,7 @@ def perform_plan(
         return made[0]
 
     played = simulation.perform(plan.piece, controller, plan.config, seed, video, on_step)
-    return Performance(plan, played, seed, slowed_steps(made[0]), held_steps(made[0]))
+    return Performance(plan, played, seed, slowed_steps(made[0]), held_steps(made[0]), wrist_steps(made[0]))
 
 
 def play(
