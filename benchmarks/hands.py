@@ -84,6 +84,7 @@ def figures(
         "step_f1": whole.step_f1,
         "f1_offsets": whole.f1_with_offsets,
         "left_out": sum(h.left_out for h in performance.hands),
+        "given": sum(len(h.part) for h in performance.hands),  # (what the reduction left the hands to play)
     }
     for hand in piece.hands:
         out[f"f1_{hand}"] = performance.report(hand).f1

@@ -94,8 +94,13 @@ def test_track_option(tmp_path):
         )
         midi.tracks.append(track)
     midi.save(tmp_path / "two.mid")
-    assert_one_line_error(run("inspect", tmp_path / "two.mid"), "outside the keyboard", "C3")
+    # one hand cannot play it (C3 is off its keyboard): the fingering planner gives both hands a note
+    both = run("inspect", tmp_path / "two.mid")
+    assert both.exit_code == 0, both.output
+    text = " ".join(both.stdout.split())
+    assert "right hand: 1 note, C4-C4" in text and "left hand: 1 note, C3-C3" in text, text
     assert run("inspect", tmp_path / "two.mid", "--track", "one").exit_code == 0
+    assert_one_line_error(run("inspect", tmp_path / "two.mid", "--track", "two"), "outside the keyboard", "C3")
     assert_one_line_error(run("inspect", tmp_path / "two.mid", "--track", "9"), "no track '9'")
 
 
@@ -122,8 +127,15 @@ def test_bad_files_answer_with_one_line(tmp_path, scale_file, command):
 
 
 def test_polyphony_and_missing_fingers(tmp_path):
-    chord = write_midi(Piece(tuple(Note(0, p, 1) for p in (60, 64, 67, 71))), tmp_path / "c.mid")
-    assert_one_line_error(run("inspect", chord), "4 notes sound at once")
+    # fingered for one hand: the fingering says whose it is, and that hand has 3 fingers
+    fingered = Piece(tuple(Note(0, p, 1, 80, f) for p, f in zip((60, 64, 67, 71), (2, 3, 4, 4))))
+    assert_one_line_error(run("inspect", write_midi(fingered, tmp_path / "f.mid")), "4 notes sound at once")
+    # unfingered, one hand's reading refuses it: both hands play it, neither given more than its fingers
+    both = run("inspect", write_midi(fingered.without_fingering(), tmp_path / "c.mid"))
+    assert both.exit_code == 0, both.output
+    text = " ".join(both.stdout.split())
+    assert "`pianobot play` plays both" in text, text
+    assert re.search(r"right hand: [123] notes?, .* left hand: [123] notes?, ", text), text
     little = write_midi(Piece((Note(0, 60, 1, 80, 5),)), tmp_path / "l.mid")
     assert_one_line_error(run("inspect", little), "fingered 5 (little)")
 

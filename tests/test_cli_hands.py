@@ -143,10 +143,15 @@ def test_what_both_hands_cannot_do_yet_is_one_line(tmp_path, monkeypatch):
 
 
 # -- bad input (issue 35, item 8) ------------------------------------------------------------------
-def test_hands_that_cross_are_one_line(tmp_path):
+def test_hands_that_cross_are_one_line_and_the_planner_gives_the_hands(tmp_path):
     song = _duet(tmp_path / "cross.mid", left=_track((48, 0, 2), (79, 2, 4)))
     result = run("play", song, "-o", tmp_path / "out.mid", "--controller", "scripted")
-    assert_one_line_error(result, "the hands cross at 1.000 s", "--hand right")
+    assert result.exit_code == 0, result.output
+    said = [line for line in result.stderr.splitlines() if "the hands cross" in line]
+    assert len(said) == 1 and "at 1.000 s" in said[0] and "--hand right" in said[0], result.stderr
+    text = " ".join(result.stdout.split())
+    assert "left hand: 1 note, C3-C3, assigned by the fingering planner" in text, text  # G5 went to the right hand
+    assert json.loads((tmp_path / "out.report.json").read_text())["f1"] == 1.0
 
 
 def test_notes_beyond_the_pianos_keys_are_one_line_named_or_not(tmp_path):
@@ -217,7 +222,8 @@ def test_inspect_shows_each_hand_in_plays_words(tmp_path):
     played = run("play", unnamed, "-o", tmp_path / "o.mid", "--controller", "scripted")
     assert "left hand: 2 notes, E2-G2, assigned by the fingering planner" in " ".join(played.stdout.split())
     crossing = _duet(tmp_path / "cross.mid", left=_track((48, 0, 2), (79, 2, 4)))
-    assert_one_line_error(run("inspect", crossing), "the hands cross")
+    text = " ".join(run("inspect", crossing).stdout.split())
+    assert "left hand: 1 note, C3-C3, assigned by the fingering planner" in text, text
 
 
 # -- the two-hand examples (issue 35, item 7) ----------------------------------------------------------
@@ -346,3 +352,20 @@ def test_the_parts_policy_plays_through_the_hold_guard_unless_told(tmp_path):
         assert [hands[h]["hold_guard"]["on"] for h in ("right", "left")] == [right, left]
         assert [hands[h]["performer"].endswith("through the hold guard") for h in ("right", "left")] == [right, left]
         assert (hands["left"]["hold_guard"]["held_finger_steps"] > 10) is left
+
+
+def test_one_hand_of_a_part_wider_than_the_keyboard_names_the_keyboard_that_fits(tmp_path):
+    """--hand right of a part wider than the keyboard: the error says which keyboard plays it (not
+    to take one hand, which was asked already), and that keyboard does."""
+    song = _duet(tmp_path / "wide.mid", right=_track((67, 0, 1), (99, 1, 2)))  # G4 and D#7
+    out = tmp_path / "out.mid"
+    line = assert_one_line_error(
+        run("play", song, "--hand", "right", "-o", out, "--controller", "scripted"),
+        "the right hand's part spans G4-D#7",
+        "--lowest-note C4 --keys 48",
+    )
+    assert "--hand" not in line
+    fits = run(
+        "play", song, "--hand", "right", "--lowest-note", "C4", "--keys", "48", "-o", out, "--controller", "scripted"
+    )
+    assert fits.exit_code == 0, fits.output

@@ -115,6 +115,22 @@ def test_overlapping_notes_of_one_pitch_are_resolved_with_a_warning(tmp_path):
     assert [(n.onset, n.offset, n.velocity) for n in piece] == [(0.0, 0.5, 80), (0.5, 1.5, 100)]
 
 
+def test_many_overlaps_are_said_in_one_line_per_kind(tmp_path):
+    """A file with many doubled or cut notes warns once per kind, with the count and the first."""
+    beats = [m for i in range(12) for m in ((480 * i, on(60)), (480 * i + 240, off(60)))]  # C4 on every beat
+    long = [m for i in range(3) for m in ((1920 * i, on(72)), (1920 * i + 960, off(72)))]  # C5 for two beats
+    late = [m for i in range(3) for m in ((1920 * i + 480, on(72)), (1920 * i + 1440, off(72)))]  # again a beat in
+    path = midi_file(tmp_path / "d.mid", [("a", beats), ("b", beats), ("c", long), ("d", late)])
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        piece = read_midi(path)
+    said = [str(w.message) for w in caught if issubclass(w.category, PianobotWarning)]
+    assert len(said) == 2, said
+    assert said[0].startswith("12 notes appear twice at once (the first: C4 at 0.000 s"), said
+    assert said[1].startswith("3 notes still sound when their key starts again (the first: C5 at 0.000 s"), said
+    assert sum(n.pitch == 60 for n in piece) == 12 and sum(n.pitch == 72 for n in piece) == 6
+
+
 def test_retriggered_note_in_one_track_is_cut_with_a_warning(tmp_path):
     """Legato on a repeated note: the first note-off ends the first note, the second the second."""
     path = midi_file(tmp_path / "r.mid", [("a", [(0, on(60)), (240, on(60)), (480, off(60)), (600, off(60))])])

@@ -59,11 +59,17 @@ def test_one_player_plans_and_refusals(tmp_path):
     assert stretch.player is Player.SCRIPTED and stretch.policy is None
     with pytest.raises(PianobotError, match="controller 'sac2'"):
         plan_performance(piece, "sac2")
-    # with the thumb the packaged policy (three fingers) does not fit: nobody plays, said with where it looked
+    # with the thumb the packaged policy (three fingers) does not fit: nobody plays, said with where it
+    # looked and why the packaged one does not play it
     with pytest.raises(
-        PianobotError, match=r"no general policy plays it \(looked there and in .*policies\).*store.models"
+        PianobotError,
+        match=r"no general policy plays it \(looked there and in .*policies; the packaged general policies play "
+        r"with fingers 2 \(index\), 3 \(middle\), 4 \(ring\), this piece is read for fingers 1 \(thumb\).*"
+        r"\(hand.fingers\)\).*store.models",
     ):
         plan_performance(piece, models=tmp_path, hand=HandSpec(fingers=(1, 2, 3, 4)))
+    with pytest.raises(PianobotError, match=r"no general policy plays it \(looked there and in [^;]*policies\)"):
+        plan_performance(piece, models=tmp_path, general=False)  # (the packaged policy fits: no why)
     assert plan_performance(piece, models=tmp_path, general=False, fallback=True).performer == "scripted pianist"
     with pytest.raises(ValueError):
         Stretch(tuple(split_phrases(piece, 4)[:2]), Player.OWN, MODELS)  # an own policy plays one phrase

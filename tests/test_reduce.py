@@ -2,6 +2,7 @@
 kind of change; without --hand the planner still refuses it (pieces built in code)."""
 
 import warnings
+from dataclasses import replace
 
 import pytest
 from conftest import midi_file, off, on
@@ -133,12 +134,22 @@ def test_warnings_say_each_change_once_with_its_count(tmp_path):
 
 
 def test_without_hand_the_planner_still_refuses_what_the_hand_cannot_play(tmp_path):
+    """A fingered file is one hand's: the planner refuses what that hand cannot play (unfingered,
+    the same notes are given to both hands)."""
     runner = CliRunner()
-    wide = write_midi(piece((0, "C4", 0.5), (0, "C5", 0.5), (0.5, "D5", 1)), tmp_path / "wide.mid")
-    held = write_midi(piece((0, "E4", 2), (0, "C5", 0.5), (0.5, "G5", 1)), tmp_path / "held.mid")
+
+    def fingered(p: Piece, *fingers: int) -> Piece:
+        return Piece(tuple(replace(n, finger=f) for n, f in zip(p.notes, fingers)), bpm=p.bpm)
+
+    wide = write_midi(fingered(piece((0, "C4", 0.5), (0, "C5", 0.5), (0.5, "D5", 1)), 2, 4, 4), tmp_path / "wide.mid")
+    held = write_midi(fingered(piece((0, "E4", 2), (0, "C5", 0.5), (0.5, "G5", 1)), 2, 3, 4), tmp_path / "held.mid")
     for song, error in ((wide, "the chord C4 C5 at 0.000 s spans 16.4 cm"), (held, "no fingering lets this hand go")):
         result = runner.invoke(app, ["finger", str(song), "-o", str(tmp_path / "out.mid")])
         assert result.exit_code == 2 and error in " ".join(result.stderr.split()), result.output
+        if song == held:  # (what else to try: one voice, or --hand, which reduces the part; not --track alone)
+            assert "(--track), let the part be reduced to what one hand can play (--hand right" in " ".join(
+                result.stderr.split()
+            )
         result = runner.invoke(app, ["finger", str(song), "-o", str(tmp_path / "out.mid"), "--hand", "right"])
         assert result.exit_code == 0, result.output
         assert "the right hand's part" in " ".join(result.stderr.split())

@@ -1,6 +1,7 @@
 """Two-hand pieces at the reading level (pianobot.music.load.load_hands): hands from track names,
 bad input in one line."""
 
+import re
 import warnings
 
 import pytest
@@ -10,6 +11,7 @@ from pianobot.errors import PianobotWarning, SettingError
 from pianobot.music.load import LoadOptions, load_hands
 from pianobot.music.piece import Note, Piece
 from pianobot.music.pig import write_pig
+from pianobot.pianist.hands import load_two_hands
 
 
 def warning_lines(read, *args):
@@ -42,14 +44,22 @@ def test_notes_beyond_the_pianos_keys_are_refused_with_the_shift_that_fits(tmp_p
     assert [n.pitch for n in load_hands(path, LoadOptions(transpose=-12))] == [98, 48]
 
 
-def test_hands_that_cross_are_refused_in_one_line(tmp_path):
+def test_hands_that_cross_are_said_in_one_line_and_the_planner_gives_the_hands(tmp_path):
     path = midi_file(
         tmp_path / "cross.mid",
         [("Right Hand", _track((60, 0, 2))), ("Left Hand", _track((48, 0, 1), (67, 1, 2)))],
     )
-    with pytest.raises(SettingError, match=r"hands cross at 0.500 s: the left hand's G4 .* right hand's C4") as e:
-        load_hands(path)
-    assert e.value.field == "load.hand"
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        read = load_hands(path)
+    said = [str(w.message) for w in caught if issubclass(w.category, PianobotWarning)]
+    assert len(said) == 1 and re.search(r"hands cross at 0.500 s: the left hand's G4 .* right hand's C4", said[0])
+    assert "the fingering planner gives every note a hand" in said[0] and "load.hand right" in said[0]
+    assert all(n.hand is None for n in read.notes)  # (not the file's: load_two_hands gives them)
+    both = load_two_hands(path)
+    assert set(both.hands) == {"right", "left"}
+    for a in both.part("left").notes:  # no left-hand note at or above a right-hand note sounding with it
+        assert all(a.pitch < b.pitch for b in both.part("right").notes if a.onset < b.offset and b.onset < a.offset)
     # a legato overlap (the left hand's note let go just after the right hand's starts) is no crossing
     legato = midi_file(
         tmp_path / "legato.mid",

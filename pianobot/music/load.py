@@ -198,10 +198,11 @@ def load_hands(path: str | Path, options: LoadOptions = LoadOptions()) -> Piece:
     the PIG file's), None where nothing says (the fingering planner then gives it one:
     :func:`pianobot.pianist.hands.load_two_hands`).
 
-    Bad input, in one line: notes beyond the piano's 88 keys and hands that cross are refused
-    (:class:`SettingError` naming the setting that helps); three or more tracks of notes that are
-    not all named for hands are read as one part whose notes the planner gives to the hands, said
-    in one warning."""
+    Bad input, in one line: notes beyond the piano's 88 keys are refused (:class:`SettingError`
+    naming the setting that helps). Said in one warning each: hands that cross (the robot's two
+    hands share one rail) are not taken from the file, and the planner gives every note a hand;
+    three or more tracks of notes that are not all named for hands are read as one part whose
+    notes the planner gives to the hands."""
     path = Path(path)
     if options.hand is not None:
         raise SettingError(
@@ -235,7 +236,15 @@ def load_hands(path: str | Path, options: LoadOptions = LoadOptions()) -> Piece:
                 )
             )
     _check_keys(piece, path)
-    _check_crossing(piece, path)
+    crossing = _crossing(piece)
+    if crossing:
+        warnings.warn(
+            PianobotWarning(
+                f"{path.name}: the hands cross at {crossing}, and the robot's two hands cannot cross: "
+                "the fingering planner gives every note a hand instead (play one hand with load.hand right or load.hand left)"
+            )
+        )
+        piece = piece.with_hands(None)
     return piece
 
 
@@ -254,10 +263,10 @@ def _check_keys(piece: Piece, path: Path) -> None:
     )
 
 
-def _check_crossing(piece: Piece, path: Path) -> None:
-    """Refuse a left-hand note that sounds above (or on) a right-hand note at the same time: the
-    robot's hands share one rail and cannot cross. Notes let go within :data:`LEGATO_OVERLAP` of
-    the other's onset do not count (a player's legato)."""
+def _crossing(piece: Piece) -> str:
+    """Where a left-hand note first sounds above (or on) a right-hand note at the same time, in
+    words ('1.000 s: the left hand's G5 sounds at or above the right hand's D5'), else ''. Notes
+    let go within :data:`LEGATO_OVERLAP` of the other's onset do not count (a player's legato)."""
     sounding: list[Note] = []
     for note in piece.notes:
         if note.hand is None:
@@ -267,10 +276,6 @@ def _check_crossing(piece: Piece, path: Path) -> None:
         crossed = [n for n in other if (n.pitch >= note.pitch if note.hand == "right" else n.pitch <= note.pitch)]
         if crossed:
             left, right = (crossed[0], note) if note.hand == "right" else (note, crossed[0])
-            raise SettingError(
-                f"{path.name}: the hands cross at {note.onset:.3f} s: the left hand's {left.name} sounds at or above "
-                f"the right hand's {right.name}, and the robot's two hands cannot cross: play one hand with "
-                "load.hand right or load.hand left",
-                "load.hand",
-            )
+            return f"{note.onset:.3f} s: the left hand's {left.name} sounds at or above the right hand's {right.name}"
         sounding.append(note)
+    return ""

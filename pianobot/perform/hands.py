@@ -40,7 +40,7 @@ from pianobot.agent.general import left_hand_policy
 from pianobot.errors import PianobotError, PianobotWarning, SettingError
 from pianobot.music import midi_io
 from pianobot.music.hand_scores import HandsReport, compare_hands
-from pianobot.music.instrument import HandSpec, KeyboardSpec
+from pianobot.music.instrument import HandSpec, KeyboardSpec, check_playable
 from pianobot.music.load import LoadOptions, load_hands, load_piece, thin_hand
 from pianobot.music.metrics import Report
 from pianobot.music.piece import HANDS, Note, Piece, pitch_name
@@ -50,6 +50,7 @@ from pianobot.perform.plan import Performance
 from pianobot.perform.rollout import Rollout
 from pianobot.pianist.fingering import ensure_fingering
 from pianobot.pianist.hands import load_two_hands, reduce_hand
+from pianobot.pianist.reduce import load_for_hand
 
 APART = "each hand in a simulation of its own"
 """How both hands play with ``together=False``: said wherever such a performance is reported."""
@@ -122,32 +123,56 @@ def two_hands(
 
     Both hands: without ``options.hand`` and ``options.track``, a file whose tracks are named for
     hands (the notes of others given hands by the fingering planner), or a PIG file, with notes
-    for both hands; or a file that cannot be one hand's, its notes spanning more keys than one
-    hand's ``keyboard`` has (one hand's reading refuses it), whose notes the fingering planner
-    gives to both hands. The reading's warnings are said only where both hands play (or where it
-    refuses the file: hands that cross, notes beyond the piano)."""
+    for both hands; or a file that cannot be one hand's, whose notes the fingering planner gives
+    to both hands: its notes span more keys than one hand's ``keyboard`` has, or, unfingered,
+    one hand's reading refuses it (notes off ``keyboard``, more at once than the hand's fingers,
+    a chord or a move it cannot reach). Where the planner gives every note to one hand, or both
+    hands' reading refuses a file that one hand's refuses too, one hand's reading says why. The
+    reading's warnings are said only where both hands play (or where it refuses the file: notes
+    beyond the piano)."""
     path = Path(path)
     if options.hand is not None or options.track is not None:
         return None
     if path.suffix.lower() == ".txt" and (options.tempo or options.fingering or options.quantize):
         return None  # (one hand's reading refuses them in its own words)
+    one_hand_refuses = False
     if not names_hands(path):
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # said when the piece is read
-            pitches = [n.pitch for n in load_piece(path, options).notes]
+            piece = load_piece(path, options)
+        pitches = [n.pitch for n in piece.notes]
         if max(pitches) - min(pitches) < keyboard.count:
-            return None
+            if any(n.finger is not None for n in piece.notes) or one_hand_plays(path, options, spec, keyboard):
+                return None  # (a fingered file is one hand's: its fingers say so)
+            one_hand_refuses = True
     try:
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
             hands = read_hands(path, options, spec)
     except PianobotError:
+        if one_hand_refuses:
+            return None  # one hand's reading says why, in its own words
         _warn_again(caught)
         raise
     if len(hands.piece.hands) < 2:
         return None
     _warn_again(caught)
     return hands
+
+
+def one_hand_plays(path: str | Path, options: LoadOptions, spec: HandSpec, keyboard: KeyboardSpec) -> bool:
+    """Whether one hand's reading of the file at ``path`` plays it on ``keyboard``: its notes on the
+    keys, no more at once than ``spec``'s fingers, and a fingering the planner finds (what
+    ``pianobot play`` checks before it plays one hand)."""
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # said when the piece is read
+            piece = load_for_hand(path, options, keyboard, spec)
+            check_playable(piece, keyboard, spec)
+            ensure_fingering(piece, keyboard, spec, options.refinger)
+    except PianobotError:
+        return False
+    return True
 
 
 def _warn_again(caught: list) -> None:

@@ -210,18 +210,21 @@ class Performance:
 
 
 def assign(
-    phrases: list[Phrase], models: Path, general: Path | None = None, fallback: bool = False
+    phrases: list[Phrase], models: Path, general: Path | None = None, fallback: bool = False, passed_over: str = ""
 ) -> tuple[Stretch, ...]:
     """Who plays each phrase (the module's rule), as stretches in order. A phrase nobody can play
-    is a :class:`PianobotError` naming it, where the store is and how to go on."""
+    is a :class:`PianobotError` naming it, where the store is, why the packaged general policy
+    does not play it (``passed_over``, :func:`passed_over`) and how to go on."""
     index = store.general_plays(models)
     own = {p.index: f for p in phrases if (f := find_policy(models, p)) is not None and f.name not in index}
     for phrase in phrases:
         if phrase.index not in own and general is None and not fallback:
             notes = " ".join(n.name for n in phrase.notes)
+            where = str(models) if Path(str(models)).is_absolute() else f"{models} ({Path(models).resolve()})"
+            why = f"looked there and in {PACKAGED}" + (f"; {passed_over}" if passed_over else "")
             raise SettingError(
-                f"phrase {phrase.index} ({notes}) has no policy of its own in the model store {models} "
-                f"({Path(models).resolve()}) and no general policy plays it (looked there and in {PACKAGED}): "
+                f"phrase {phrase.index} ({notes}) has no policy of its own in the model store {where} "
+                f"and no general policy plays it ({why}): "
                 "train it with `pianobot train` (same reading options), train a general policy with "
                 "`pianobot train --task parts`, name another store with store.models DIR, add play.fallback scripted, "
                 "or play with play.controller scripted",
@@ -293,6 +296,27 @@ def _general_for(
     )
 
 
+def passed_over(keyboard: KeyboardSpec, hand: HandSpec) -> str:
+    """Why the packaged general policies do not play a piece read for ``keyboard`` and ``hand``, in
+    words naming the settings (the first that differs); '' where one plays it."""
+    packaged = general_candidates(None)
+    if not packaged or any(
+        plays_keyboard(env, sac, keyboard) and env.world.hand.spec == hand
+        for env, sac in (policy_configs(f) for f in packaged)
+    ):
+        return ""
+    world = policy_configs(packaged[0])[0].world
+    if world.hand.spec != hand:
+        return (
+            f"the packaged general policies play with fingers {world.hand.spec.describe()}, this piece is read for "
+            f"fingers {hand.describe()} (hand.fingers)"
+        )
+    return (
+        f"the packaged general policies play {world.keyboard.spec.describe()}, this piece is read for "
+        f"{keyboard.describe()} (keyboard.lowest, keyboard.count)"
+    )
+
+
 def plan_performance(
     piece: Piece,
     controller: str = "sac",
@@ -335,7 +359,7 @@ def plan_performance(
     phrases = trained_split(models, piece, phrase_notes)
     env = _own_environment(models, phrases)
     folder = _general_for(models, env, keyboard, hand, general_policy) if general else None
-    stretches = assign(phrases, models, folder, fallback)
+    stretches = assign(phrases, models, folder, fallback, passed_over(keyboard, hand) if general else "")
     if env is None and folder is not None:
         env = on_keyboard(*policy_configs(folder), keyboard)
     if env is None:  # the scripted pianist plays every phrase

@@ -318,7 +318,8 @@ class Planner:
             raise SettingError(
                 f"no fingering lets this hand go from {' '.join(n.name for n in chords[i - 1])} to "
                 f"{' '.join(n.name for n in chords[i])} at {chords[i][0].onset:.3f} s: the notes held there cross or lie "
-                "too far apart for its fingers; play one voice (load.track or load.hand) or shorten the held notes",
+                "too far apart for its fingers; play one voice (load.track), let the part be reduced to what one hand "
+                "can play (load.hand right or load.hand left), or shorten the held notes",
                 "load.track",
                 "load.hand",
             )

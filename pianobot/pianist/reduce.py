@@ -41,10 +41,10 @@ from typing import Sequence
 
 import numpy as np
 
-from pianobot.errors import PianobotWarning
-from pianobot.music.instrument import HandSpec, KeyboardSpec
+from pianobot.errors import PianobotWarning, SettingError
+from pianobot.music.instrument import PIANO, HandSpec, KeyboardSpec
 from pianobot.music.load import LoadOptions, load_part
-from pianobot.music.piece import Note, Piece
+from pianobot.music.piece import Note, Piece, pitch_name
 from pianobot.pianist.fingering import Planner, Reach
 from pianobot.sim.hand import HandConfig
 from pianobot.sim.keyboard import KeyboardConfig
@@ -126,6 +126,16 @@ def load_for_hand(path: str | Path, options: LoadOptions, keyboard: KeyboardSpec
     piece = load_part(path, options, hand)
     if options.hand is None:
         return piece
+    low, high = min(n.pitch for n in piece.notes), max(n.pitch for n in piece.notes)
+    if high - low >= keyboard.count:  # (no transposition fits it: say what keyboard does)
+        lowest = max(low // 12 * 12, PIANO.lowest)
+        count = min((high - lowest) // 12 * 12 + 12, PIANO.highest - lowest + 1)
+        raise SettingError(
+            f"the {options.hand} hand's part spans {pitch_name(low)}-{pitch_name(high)}, more keys than the keyboard "
+            f"{keyboard.describe()}: widen the keyboard, e.g. keyboard.lowest {pitch_name(lowest)} keyboard.count {count}",
+            "keyboard.lowest",
+            "keyboard.count",
+        )
     return reduce_part(piece, keyboard, hand, f"the {options.hand} hand's part").piece
 
 

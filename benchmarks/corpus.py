@@ -1,0 +1,181 @@
+"""Real two-hand keyboard music nobody here wrote: excerpts of music21's corpus of public-domain
+scores, written to MIDI files and played as ``pianobot play`` plays them, against each file.
+
+    pip install -e ".[corpus]"      # music21, which carries its corpus
+    python -m benchmarks.corpus [--out out/corpus] [--json out.json] [--only NAME ...]
+
+Each excerpt is a piece's first measures (from :data:`EXCERPTS`' first measure), as many as keep
+it within :data:`MAX_NOTES` notes and :data:`MAX_SECONDS` seconds at the score's own tempo
+(music21's default of 120 bpm where the score gives none), repeats not taken; its staves are
+the MIDI file's tracks, as music21 writes them (named "Piano" and the like, not for a hand: the
+fingering planner gives every note its hand, as it does for such a file in ``pianobot play``).
+Nothing was chosen or tuned on these pieces: they were played once, as found.
+
+Both players play each file as ``pianobot play`` reads it (:func:`pianobot.perform.hands.two_hands`):
+the general policies (the packaged ones: the parts policy on both hands, through the hold guard)
+from hand start 0, and the scripted pianist; figures against the file as written, so notes the
+reduction left out (faster than the hand moves, chords wider than it reaches, more notes than it
+has fingers) count as missed. ``notes given`` is how many of the written notes the hands were
+given to play after that reduction: the scripted pianist's ceiling.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import tempfile
+import time
+import warnings
+from pathlib import Path
+
+import numpy as np
+import torch
+
+from benchmarks.hands import figures
+from pianobot.errors import PianobotError, PianobotWarning
+from pianobot.music.load import LoadOptions
+from pianobot.perform.hands import two_hands
+
+EXCERPTS = (
+    # (name, music21 corpus path, the parts that are the piano's staves (None: all), first measure)
+    ("bach-prelude-c", "bach/bwv846", None, 1),
+    ("mozart-k545", "mozart/k545/movement1_exposition", None, 1),
+    ("joplin-maple-leaf", "joplin/maple_leaf_rag", None, 0),
+    ("chopin-mazurka-6-2", "chopin/mazurka06-2.krn", None, 1),
+    ("cpebach-h186", "cpebach/h186", None, 1),
+    ("schoenberg-op19-2", "schoenberg/opus19/movement2", None, 1),
+    ("schoenberg-op19-6", "schoenberg/opus19/movement6", None, 1),
+    ("clara-schumann-polonaise", "schumann_clara/polonaise_op1n1", None, 1),
+    ("beach-prayer", "beach/prayer_of_a_tired_child", (4, 5), 1),
+    ("aloha-oe", "liliuokalani/aloha_oe", (5, 6), 0),
+    ("chorale-bwv66-6", "bach/bwv66.6", None, 0),
+    ("chorale-bwv269", "bach/bwv269", None, 0),
+)
+"""Two-staff keyboard pieces of every kind the corpus holds (a prelude, a sonata, a rag, a
+mazurka, a polonaise, atonal miniatures, a song's accompaniment) and two four-voice chorales."""
+MAX_NOTES = 150
+MAX_SECONDS = 40.0
+
+
+def _measures(score, parts, first: int, last: int):
+    """The excerpt: measures ``first``..``last`` of ``parts``, repeat signs taken away."""
+    from music21 import bar, stream
+
+    excerpt = stream.Score()
+    for part in score.parts if parts is None else [score.parts[i] for i in parts]:
+        sub = part.measures(first, last)
+        for measure in sub.recurse().getElementsByClass("Measure"):
+            for side in ("leftBarline", "rightBarline"):
+                if isinstance(getattr(measure, side), bar.Repeat):
+                    setattr(measure, side, None)
+            for mark in list(measure.getElementsByClass("RepeatExpression")):
+                measure.remove(mark)
+        for bracket in list(sub.recurse().getElementsByClass("RepeatBracket")):
+            sub.remove(bracket, recurse=True)
+        excerpt.insert(0, sub)
+    return excerpt
+
+
+def write_excerpt(path: str, parts, first: int, out: Path) -> dict:
+    """Write the longest excerpt from measure ``first`` within the limits to ``out``; what it holds."""
+    from music21 import corpus
+    from music21.midi import translate
+
+    score = corpus.parse(path)
+    measures = [m.number for m in score.parts[0].getElementsByClass("Measure")]
+    kept = None
+    for last in range(first, max(measures) + 1):
+        excerpt = _measures(score, parts, first, last)
+        notes = sum(len(n.pitches) for n in excerpt.stripTies().flatten().notes)
+        if notes > MAX_NOTES or excerpt.flatten().seconds > MAX_SECONDS:
+            break
+        kept = (last, excerpt)
+    if kept is None:
+        raise ValueError(f"{path}: measure {first} alone is over the limits")
+    last, excerpt = kept
+    midi = translate.streamToMidiFile(excerpt)
+    midi.open(str(out), "wb")
+    midi.write()
+    midi.close()
+    return {"source": path, "measures": f"{first}-{last}"}
+
+
+def play_corpus(folder: Path, only: tuple[str, ...] = ()) -> list[dict]:
+    """Write the excerpts to ``folder`` and play each with both players; a row each."""
+    folder.mkdir(parents=True, exist_ok=True)
+    rows = []
+    for name, path, parts, first in EXCERPTS:
+        if only and name not in only:
+            continue
+        file = folder / f"{name}.mid"
+        row = {"piece": name, **write_excerpt(path, parts, first, file)}
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", PianobotWarning)
+                reading = two_hands(file, LoadOptions())
+        except PianobotError as error:  # (refused: the row says why)
+            rows.append({**row, "refused": str(error)})
+            print(f"{name}: refused: {error}", flush=True)
+            continue
+        if reading is None:
+            rows.append({**row, "refused": "read as one hand's file"})
+            print(f"{name}: read as one hand's file", flush=True)
+            continue
+        with tempfile.TemporaryDirectory() as models:  # (an empty store: the packaged policies play)
+            piece = reading.piece
+            row.update(notes=len(piece), sac=figures(piece, "sac", models), scripted=figures(piece, "scripted", models))
+        rows.append(row)
+        print(f"{name}: general {row['sac']['f1']:.3f}, scripted {row['scripted']['f1']:.3f}", flush=True)
+    return rows
+
+
+def table(rows: list[dict]) -> str:
+    lines = [
+        "| piece | corpus path (measures) | notes | notes given | note F1, general policy | right | left | "
+        "per-step F1 | note F1, scripted pianist | general / scripted |",
+        "| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |",
+    ]
+    played = [r for r in rows if "refused" not in r]
+    for r in rows:
+        where = f"`{r['source']}` ({r['measures']})"
+        if "refused" in r:
+            lines.append(f"| {r['piece']} | {where} | | | refused: {r['refused']} | | | | | |")
+            continue
+        g, s = r["sac"], r["scripted"]
+        lines.append(
+            f"| {r['piece']} | {where} | {r['notes']} | {g['given']} | {g['f1']:.3f} | {g.get('f1_right', 0):.3f} | "
+            f"{g.get('f1_left', 0):.3f} | {g['step_f1']:.3f} | {s['f1']:.3f} | {g['f1'] / s['f1']:.0%} |"
+        )
+    if played:
+        general = np.mean([r["sac"]["f1"] for r in played])
+        scripted = np.mean([r["scripted"]["f1"] for r in played])
+        given = sum(r["sac"]["given"] for r in played) / sum(r["notes"] for r in played)
+        lines.append(
+            f"| mean ({len(played)} played) | | | {given:.0%} given | {general:.3f} | | | "
+            f"{np.mean([r['sac']['step_f1'] for r in played]):.3f} | {scripted:.3f} | {general / scripted:.0%} |"
+        )
+    return "\n".join(lines)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--out", type=Path, default=Path("out/corpus"), help="folder the excerpts are written to")
+    parser.add_argument("--only", nargs="+", default=(), help="only these excerpts (by name)")
+    parser.add_argument("--json", type=Path, help="write every figure to this file")
+    args = parser.parse_args()
+    torch.set_num_threads(1)  # (the simulation is the cost; torch's threads would only contend)
+    try:
+        import music21
+    except ImportError:
+        parser.error('music21 is not installed: pip install -e ".[corpus]"')
+    started = time.perf_counter()
+    rows = play_corpus(args.out, tuple(args.only))
+    print()
+    print(table(rows))
+    print(f"\nmusic21 {music21.__version__}; {time.perf_counter() - started:.0f} s")
+    if args.json:
+        args.json.write_text(json.dumps({"music21": music21.__version__, "rows": rows}, indent=2) + "\n")
+
+
+if __name__ == "__main__":
+    main()
