@@ -6,17 +6,21 @@ scores, written to MIDI files and played as ``pianobot play`` plays them, agains
 
 Each excerpt is a piece's first measures (from :data:`EXCERPTS`' first measure), as many as keep
 it within :data:`MAX_NOTES` notes and :data:`MAX_SECONDS` seconds at the score's own tempo
-(music21's default of 120 bpm where the score gives none), repeats not taken; its staves are
-the MIDI file's tracks, as music21 writes them (named "Piano" and the like, not for a hand: the
-fingering planner gives every note its hand, as it does for such a file in ``pianobot play``).
+(music21's default of 120 bpm where the score gives none), repeats not taken; its staves (the
+chorales' voices) are the MIDI file's tracks, named as music21 names them: "Piano" and the like,
+for no hand, so the fingering planner gives their notes hands, as ``pianobot play`` does; a
+chorale's "Bass" is read as a left hand's track (its other voices go to the hands by the planner).
 Nothing was chosen or tuned on these pieces: they were played once, as found.
 
 Both players play each file as ``pianobot play`` reads it (:func:`pianobot.perform.hands.two_hands`):
 the general policies (the packaged ones: the parts policy on both hands, through the hold guard)
 from hand start 0, and the scripted pianist; figures against the file as written, so notes the
 reduction left out (faster than the hand moves, chords wider than it reaches, more notes than it
-has fingers) count as missed. ``notes given`` is how many of the written notes the hands were
-given to play after that reduction: the scripted pianist's ceiling.
+has fingers) count as missed. ``notes`` is the file as ``pianobot play`` reads it (a chord of
+more notes than two hands have fingers thinned), ``notes given`` how many of them the hands were
+given to play after that reduction: the most a player can strike. ``--apart`` plays each hand in a
+simulation of its own (``pianobot.perform.hands.play_hands(..., together=False)``): what the
+hands lose by getting in each other's way.
 """
 
 from __future__ import annotations
@@ -100,8 +104,9 @@ def write_excerpt(path: str, parts, first: int, out: Path) -> dict:
     return {"source": path, "measures": f"{first}-{last}"}
 
 
-def play_corpus(folder: Path, only: tuple[str, ...] = ()) -> list[dict]:
-    """Write the excerpts to ``folder`` and play each with both players; a row each."""
+def play_corpus(folder: Path, only: tuple[str, ...] = (), together: bool = True) -> list[dict]:
+    """Write the excerpts to ``folder`` and play each with both players (``together``: both hands
+    in one simulation, as ``pianobot play`` plays them); a row each."""
     folder.mkdir(parents=True, exist_ok=True)
     rows = []
     for name, path, parts, first in EXCERPTS:
@@ -123,7 +128,11 @@ def play_corpus(folder: Path, only: tuple[str, ...] = ()) -> list[dict]:
             continue
         with tempfile.TemporaryDirectory() as models:  # (an empty store: the packaged policies play)
             piece = reading.piece
-            row.update(notes=len(piece), sac=figures(piece, "sac", models), scripted=figures(piece, "scripted", models))
+            row.update(
+                notes=len(piece),
+                sac=figures(piece, "sac", models, together=together),
+                scripted=figures(piece, "scripted", models, together=together),
+            )
         rows.append(row)
         print(f"{name}: general {row['sac']['f1']:.3f}, scripted {row['scripted']['f1']:.3f}", flush=True)
     return rows
@@ -144,7 +153,7 @@ def table(rows: list[dict]) -> str:
         g, s = r["sac"], r["scripted"]
         lines.append(
             f"| {r['piece']} | {where} | {r['notes']} | {g['given']} | {g['f1']:.3f} | {g.get('f1_right', 0):.3f} | "
-            f"{g.get('f1_left', 0):.3f} | {g['step_f1']:.3f} | {s['f1']:.3f} | {g['f1'] / s['f1']:.0%} |"
+            f"{g.get('f1_left', 0):.3f} | {g['step_f1']:.3f} | {s['f1']:.3f} | {_share(g['f1'], s['f1'])} |"
         )
     if played:
         general = np.mean([r["sac"]["f1"] for r in played])
@@ -152,9 +161,13 @@ def table(rows: list[dict]) -> str:
         given = sum(r["sac"]["given"] for r in played) / sum(r["notes"] for r in played)
         lines.append(
             f"| mean ({len(played)} played) | | | {given:.0%} given | {general:.3f} | | | "
-            f"{np.mean([r['sac']['step_f1'] for r in played]):.3f} | {scripted:.3f} | {general / scripted:.0%} |"
+            f"{np.mean([r['sac']['step_f1'] for r in played]):.3f} | {scripted:.3f} | {_share(general, scripted)} |"
         )
     return "\n".join(lines)
+
+
+def _share(general: float, scripted: float) -> str:
+    return f"{general / scripted:.0%}" if scripted > 0 else "n/a"
 
 
 def main() -> None:
@@ -162,6 +175,7 @@ def main() -> None:
     parser.add_argument("--out", type=Path, default=Path("out/corpus"), help="folder the excerpts are written to")
     parser.add_argument("--only", nargs="+", default=(), help="only these excerpts (by name)")
     parser.add_argument("--json", type=Path, help="write every figure to this file")
+    parser.add_argument("--apart", action="store_true", help="each hand in a simulation of its own")
     args = parser.parse_args()
     torch.set_num_threads(1)  # (the simulation is the cost; torch's threads would only contend)
     try:
@@ -169,12 +183,14 @@ def main() -> None:
     except ImportError:
         parser.error('music21 is not installed: pip install -e ".[corpus]"')
     started = time.perf_counter()
-    rows = play_corpus(args.out, tuple(args.only))
+    rows = play_corpus(args.out, tuple(args.only), together=not args.apart)
+    seconds = time.perf_counter() - started
     print()
     print(table(rows))
-    print(f"\nmusic21 {music21.__version__}; {time.perf_counter() - started:.0f} s")
+    print(f"\nmusic21 {music21.__version__}; {'each hand apart; ' if args.apart else ''}{seconds:.0f} s")
     if args.json:
-        args.json.write_text(json.dumps({"music21": music21.__version__, "rows": rows}, indent=2) + "\n")
+        record = {"music21": music21.__version__, "apart": args.apart, "seconds": round(seconds), "rows": rows}
+        args.json.write_text(json.dumps(record, indent=2) + "\n")
 
 
 if __name__ == "__main__":

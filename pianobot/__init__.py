@@ -9,7 +9,7 @@ stays quick (it registers the gymnasium ids ``pianobot/Piano-v0``, ``pianobot/On
 - :class:`ScriptedPianist` -- the hand-written pianist;
 - :func:`play` -- a whole piece performed as ``pianobot play`` performs it (:func:`plan_performance`
   says who plays each stretch, :func:`perform_plan` plays a plan); a piece with both hands plays
-  both, each hand in a simulation of its own (:func:`load_two_hands` reads a two-hand file);
+  both, in one simulation (:func:`load_two_hands` reads a two-hand file);
 - :func:`compare` -- note F1, velocity and timing errors of a performance against its score.
 """
 

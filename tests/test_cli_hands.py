@@ -369,3 +369,36 @@ def test_one_hand_of_a_part_wider_than_the_keyboard_names_the_keyboard_that_fits
         "play", song, "--hand", "right", "--lowest-note", "C4", "--keys", "48", "-o", out, "--controller", "scripted"
     )
     assert fits.exit_code == 0, fits.output
+
+
+def test_a_melody_that_only_needs_transposing_stays_one_hands(tmp_path):
+    """One line of notes above the keyboard is one hand's: the error says which --transpose plays
+    it, rather than sharing the notes between two hands."""
+    song = _one_track(tmp_path / "high.mid", *((p, i, i + 1) for i, p in enumerate((72, 76, 79, 84, 88, 91, 95))))
+    line = assert_one_line_error(run("inspect", song), "outside the keyboard C4-B5", "--transpose -12")
+    assert "hand" not in line.split("outside")[0]
+    assert run("inspect", song, "--transpose", "-12").exit_code == 0
+
+
+def test_score_of_one_hand_of_a_wide_part_scores_it(tmp_path):
+    """score has no keyboard options: --hand right of a part wider than the keyboard is scored as
+    written (play refuses it, naming the keyboard that fits)."""
+    song = _duet(tmp_path / "wide.mid", right=_track((67, 0, 1), (99, 4, 5)))
+    played = run(
+        "play",
+        song,
+        "--hand",
+        "right",
+        "--lowest-note",
+        "C4",
+        "--keys",
+        "48",
+        "-o",
+        tmp_path / "p.mid",
+        "--controller",
+        "scripted",
+    )
+    assert played.exit_code == 0, played.output
+    scored = run("score", tmp_path / "p.mid", song, "--hand", "right", "--json", tmp_path / "s.json")
+    assert scored.exit_code == 0, scored.output
+    assert json.loads((tmp_path / "s.json").read_text())["f1"] == 1.0

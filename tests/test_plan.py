@@ -11,10 +11,10 @@ import pianobot
 from pianobot.agent import store
 from pianobot.agent.general import GENERAL_KEY, PACKAGED
 from pianobot.errors import PianobotError
-from pianobot.music.instrument import HandSpec
+from pianobot.music.instrument import HandSpec, KeyboardSpec
 from pianobot.music.phrases import DEFAULT_MAX_NOTES, split_phrases
 from pianobot.music.piece import Note, Piece
-from pianobot.perform.plan import Player, Stretch, plan_performance
+from pianobot.perform.plan import Player, Stretch, passed_over, plan_performance
 
 ROOT = Path(__file__).parent.parent
 MODELS = ROOT / "models"
@@ -64,12 +64,13 @@ def test_one_player_plans_and_refusals(tmp_path):
     with pytest.raises(
         PianobotError,
         match=r"no general policy plays it \(looked there and in .*policies; the packaged general policies play "
-        r"with fingers 2 \(index\), 3 \(middle\), 4 \(ring\), this piece is read for fingers 1 \(thumb\).*"
+        r"with fingers 2 \(index\), 3 \(middle\), 4 \(ring\); this piece is read for fingers 1 \(thumb\).*"
         r"\(hand.fingers\)\).*store.models",
     ):
         plan_performance(piece, models=tmp_path, hand=HandSpec(fingers=(1, 2, 3, 4)))
-    with pytest.raises(PianobotError, match=r"no general policy plays it \(looked there and in [^;]*policies\)"):
-        plan_performance(piece, models=tmp_path, general=False)  # (the packaged policy fits: no why)
+    assert passed_over(KeyboardSpec(), HandSpec()) == ""  # the packaged policies play these: nothing to say
+    assert passed_over(KeyboardSpec(48, 36), HandSpec()) == ""  # (wider keyboards too)
+    assert passed_over(KeyboardSpec(48, 20), HandSpec()).endswith("read for C3-G4 (20 keys) (keyboard.count)")
     assert plan_performance(piece, models=tmp_path, general=False, fallback=True).performer == "scripted pianist"
     with pytest.raises(ValueError):
         Stretch(tuple(split_phrases(piece, 4)[:2]), Player.OWN, MODELS)  # an own policy plays one phrase

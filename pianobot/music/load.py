@@ -238,10 +238,11 @@ def load_hands(path: str | Path, options: LoadOptions = LoadOptions()) -> Piece:
     _check_keys(piece, path)
     crossing = _crossing(piece)
     if crossing:
+        one = "" if path.suffix.lower() == ".txt" else " (play one hand with load.hand right or load.hand left)"
         warnings.warn(
             PianobotWarning(
                 f"{path.name}: the hands cross at {crossing}, and the robot's two hands cannot cross: "
-                "the fingering planner gives every note a hand instead (play one hand with load.hand right or load.hand left)"
+                f"the fingering planner gives every note a hand instead{one}"
             )
         )
         piece = piece.with_hands(None)

@@ -50,7 +50,6 @@ from pianobot.perform.plan import Performance
 from pianobot.perform.rollout import Rollout
 from pianobot.pianist.fingering import ensure_fingering
 from pianobot.pianist.hands import load_two_hands, reduce_hand
-from pianobot.pianist.reduce import load_for_hand
 
 APART = "each hand in a simulation of its own"
 """How both hands play with ``together=False``: said wherever such a performance is reported."""
@@ -135,16 +134,18 @@ def two_hands(
         return None
     if path.suffix.lower() == ".txt" and (options.tempo or options.fingering or options.quantize):
         return None  # (one hand's reading refuses them in its own words)
-    one_hand_refuses = False
+    one_hand_refuses = ""
     if not names_hands(path):
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # said when the piece is read
             piece = load_piece(path, options)
         pitches = [n.pitch for n in piece.notes]
         if max(pitches) - min(pitches) < keyboard.count:
-            if any(n.finger is not None for n in piece.notes) or one_hand_plays(path, options, spec, keyboard):
+            if any(n.finger is not None for n in piece.notes):
                 return None  # (a fingered file is one hand's: its fingers say so)
-            one_hand_refuses = True
+            one_hand_refuses = one_hand_refusal(piece, spec, keyboard, options.refinger)
+            if not one_hand_refuses:
+                return None
     try:
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
@@ -157,22 +158,34 @@ def two_hands(
     if len(hands.piece.hands) < 2:
         return None
     _warn_again(caught)
+    if one_hand_refuses:
+        warnings.warn(
+            PianobotWarning(
+                f"{path.name}: one hand cannot play it ({one_hand_refuses}): its notes are given to both hands"
+            )
+        )
     return hands
 
 
-def one_hand_plays(path: str | Path, options: LoadOptions, spec: HandSpec, keyboard: KeyboardSpec) -> bool:
-    """Whether one hand's reading of the file at ``path`` plays it on ``keyboard``: its notes on the
-    keys, no more at once than ``spec``'s fingers, and a fingering the planner finds (what
-    ``pianobot play`` checks before it plays one hand)."""
+def one_hand_refusal(piece: Piece, spec: HandSpec, keyboard: KeyboardSpec, refinger: bool = False) -> str:
+    """Why one hand with ``spec``'s fingers cannot play ``piece`` (unfingered, spanning fewer keys
+    than ``keyboard`` has), in words; '' where it can. It is asked on a keyboard of ``keyboard``'s
+    size under the piece's notes: notes a transposition would bring onto the keys are no reason for
+    two hands (one hand's reading then says which ``--transpose``). A single line of notes is
+    always one hand's (the fingering planner only slows what is fast); chords and held notes are
+    asked of the planner."""
+    low, high = min(n.pitch for n in piece.notes), max(n.pitch for n in piece.notes)
+    lowest = low - 1 if KeyboardSpec.is_black(low) and high - low < keyboard.count - 1 else low  # (a white key)
+    under = KeyboardSpec(min(lowest, 128 - keyboard.count), keyboard.count)
     try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")  # said when the piece is read
-            piece = load_for_hand(path, options, keyboard, spec)
-            check_playable(piece, keyboard, spec)
-            ensure_fingering(piece, keyboard, spec, options.refinger)
-    except PianobotError:
-        return False
-    return True
+        check_playable(piece, under, spec)  # (more notes at once than fingers)
+        if piece.max_polyphony()[0] > 1:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")  # (one hand's reading says them, where one hand plays)
+                ensure_fingering(piece, under, spec, refinger)
+    except PianobotError as refused:
+        return str(refused).split(": ")[0]
+    return ""
 
 
 def _warn_again(caught: list) -> None:

@@ -210,18 +210,22 @@ class Performance:
 
 
 def assign(
-    phrases: list[Phrase], models: Path, general: Path | None = None, fallback: bool = False, passed_over: str = ""
+    phrases: list[Phrase],
+    models: Path,
+    general: Path | None = None,
+    fallback: bool = False,
+    passed_over: Callable[[], str] = lambda: "",
 ) -> tuple[Stretch, ...]:
     """Who plays each phrase (the module's rule), as stretches in order. A phrase nobody can play
     is a :class:`PianobotError` naming it, where the store is, why the packaged general policy
-    does not play it (``passed_over``, :func:`passed_over`) and how to go on."""
+    does not play it (``passed_over()``, asked only then: :func:`passed_over`) and how to go on."""
     index = store.general_plays(models)
     own = {p.index: f for p in phrases if (f := find_policy(models, p)) is not None and f.name not in index}
     for phrase in phrases:
         if phrase.index not in own and general is None and not fallback:
             notes = " ".join(n.name for n in phrase.notes)
             where = str(models) if Path(str(models)).is_absolute() else f"{models} ({Path(models).resolve()})"
-            why = f"looked there and in {PACKAGED}" + (f"; {passed_over}" if passed_over else "")
+            why = f"looked there and in {PACKAGED}" + (f"; {reason}" if (reason := passed_over()) else "")
             raise SettingError(
                 f"phrase {phrase.index} ({notes}) has no policy of its own in the model store {where} "
                 f"and no general policy plays it ({why}): "
@@ -308,12 +312,12 @@ def passed_over(keyboard: KeyboardSpec, hand: HandSpec) -> str:
     world = policy_configs(packaged[0])[0].world
     if world.hand.spec != hand:
         return (
-            f"the packaged general policies play with fingers {world.hand.spec.describe()}, this piece is read for "
+            f"the packaged general policies play with fingers {world.hand.spec.describe()}; this piece is read for "
             f"fingers {hand.describe()} (hand.fingers)"
         )
     return (
-        f"the packaged general policies play {world.keyboard.spec.describe()}, this piece is read for "
-        f"{keyboard.describe()} (keyboard.lowest, keyboard.count)"
+        f"the packaged general policies play keyboards of {world.keyboard.spec.count} keys or more; this piece is "
+        f"read for {keyboard.describe()} (keyboard.count)"
     )
 
 
@@ -359,7 +363,9 @@ def plan_performance(
     phrases = trained_split(models, piece, phrase_notes)
     env = _own_environment(models, phrases)
     folder = _general_for(models, env, keyboard, hand, general_policy) if general else None
-    stretches = assign(phrases, models, folder, fallback, passed_over(keyboard, hand) if general else "")
+    stretches = assign(
+        phrases, models, folder, fallback, (lambda: passed_over(keyboard, hand)) if general else lambda: ""
+    )
     if env is None and folder is not None:
         env = on_keyboard(*policy_configs(folder), keyboard)
     if env is None:  # the scripted pianist plays every phrase

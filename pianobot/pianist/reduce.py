@@ -119,15 +119,19 @@ def reduce_part(piece: Piece, keyboard: KeyboardSpec, hand: HandSpec, part: str 
     return reduction
 
 
-def load_for_hand(path: str | Path, options: LoadOptions, keyboard: KeyboardSpec, hand: HandSpec) -> Piece:
+def load_for_hand(
+    path: str | Path, options: LoadOptions, keyboard: KeyboardSpec, hand: HandSpec, fit: bool = True
+) -> Piece:
     """:func:`~pianobot.music.load.load_part`; with ``options.hand``, the part is also reduced to
-    what ``hand`` can play on ``keyboard`` (:func:`reduce_part`, one warning per kind of change).
+    what ``hand`` can play on ``keyboard`` (:func:`reduce_part`, one warning per kind of change)
+    and, with ``fit``, a part wider than ``keyboard`` is refused in one line naming a keyboard that
+    holds it (``score``, which plays nothing and has no keyboard options, reads it as it is).
     Without it, a piece is read as it is, and the fingering planner refuses what the hand cannot play."""
     piece = load_part(path, options, hand)
     if options.hand is None:
         return piece
     low, high = min(n.pitch for n in piece.notes), max(n.pitch for n in piece.notes)
-    if high - low >= keyboard.count:  # (no transposition fits it: say what keyboard does)
+    if fit and high - low >= keyboard.count:  # (no transposition fits it: say what keyboard does)
         lowest = max(low // 12 * 12, PIANO.lowest)
         count = min((high - lowest) // 12 * 12 + 12, PIANO.highest - lowest + 1)
         raise SettingError(

@@ -70,7 +70,7 @@ def inspect(
         both = both_hands(song, reading)
     except PianobotError:
         if named:
-            raise  # the two-hand reading's refusal (hands that cross, notes beyond the piano)
+            raise  # the two-hand reading's refusal (notes beyond the piano)
         both = None  # one hand's reading, below, says what it found, then what is wrong
     if both is not None:
         _both_hands(console, both, tracks, json_path)

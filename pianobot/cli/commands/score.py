@@ -65,7 +65,7 @@ def score(
         reference_piece = hands.piece  # every note with its hand, as play scored it
     else:
         reference_piece = load_for_hand(
-            reference, reading.options, reading.keyboard, reading.hand
+            reference, reading.options, reading.keyboard, reading.hand, fit=False
         )  # with --hand, reduced as play reduces it
     played_piece = midi_io.read_midi(played)
     scores = compare_hands(reference_piece, played_piece, onset_tolerance=onset_tolerance)
