@@ -560,3 +560,17 @@ def test_the_committed_general_policy_plays_unseen_songs_from_any_folder(tmp_pat
     assert report["phrases"] and all(s.startswith("general policy task-melody-") for s in report["phrases"].values())
     assert report["general_policy"]["path"].endswith(tuple(p.name for p in PACKAGED.glob("task-melody-*")))
     assert report["f1"] >= 0.9, report["f1"]
+
+
+def test_inspect_says_when_the_file_changes_tempo(tmp_path):
+    """The line's tempo is the file's first; a file that changes tempo says so (and JSON lists them)."""
+    from conftest import midi_file, off, on
+
+    notes = [m for i in range(4) for m in ((480 * i, on(60 + 2 * i)), (480 * i + 400, off(60 + 2 * i)))]
+    song = midi_file(tmp_path / "t.mid", [("melody", notes)], tempo_events=((0, 600_000), (960, 500_000)))
+    result = run("inspect", song, "--json", tmp_path / "i.json")
+    assert result.exit_code == 0, result.output
+    assert "s at 100 bpm, then 1 other tempo (100-120 bpm);" in " ".join(result.stdout.split())
+    assert json.loads((tmp_path / "i.json").read_text())["tempi"] == [100.0, 120.0]
+    steady = run("inspect", song, "--tempo", "90")
+    assert "s at 90 bpm;" in " ".join(steady.stdout.split())

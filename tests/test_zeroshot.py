@@ -84,3 +84,30 @@ def test_the_two_hand_examples_table_counts_an_example_only_if_every_hand_start_
     mean = [cell.strip() for cell in lines[6].split("|")[1:-1]]
     assert mean[3] == "0.942" and mean[5] == "0.990" and mean[6] == "0.800"  # one-slip's own mean is 0.943
     assert lines[-1] == "examples at note F1 0.9 or more from every hand start: 1 of 2"
+
+
+def test_the_corpus_table_counts_what_was_given_and_what_was_refused():
+    """benchmarks.corpus's table (music21 is not needed for it): the mean over the played rows only,
+    the share of notes given over all of them, a refusal as its own row, no division by a zero F1."""
+    from benchmarks import corpus
+
+    def row(name, notes, given, general, scripted):
+        figures = {"f1": general, "f1_right": general, "f1_left": general, "step_f1": 0.5, "given": given}
+        return {
+            "piece": name,
+            "source": f"x/{name}",
+            "measures": "1-4",
+            "notes": notes,
+            "sac": figures,
+            "scripted": {**figures, "f1": scripted},
+        }
+
+    rows = [
+        row("a", 100, 90, 0.8, 1.0),
+        row("b", 100, 60, 0.0, 0.0),
+        {"piece": "c", "source": "x/c", "measures": "1-2", "refused": "read as one hand's file"},
+    ]
+    text = corpus.table(rows)
+    assert "| c | `x/c` (1-2) | | | refused: read as one hand's file |" in text
+    assert "| b | `x/b` (1-4) | 100 | 60 | 0.000 |" in text and "| n/a |" in text
+    assert "| mean (2 played) | | | 75% given | 0.400 | | | 0.500 | 0.500 | 80% |" in text

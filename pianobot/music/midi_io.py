@@ -485,6 +485,19 @@ def write_midi(piece: Piece, path: str | Path, *, name: str = "pianobot") -> Pat
     return atomic_write(path, midi_bytes(piece, name=name))
 
 
+def tempi(path: str | Path) -> list[float]:
+    """The tempos of a MIDI file in beats per minute, in the order they take effect (120 until its
+    first set_tempo, where that is after the start), each change to another tempo once."""
+    midi = _load(Path(path))
+    changes = sorted((t, m.tempo) for track in midi.tracks for t, m in _absolute(track) if m.type == "set_tempo")
+    found = [] if changes and changes[0][0] == 0 else [120.0]
+    for _, tempo in changes:
+        bpm = round(mido.tempo2bpm(tempo), 3) if tempo > 0 else 0.0
+        if not found or found[-1] != bpm:
+            found.append(bpm)
+    return found
+
+
 def describe_tracks(path: str | Path) -> list[TrackInfo]:
     """Tracks of a MIDI file, for `pianobot inspect`."""
     return list_tracks(_load(Path(path)))

@@ -49,9 +49,10 @@ def inspect(
     if json_path is not None and not to_stdout:
         check_writable(json_path)
     console = err if to_stdout else out  # standard output carries the JSON
-    tracks, named = [], False
+    tracks, named, tempi = [], False, None
     if song.suffix.lower() != ".txt":
         tracks = midi_io.describe_tracks(song)
+        tempi = None if options.tempo is not None else midi_io.tempi(song)  # (--tempo re-times it at one tempo)
         hands = {i: h for h in HANDS for i in hand_tracks(tracks, h)}
         named = bool(hands)
         console.print(display.tracks_table([replace(t, name=said(t.name)) for t in tracks], hands))
@@ -73,12 +74,12 @@ def inspect(
             raise  # the two-hand reading's refusal (notes beyond the piano)
         both = None  # one hand's reading, below, says what it found, then what is wrong
     if both is not None:
-        _both_hands(console, both, tracks, json_path)
+        _both_hands(console, both, tracks, json_path, tempi)
         return
     if len([t for t in tracks if t.notes]) > 1 and options.track is None and options.hand is None:
         console.print("[yellow]several tracks are merged; play one part with --track N or --hand right|left[/yellow]")
     piece = load_for_hand(song, options, keyboard, hand_spec)
-    line, data = _summary(piece)
+    line, data = _summary(piece, tempi)
     console.print(line)
     piece, plan = ensure_fingering(piece, keyboard, hand_spec, options.refinger)
     if plan is not None:
@@ -119,14 +120,18 @@ def inspect(
         )
 
 
-def _summary(piece) -> tuple[str, dict]:
-    """A piece in one line (its notes, length, range, polyphony, velocities, fingering), and as JSON."""
+def _summary(piece, tempi: list[float] | None = None) -> tuple[str, dict]:
+    """A piece in one line (its notes, length, tempo, range, polyphony, velocities, fingering), and as
+    JSON; ``tempi``: the file's tempos, where it changes tempo and no --tempo re-times it."""
     polyphony, _ = piece.max_polyphony()
     given = sum(n.finger is not None for n in piece.notes)
     low, high = min(n.pitch for n in piece.notes), max(n.pitch for n in piece.notes)
     velocities = sorted({n.velocity for n in piece.notes})
+    tempo = f"{piece.bpm:.0f} bpm"
+    if tempi and len(tempi) > 1:
+        tempo += f", then {len(tempi) - 1} other tempo{'s' * (len(tempi) > 2)} ({min(tempi):.0f}-{max(tempi):.0f} bpm)"
     line = (
-        f"{len(piece)} notes, {piece.duration:.2f} s at {piece.bpm:.0f} bpm; range {pitch_name(low)}-{pitch_name(high)} "
+        f"{len(piece)} notes, {piece.duration:.2f} s at {tempo}; range {pitch_name(low)}-{pitch_name(high)} "
         f"({high - low} semitones); at most {polyphony} note{'s' * (polyphony != 1)} at once; velocities {velocities[0]}-{velocities[-1]}; "
         f"{given}/{len(piece)} notes fingered in the file"
     )
@@ -134,6 +139,7 @@ def _summary(piece) -> tuple[str, dict]:
         "notes": len(piece),
         "duration": piece.duration,
         "bpm": piece.bpm,
+        "tempi": list(tempi) if tempi else [piece.bpm],
         "range": [pitch_name(low), pitch_name(high)],
         "polyphony": polyphony,
         "fingered_in_file": given,
@@ -141,11 +147,11 @@ def _summary(piece) -> tuple[str, dict]:
     return line, data
 
 
-def _both_hands(console, reading, tracks, json_path) -> None:
+def _both_hands(console, reading, tracks, json_path, tempi=None) -> None:
     """What `inspect` says of a file `play` plays with both hands: each hand in play's words."""
     from pianobot.perform.hands import TOGETHER
 
-    line, data = _summary(reading.piece)
+    line, data = _summary(reading.piece, tempi)
     console.print(line)
     for hand in reading.piece.hands:
         console.print(said(reading.describe(hand)), soft_wrap=True)
