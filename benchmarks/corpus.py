@@ -20,7 +20,9 @@ has fingers) count as missed. ``notes`` is the file as ``pianobot play`` reads i
 more notes than two hands have fingers thinned), ``notes given`` how many of them the hands were
 given to play after that reduction: the most a player can strike. ``--apart`` plays each hand in a
 simulation of its own (``pianobot.perform.hands.play_hands(..., together=False)``): what the
-hands lose by getting in each other's way.
+hands lose by getting in each other's way. ``--thumb`` gives each hand its thumb as well
+(``pianobot play --thumb``): the scripted pianist alone plays, since the packaged general
+policies have no thumb.
 """
 
 from __future__ import annotations
@@ -37,6 +39,7 @@ import torch
 
 from benchmarks.hands import figures
 from pianobot.errors import PianobotError, PianobotWarning
+from pianobot.music.instrument import HandSpec
 from pianobot.music.load import LoadOptions
 from pianobot.perform.hands import two_hands
 
@@ -104,9 +107,12 @@ def write_excerpt(path: str, parts, first: int, out: Path) -> dict:
     return {"source": path, "measures": f"{first}-{last}"}
 
 
-def play_corpus(folder: Path, only: tuple[str, ...] = (), together: bool = True) -> list[dict]:
+def play_corpus(
+    folder: Path, only: tuple[str, ...] = (), together: bool = True, hand: HandSpec = HandSpec()
+) -> list[dict]:
     """Write the excerpts to ``folder`` and play each with both players (``together``: both hands
-    in one simulation, as ``pianobot play`` plays them); a row each."""
+    in one simulation, as ``pianobot play`` plays them; ``hand``: each hand's fingers, the general
+    policy only where they are the packaged policies' three); a row each."""
     folder.mkdir(parents=True, exist_ok=True)
     rows = []
     for name, path, parts, first in EXCERPTS:
@@ -117,7 +123,7 @@ def play_corpus(folder: Path, only: tuple[str, ...] = (), together: bool = True)
         try:
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore", PianobotWarning)
-                reading = two_hands(file, LoadOptions())
+                reading = two_hands(file, LoadOptions(), hand)
         except PianobotError as error:  # (refused: the row says why)
             rows.append({**row, "refused": str(error)})
             print(f"{name}: refused: {error}", flush=True)
@@ -128,17 +134,21 @@ def play_corpus(folder: Path, only: tuple[str, ...] = (), together: bool = True)
             continue
         with tempfile.TemporaryDirectory() as models:  # (an empty store: the packaged policies play)
             piece = reading.piece
+            general = figures(piece, "sac", models, together=together) if hand == HandSpec() else None
             row.update(
                 notes=len(piece),
-                sac=figures(piece, "sac", models, together=together),
-                scripted=figures(piece, "scripted", models, together=together),
+                sac=general,
+                scripted=figures(piece, "scripted", models, together=together, hand=hand),
             )
         rows.append(row)
-        print(f"{name}: general {row['sac']['f1']:.3f}, scripted {row['scripted']['f1']:.3f}", flush=True)
+        general = f"{row['sac']['f1']:.3f}" if row["sac"] else "n/a"
+        print(f"{name}: general {general}, scripted {row['scripted']['f1']:.3f}", flush=True)
     return rows
 
 
 def table(rows: list[dict]) -> str:
+    """The rows as Markdown; "notes given" as the general policy was given them (the scripted
+    pianist's where the general policy did not play: ``--thumb``)."""
     lines = [
         "| piece | corpus path (measures) | notes | notes given | note F1, general policy | right | left | "
         "per-step F1 | note F1, scripted pianist | general / scripted |",
@@ -151,17 +161,23 @@ def table(rows: list[dict]) -> str:
             lines.append(f"| {r['piece']} | {where} | | | refused: {r['refused']} | | | | | |")
             continue
         g, s = r["sac"], r["scripted"]
+        general = (
+            f"{g['f1']:.3f} | {g['f1_right']:.3f} | {g['f1_left']:.3f} | {g['step_f1']:.3f}" if g else "n/a | | | n/a"
+        )
+        share = _share(g["f1"], s["f1"]) if g else "n/a"
         lines.append(
-            f"| {r['piece']} | {where} | {r['notes']} | {g['given']} | {g['f1']:.3f} | {g.get('f1_right', 0):.3f} | "
-            f"{g.get('f1_left', 0):.3f} | {g['step_f1']:.3f} | {s['f1']:.3f} | {_share(g['f1'], s['f1'])} |"
+            f"| {r['piece']} | {where} | {r['notes']} | {(g or s)['given']} | {general} | {s['f1']:.3f} | {share} |"
         )
     if played:
-        general = np.mean([r["sac"]["f1"] for r in played])
+        given = sum((r["sac"] or r["scripted"])["given"] for r in played) / sum(r["notes"] for r in played)
         scripted = np.mean([r["scripted"]["f1"] for r in played])
-        given = sum(r["sac"]["given"] for r in played) / sum(r["notes"] for r in played)
+        with_general = [r for r in played if r["sac"]]
+        general = np.mean([r["sac"]["f1"] for r in with_general]) if with_general else None
+        steps = np.mean([r["sac"]["step_f1"] for r in with_general]) if with_general else None
         lines.append(
-            f"| mean ({len(played)} played) | | | {given:.0%} given | {general:.3f} | | | "
-            f"{np.mean([r['sac']['step_f1'] for r in played]):.3f} | {scripted:.3f} | {_share(general, scripted)} |"
+            f"| mean ({len(played)} played) | | | {given:.0%} given | "
+            + (f"{general:.3f} | | | {steps:.3f}" if general is not None else "n/a | | | n/a")
+            + f" | {scripted:.3f} | {_share(general, scripted) if general is not None else 'n/a'} |"
         )
     return "\n".join(lines)
 
@@ -176,6 +192,9 @@ def main() -> None:
     parser.add_argument("--only", nargs="+", default=(), help="only these excerpts (by name)")
     parser.add_argument("--json", type=Path, help="write every figure to this file")
     parser.add_argument("--apart", action="store_true", help="each hand in a simulation of its own")
+    parser.add_argument(
+        "--thumb", action="store_true", help="each hand with its thumb too (the scripted pianist alone plays)"
+    )
     args = parser.parse_args()
     torch.set_num_threads(1)  # (the simulation is the cost; torch's threads would only contend)
     try:
@@ -183,13 +202,21 @@ def main() -> None:
     except ImportError:
         parser.error('music21 is not installed: pip install -e ".[corpus]"')
     started = time.perf_counter()
-    rows = play_corpus(args.out, tuple(args.only), together=not args.apart)
+    hand = HandSpec(fingers=(1, 2, 3, 4)) if args.thumb else HandSpec()
+    rows = play_corpus(args.out, tuple(args.only), together=not args.apart, hand=hand)
     seconds = time.perf_counter() - started
     print()
     print(table(rows))
-    print(f"\nmusic21 {music21.__version__}; {'each hand apart; ' if args.apart else ''}{seconds:.0f} s")
+    how = ("each hand apart; " if args.apart else "") + ("with thumbs; " if args.thumb else "")
+    print(f"\nmusic21 {music21.__version__}; {how}{seconds:.0f} s")
     if args.json:
-        record = {"music21": music21.__version__, "apart": args.apart, "seconds": round(seconds), "rows": rows}
+        record = {
+            "music21": music21.__version__,
+            "apart": args.apart,
+            "thumb": args.thumb,
+            "seconds": round(seconds),
+            "rows": rows,
+        }
         args.json.write_text(json.dumps(record, indent=2) + "\n")
 
 

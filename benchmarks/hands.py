@@ -50,7 +50,7 @@ import torch
 
 from pianobot.errors import PianobotWarning
 from pianobot.music.duets import duet_set, random_duet
-from pianobot.music.instrument import KeyboardSpec
+from pianobot.music.instrument import HandSpec, KeyboardSpec
 from pianobot.music.load import LoadOptions
 from pianobot.music.piece import parse_pitch
 from pianobot.perform.hands import play_hands, two_hands
@@ -72,12 +72,15 @@ def figures(
     hold_guard: bool | None = None,
     seed: int = 0,
     keyboard: KeyboardSpec | None = None,
+    hand: HandSpec | None = None,
 ) -> dict:
     options = {"general_policy": general} if controller == "sac" and general is not None else {}
     options["hold_guard"] = hold_guard
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", PianobotWarning)  # the left-out counts are in the figures
-        performance = play_hands(piece, controller, models, seed=seed, together=together, keyboard=keyboard, **options)
+        performance = play_hands(
+            piece, controller, models, seed=seed, together=together, keyboard=keyboard, hand=hand, **options
+        )
     whole = performance.report()
     out = {
         "f1": whole.f1,

@@ -111,3 +111,8 @@ def test_the_corpus_table_counts_what_was_given_and_what_was_refused():
     assert "| c | `x/c` (1-2) | | | refused: read as one hand's file |" in text
     assert "| b | `x/b` (1-4) | 100 | 60 | 0.000 |" in text and "| n/a |" in text
     assert "| mean (2 played) | | | 75% given | 0.400 | | | 0.500 | 0.500 | 80% |" in text
+    # --thumb: the scripted pianist alone played; what it was given counts
+    thumbs = [{**r, "sac": None} for r in rows[:2]]
+    text = corpus.table(thumbs)
+    assert "| a | `x/a` (1-4) | 100 | 90 | n/a | | | n/a | 1.000 | n/a |" in text
+    assert "| mean (2 played) | | | 75% given | n/a | | | n/a | 0.500 | n/a |" in text
