@@ -402,3 +402,18 @@ def test_score_of_one_hand_of_a_wide_part_scores_it(tmp_path):
     scored = run("score", tmp_path / "p.mid", song, "--hand", "right", "--json", tmp_path / "s.json")
     assert scored.exit_code == 0, scored.output
     assert json.loads((tmp_path / "s.json").read_text())["f1"] == 1.0
+
+
+def test_a_one_hand_file_with_chords_is_fingered_once(tmp_path, monkeypatch):
+    """Asking whether one hand plays an unfingered file with chords plans its fingering; reading it
+    for that hand then reuses the plan rather than planning the same notes again."""
+    from pianobot.pianist import fingering
+
+    calls = []
+    planner = fingering.plan_fingering
+    monkeypatch.setattr(fingering, "plan_fingering", lambda *a, **k: calls.append(1) or planner(*a, **k))
+    fingering._plan.cache_clear()
+    song = _one_track(tmp_path / "chords.mid", (60, 0, 1), (64, 0, 1), (62, 1, 2), (65, 1, 2), (64, 2, 3), (67, 2, 3))
+    result = run("inspect", song)
+    assert result.exit_code == 0, result.output
+    assert "playable" in result.stdout and len(calls) == 1, (calls, result.output)

@@ -176,7 +176,12 @@ def one_hand_refusal(piece: Piece, spec: HandSpec, keyboard: KeyboardSpec, refin
     asked of the planner."""
     low, high = min(n.pitch for n in piece.notes), max(n.pitch for n in piece.notes)
     lowest = low - 1 if KeyboardSpec.is_black(low) and high - low < keyboard.count - 1 else low  # (a white key)
-    under = KeyboardSpec(min(lowest, 128 - keyboard.count), keyboard.count)
+    under = (
+        keyboard
+        if low in keyboard and high in keyboard
+        else KeyboardSpec(min(lowest, 128 - keyboard.count), keyboard.count)
+    )
+    # (on the reading's own keyboard where the notes fit it: one hand's reading then reuses the plan)
     try:
         check_playable(piece, under, spec)  # (more notes at once than fingers)
         if piece.max_polyphony()[0] > 1:

@@ -37,6 +37,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from functools import lru_cache
 from itertools import combinations
 from typing import Sequence
 
@@ -366,8 +367,16 @@ def ensure_fingering(
     if piece.has_fingering and not refinger:
         return piece, None
     check_playable(piece.without_fingering(), keyboard, hand)  # on the keyboard, not too many notes at once
-    plan = plan_fingering(piece, KeyboardConfig(spec=keyboard), HandConfig(spec=hand))
+    plan = _plan(piece, piece.bpm, keyboard, hand)
     return plan.piece, plan
+
+
+@lru_cache(maxsize=2)
+def _plan(piece: Piece, bpm: float, keyboard: KeyboardSpec, hand: HandSpec) -> FingeringPlan:
+    """:func:`plan_fingering`, kept for the last pieces asked (``bpm`` is in the key because a
+    piece's equality leaves it out): ``pianobot play`` asks whether one hand plays a file, then
+    plays it, and music objects are immutable, so the plan is the same both times."""
+    return plan_fingering(piece, KeyboardConfig(spec=keyboard), HandConfig(spec=hand))
 
 
 def plan_fingering(
