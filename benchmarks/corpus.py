@@ -151,7 +151,7 @@ def table(rows: list[dict]) -> str:
     pianist's where the general policy did not play: ``--thumb``)."""
     lines = [
         "| piece | corpus path (measures) | notes | notes given | note F1, general policy | right | left | "
-        "per-step F1 | note F1, scripted pianist | general / scripted |",
+        "per-step F1, general policy | note F1, scripted pianist | general / scripted |",
         "| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |",
     ]
     played = [r for r in rows if "refused" not in r]

@@ -116,3 +116,33 @@ def test_the_corpus_table_counts_what_was_given_and_what_was_refused():
     text = corpus.table(thumbs)
     assert "| a | `x/a` (1-4) | 100 | 90 | n/a | | | n/a | 1.000 | n/a |" in text
     assert "| mean (2 played) | | | 75% given | n/a | | | n/a | 0.500 | n/a |" in text
+
+
+def test_the_corpus_options_reach_the_players(monkeypatch, tmp_path):
+    """--apart plays each hand in a simulation of its own, --thumb gives each hand its thumb, --only
+    names the excerpts; --json writes what was played (music21 stood in for: the run is not made)."""
+    import json
+    import sys
+    import types
+
+    from benchmarks import corpus
+    from pianobot.music.instrument import HandSpec
+
+    asked = {}
+
+    def play_corpus(folder, only=(), together=True, hand=HandSpec()):
+        asked.update(folder=folder, only=only, together=together, hand=hand)
+        return []
+
+    monkeypatch.setitem(sys.modules, "music21", types.SimpleNamespace(__version__="test"))
+    monkeypatch.setattr(corpus, "play_corpus", play_corpus)
+    out = tmp_path / "c.json"
+    argv = ["corpus", "--out", str(tmp_path), "--only", "aloha-oe", "--apart", "--thumb", "--json", str(out)]
+    monkeypatch.setattr(sys, "argv", argv)
+    corpus.main()
+    assert asked == {"folder": tmp_path, "only": ("aloha-oe",), "together": False, "hand": HandSpec((1, 2, 3, 4))}
+    record = json.loads(out.read_text())
+    assert record["apart"] is True and record["thumb"] is True and record["rows"] == []
+    monkeypatch.setattr(sys, "argv", ["corpus", "--out", str(tmp_path)])
+    corpus.main()
+    assert asked["together"] is True and asked["hand"] == HandSpec() and asked["only"] == ()

@@ -40,7 +40,7 @@ from pianobot.agent.general import left_hand_policy
 from pianobot.errors import PianobotError, PianobotWarning, SettingError
 from pianobot.music import midi_io
 from pianobot.music.hand_scores import HandsReport, compare_hands
-from pianobot.music.instrument import HandSpec, KeyboardSpec, check_playable
+from pianobot.music.instrument import HandSpec, KeyboardSpec, check_playable, suggest_transpose
 from pianobot.music.load import LoadOptions, load_hands, load_piece, thin_hand
 from pianobot.music.metrics import Report
 from pianobot.music.piece import HANDS, Note, Piece, pitch_name
@@ -169,19 +169,13 @@ def two_hands(
 
 def one_hand_refusal(piece: Piece, spec: HandSpec, keyboard: KeyboardSpec, refinger: bool = False) -> str:
     """Why one hand with ``spec``'s fingers cannot play ``piece`` (unfingered, spanning fewer keys
-    than ``keyboard`` has), in words; '' where it can. It is asked on a keyboard of ``keyboard``'s
-    size under the piece's notes: notes a transposition would bring onto the keys are no reason for
-    two hands (one hand's reading then says which ``--transpose``). A single line of notes is
+    than ``keyboard`` has), in words; '' where it can. It is asked on ``keyboard`` moved by the
+    transposition one hand's reading would suggest (:func:`~pianobot.music.instrument.suggest_transpose`):
+    notes a transposition brings onto the keys are no reason for two hands. A single line of notes is
     always one hand's (the fingering planner only slows what is fast); chords and held notes are
     asked of the planner."""
-    low, high = min(n.pitch for n in piece.notes), max(n.pitch for n in piece.notes)
-    lowest = low - 1 if KeyboardSpec.is_black(low) and high - low < keyboard.count - 1 else low  # (a white key)
-    under = (
-        keyboard
-        if low in keyboard and high in keyboard
-        else KeyboardSpec(min(lowest, 128 - keyboard.count), keyboard.count)
-    )
-    # (on the reading's own keyboard where the notes fit it: one hand's reading then reuses the plan)
+    shift = suggest_transpose(piece, keyboard) or 0  # (0 where the notes fit: the plan is then reused)
+    under = KeyboardSpec(max(0, min(keyboard.lowest - shift, 128 - keyboard.count)), keyboard.count)
     try:
         check_playable(piece, under, spec)  # (more notes at once than fingers)
         if piece.max_polyphony()[0] > 1:
