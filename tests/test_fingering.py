@@ -255,3 +255,17 @@ def test_finger_command_refuses_bad_output_names(tmp_path):
         result = runner.invoke(app, ["finger", str(song), "-o", str(target)])
         assert result.exit_code == 2 and word in result.stderr and "Traceback" not in result.output
     assert song.read_bytes() == before and not (tmp_path / "f.txt").exists()
+
+
+def test_the_planner_keeps_the_wrist_in_the_room_it_is_given_where_a_fingering_allows():
+    planner = Planner()
+    piece = melody("E4 G4 E4 G4")
+    free = planner.plan(piece)
+    assert [n.finger for n in free.piece.notes] == [2, 3, 2, 3]
+    # the other hand leaves this one only the wrist positions up to half a white key above E4's
+    high = planner.key_x[planner.spec.index(parse_pitch("E4"))] + 0.5 * planner.pitch
+    kept = planner.plan(piece.without_fingering(), [(-math.inf, high)] * len(piece.chords()))
+    assert max(kept.wrist) <= high < min(free.wrist)
+    assert [n.finger for n in kept.piece.notes] == [3, 4, 3, 4]  # the highest fingers: the wrist farthest down
+    with pytest.raises(ValueError, match="room has 1 entries for 4 chords"):
+        planner.plan(piece, [(-math.inf, high)])

@@ -1,6 +1,7 @@
 """Hand assignment by planning (pianobot.pianist.hands): small pieces with known answers."""
 
 import warnings
+from dataclasses import replace
 
 import pytest
 from test_two_hands import warning_lines
@@ -8,7 +9,7 @@ from test_two_hands import warning_lines
 from pianobot.errors import PianobotWarning
 from pianobot.music.instrument import HandSpec
 from pianobot.music.piece import Note, Piece, parse_pitch
-from pianobot.pianist.hands import assign_hands, finger_hands, reaches, thin_for_hands
+from pianobot.pianist.hands import assign_hands, finger_apart, finger_hands, reaches, stands, thin_for_hands
 
 
 def notes(*items, hand=None):
@@ -139,3 +140,51 @@ def test_given_hands_that_cross_inside_a_chord_are_one_clear_error():
     crossed = Piece.of([*notes(("C5", 0, 1), hand="left"), *notes(("C4", 0, 1), hand="right")])
     with pytest.raises(PianobotError, match="hands that cross"):
         assign_hands(crossed)
+
+
+def interleaved(count: int = 12) -> Piece:
+    """A right hand alternating G4 A#4 over a left hand alternating D#4 A#3: hands a third apart."""
+    notes = []
+    for i in range(count):
+        t = 0.25 * i
+        notes.append(Note(t, parse_pitch("G4" if i % 2 == 0 else "A#4"), t + 0.25, 80, hand="right"))
+        notes.append(Note(t, parse_pitch("D#4" if i % 2 == 0 else "A#3"), t + 0.25, 70, hand="left"))
+    return Piece(tuple(notes), bpm=120)
+
+
+def fingered_parts(piece: Piece) -> dict:
+    from pianobot.perform.hands import prepare_part
+
+    parts = {}
+    for hand in ("right", "left"):
+        window, part, *_ = prepare_part(piece, hand, None, HandSpec(), start=0.0)
+        parts[hand] = (window, part)
+    return parts
+
+
+def least_gap(parts: dict, fingered: dict) -> float:
+    right = stands(parts["right"][0], fingered["right"])
+    left = stands(parts["left"][0], fingered["left"])
+    return min(up - down for s, e, up in right for s2, e2, down in left if s < e2 and s2 < e)
+
+
+def test_hands_close_together_are_fingered_to_keep_their_wrists_as_far_apart_as_the_world_keeps_them():
+    from pianobot.sim.hand import HandConfig, thumb_side_reach
+
+    parts = fingered_parts(interleaved())
+    gap = 2 * thumb_side_reach(HandConfig())
+    alone = {hand: part for hand, (_, part) in parts.items()}
+    assert least_gap(parts, alone) < gap - 0.01  # each hand fingered on its own: the wrists would meet
+    apart = {hand: plan.piece for hand, plan in finger_apart(parts).items()}
+    assert least_gap(parts, apart) >= gap - 1e-9
+    for hand in ("right", "left"):  # the same notes, other fingers
+        assert [(n.onset, n.pitch) for n in apart[hand].notes] == [(n.onset, n.pitch) for n in alone[hand].notes]
+        assert apart[hand].has_fingering
+
+
+def test_hands_far_apart_keep_the_fingering_each_was_given():
+    far = Piece(tuple(n if n.hand == "right" else replace(n, pitch=n.pitch - 24) for n in interleaved().notes), bpm=120)
+    parts = fingered_parts(far)
+    assert {hand: plan.piece for hand, plan in finger_apart(parts).items()} == {
+        hand: part for hand, (_, part) in parts.items()
+    }

@@ -292,3 +292,11 @@ def test_judging_both_hands_after_training_says_a_warning_of_its_plays_once(tmp_
     assert plays == list(accept.JUDGE_SEEDS) and verdict.before == verdict.after == (0.5, 0.5, 0.5)
     assert [str(w.message) for w in caught] == ["the hands play apart"]
     assert verdict.general_plays == ("right 0", "left 0") and not verdict.used
+
+
+def test_hands_a_third_apart_play_whole_where_their_fingerings_keep_the_wrists_apart():
+    from test_hands import interleaved
+
+    piece = interleaved()
+    performance = play_hands(piece, "scripted")  # fingered on its own, each hand: F1 0.39, the wrists pushed aside
+    assert performance.report().f1 >= 0.95

@@ -49,7 +49,7 @@ from pianobot.perform import plan
 from pianobot.perform.plan import Performance
 from pianobot.perform.rollout import Rollout
 from pianobot.pianist.fingering import ensure_fingering
-from pianobot.pianist.hands import load_two_hands, reduce_hand
+from pianobot.pianist.hands import finger_apart, load_two_hands, reduce_hand
 
 APART = "each hand in a simulation of its own"
 """How both hands play with ``together=False``: said wherever such a performance is reported."""
@@ -403,6 +403,9 @@ def prepare_parts(
         changes = tuple(str(w.message) for w in caught if issubclass(w.category, PianobotWarning))
         _warn_again(caught)
         parts[name] = (*prepared, changes)
+    if together and len(parts) == 2:  # fingerings that keep the wrists apart, where they can
+        apart = finger_apart({h: (window, part) for h, (window, part, *_) in parts.items()}, fingers)
+        parts = {h: (window, apart[h].piece, *rest) for h, (window, _, *rest) in parts.items()}
     return parts
 
 

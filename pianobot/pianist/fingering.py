@@ -73,6 +73,9 @@ TIP_GAP = 0.015
 """Least sideways distance (m) between two fingertips, in the hand's frame."""
 SETTLE_TIME = 0.2
 """Seconds a finger needs to lift and settle around a wrist move (the scripted pianist's 4 steps)."""
+ROOM_COST = 5.0
+"""Cost of each white key the wrist stands outside its room (:meth:`Planner.plan`'s ``room``: where
+the other hand leaves this one space)."""
 _INFEASIBLE = 1e9
 _TOO_FAST = 1e3
 
@@ -285,9 +288,26 @@ class Planner:
                     return f"finger {finger} must go from {pitch_name(low + key_p)} to {pitch_name(low + key)}"
         return ""
 
+    def _outside(self, chord: Sequence[Note], low: float, high: float) -> np.ndarray:
+        """:data:`ROOM_COST` per white key that each state (assignment x wrist position) of
+        ``chord`` puts the wrist outside [``low``, ``high``]: the planner's wrist, or the scripted
+        pianist's, whichever is farther out."""
+        assignments, keys, _ = self._states(chord)
+        pianist = np.array([np.mean([self.key_x[k] - FINGER_BASE_X[f] for k, f in zip(keys, a)]) for a in assignments])
+        grid = np.maximum(np.maximum(low - self.grid, self.grid - high), 0.0)
+        own = np.maximum(np.maximum(low - pianist, pianist - high), 0.0)
+        return ROOM_COST * np.maximum(grid[None, :], own[:, None]) / self.pitch
+
     # -- the whole piece ---------------------------------------------------------------------
-    def plan(self, piece: Piece) -> FingeringPlan:
+    def plan(self, piece: Piece, room: Sequence[tuple[float, float]] | None = None) -> FingeringPlan:
+        """The lowest-cost fingering of ``piece`` (the module's notes). ``room``: for each chord
+        (as :meth:`~pianobot.music.piece.Piece.chords` gives them) the lowest and highest wrist
+        position (m, ``-inf``/``inf`` for none) that keeps this hand clear of the other; a state
+        whose wrist, or where its fingers put the scripted pianist's wrist (straight over their
+        keys, on average), lies outside costs :data:`ROOM_COST` per white key."""
         chords = piece.chords()
+        if room is not None and len(room) != len(chords):
+            raise ValueError(f"room has {len(room)} entries for {len(chords)} chords")
         too_many = next((c for c in chords if len(c) > len(self.fingers)), None)
         if too_many is not None:
             raise SettingError(
@@ -307,11 +327,13 @@ class Planner:
                     "more than this hand reaches: drop a note from it or transpose part of it"
                 )
             if i == 0:
-                reaches.append(self.place(chord))
+                reach = self.place(chord)
             else:
                 reach, best = self._follow(reaches[-1], chord, in_time=False)
-                reaches.append(reach)
                 back.append(best)
+            if room is not None:
+                reach = Reach(reach.chord, reach.cost + self._outside(chord, *room[i]).ravel())
+            reaches.append(reach)
 
         index = int(np.argmin(reaches[-1].cost))
         if not reaches[-1].possible:

@@ -33,7 +33,9 @@ So notes one hand cannot take go to the other: a chord too wide for one hand is 
 them, a melody that moves into the other hand's region passes to it. Notes that already have a
 hand keep it. Each hand's part is then reduced to what the hand can play and fingered by the
 planner (:func:`finger_hands`; the left hand's part mirrored, planned as a right hand's, and
-mirrored back).
+mirrored back), the two fingerings chosen so that the wrists keep the distance the world keeps
+between them where they can (:func:`finger_apart`: two hands a third apart are fingered with
+their outer fingers rather than pushed aside as they play).
 """
 
 from __future__ import annotations
@@ -46,13 +48,14 @@ from pathlib import Path
 import numpy as np
 
 from pianobot.errors import PianobotError, PianobotWarning
-from pianobot.music.instrument import HandSpec, KeyboardSpec, keyboard_for
+from pianobot.music import window as windows
+from pianobot.music.instrument import PIANO, HandSpec, KeyboardSpec, keyboard_for
 from pianobot.music.load import CHORD_SPREAD, LEGATO_OVERLAP, LoadOptions, load_hands, thin_hand
 from pianobot.music.piece import Note, Piece, mirror_pitch
-from pianobot.pianist.fingering import FingeringPlan, Planner, ensure_fingering
+from pianobot.pianist.fingering import SETTLE_TIME, FingeringPlan, Planner, ensure_fingering
 from pianobot.pianist.reduce import reduce_part
-from pianobot.sim.hand import HandConfig
-from pianobot.sim.keyboard import KeyboardConfig
+from pianobot.sim.hand import FINGER_BASE_X, HandConfig, thumb_side_reach
+from pianobot.sim.keyboard import KeyboardConfig, key_boxes
 
 TRAVEL_COST = 12.0
 """Cost of a hand moving one octave (squared for longer moves)."""
@@ -339,12 +342,15 @@ def reduce_hand(part: Piece, keyboard: KeyboardSpec, spec: HandSpec, hand: str) 
 def finger_hands(piece: Piece, spec: HandSpec = HandSpec(), refinger: bool = False) -> HandsFingering:
     """Each hand's part of ``piece`` (every note has a hand) thinned and reduced to what the hand
     can play (:func:`~pianobot.music.load.thin_hand`, :func:`~pianobot.pianist.reduce.reduce_part`,
-    one warning per kind of change and hand) and fingered by the planner. The left hand's part is
+    one warning per kind of change and hand) and fingered by the planner, both hands planned so
+    that their wrists keep apart where a fingering allows (:func:`finger_apart`; not where
+    ``refinger`` is False and a hand's part has the file's fingering). The left hand's part is
     planned as its mirror image, a right hand's part, and mirrored back."""
     if any(n.hand is None for n in piece.notes):
         raise ValueError("finger_hands needs every note's hand: call assign_hands first")
     notes: list[Note] = []
     plans: dict[str, FingeringPlan | None] = {}
+    views: dict[str, tuple[windows.Window, Piece]] = {}
     for hand in piece.hands:
         part = piece.part(hand)
         part = part.mirror() if hand == "left" else part  # now a right hand's part
@@ -352,7 +358,89 @@ def finger_hands(piece: Piece, spec: HandSpec = HandSpec(), refinger: bool = Fal
         keyboard = keyboard_for(thinned)
         reduced = reduce_hand(thinned.with_hands(None), keyboard, spec, hand)
         fingered, plan = ensure_fingering(reduced, keyboard, spec, refinger=refinger)
+        views[hand] = (windows.Window(hand, keyboard, 0), fingered)
+        plans[hand] = plan
+    if len(views) == 2 and all(plans.values()):  # planned here: fingerings that keep the wrists apart
+        plans = finger_apart(views, spec)
+        views = {hand: (window, plans[hand].piece) for hand, (window, _) in views.items()}
+    for hand, (_, fingered) in views.items():
         fingered = fingered.with_hands("right")
         notes.extend((fingered.mirror() if hand == "left" else fingered).notes)
-        plans[hand] = plan
     return HandsFingering(Piece(tuple(notes), bpm=piece.bpm), plans)
+
+
+IDLE = 0.5
+"""A hand whose next chord is this much (s) after its notes end is idle until then: the world may
+push it aside, so it leaves the other hand room only until its notes end (and :data:`LINGER` more)."""
+LINGER = 0.1
+"""How long (s) after its notes end an idle hand still stands where it played."""
+
+
+def finger_apart(
+    parts: dict[str, tuple[windows.Window, Piece]], spec: HandSpec = HandSpec()
+) -> dict[str, FingeringPlan]:
+    """Both hands' parts, each in its window's keys (:class:`~pianobot.music.window.Window`:
+    the left hand's mirrored) and fingered, fingered again so that the wrists keep the distance
+    the world keeps between them (:attr:`~pianobot.sim.world.PianoWorld.min_separation`) where a
+    fingering allows: the right hand's part as it is fingered, the left hand's planned to keep
+    clear of it, then the right hand's planned again to keep clear of that (the planner's
+    ``room``, :meth:`~pianobot.pianist.fingering.Planner.plan`). A hand stands where its fingers
+    put the scripted pianist's wrist (straight over their keys, on average) from
+    :data:`~pianobot.pianist.fingering.SETTLE_TIME` before each chord until the next, or, idle
+    (:data:`IDLE`), until its notes end. Where no fingering keeps clear, the least crowding one
+    is taken (the world then pushes the hands apart as they play). Returns both hands' plans."""
+    if set(parts) != {"right", "left"}:
+        raise ValueError(f"finger_apart needs both hands' parts, not {', '.join(parts)}")
+    gap = 2 * thumb_side_reach(HandConfig(spec=spec))
+    fingered = {hand: part for hand, (_, part) in parts.items()}
+    plans = {}
+    for hand, other in (("left", "right"), ("right", "left")):
+        window, part = parts[hand]
+        planner = Planner(KeyboardConfig(spec=window.keyboard), HandConfig(spec=spec))
+        others = stands(parts[other][0], fingered[other])
+        to_frame = _frame(window, part, planner)
+        room = []
+        for start, end, _ in stands(window, fingered[hand]):
+            near = [x for s, e, x in others if s < end and e > start]
+            if not near:
+                room.append((-np.inf, np.inf))
+            elif hand == "left":  # in the world: at most the right wrist's lowest less the gap
+                room.append((to_frame(min(near) - gap), np.inf))
+            else:
+                room.append((to_frame(max(near) + gap), np.inf))
+        plans[hand] = planner.plan(part.without_fingering(), room)
+        fingered[hand] = plans[hand].piece
+    return plans
+
+
+def _world_x(pitch: int) -> float:
+    """Where the key of ``pitch`` lies on the piano's 88 keys (m from the lowest)."""
+    return _PIANO_X[pitch - PIANO.lowest]
+
+
+_PIANO_X = np.array([b.center[0] for b in key_boxes(KeyboardConfig(spec=PIANO))])
+
+
+def _frame(window: windows.Window, part: Piece, planner: Planner):
+    """The map from a wrist position in the world (m along the piano) to the same position in the
+    frame of ``planner`` (``window``'s keys, mirrored for the left hand), as a function."""
+    pitch = part.notes[0].pitch
+    view, world = planner.key_x[planner.spec.index(pitch)], _world_x(window.outward(pitch))
+    if window.hand == "left":
+        return lambda x: view + world - x
+    return lambda x: x - world + view
+
+
+def stands(window: windows.Window, part: Piece) -> list[tuple[float, float, float]]:
+    """Where a hand's fingered ``part`` (in ``window``'s keys) puts its wrist in the world: for each
+    chord (start s, end s, wrist m along the piano), in the module's :func:`finger_apart` terms."""
+    chords = part.chords()
+    sign = -1.0 if window.hand == "left" else 1.0  # (the left hand's finger bases lie mirrored)
+    stands = []
+    for i, chord in enumerate(chords):
+        wrist = float(np.mean([_world_x(window.outward(n.pitch)) - sign * FINGER_BASE_X[n.finger] for n in chord]))
+        ends = max(n.offset for n in chord)
+        following = chords[i + 1][0].onset if i + 1 < len(chords) else ends
+        end = following if following - ends < IDLE else ends + LINGER
+        stands.append((chord[0].onset - SETTLE_TIME, max(end, chord[0].onset), wrist))
+    return stands
