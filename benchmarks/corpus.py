@@ -21,8 +21,9 @@ more notes than two hands have fingers thinned), ``notes given`` how many of the
 given to play after that reduction: the most a player can strike. ``--apart`` plays each hand in a
 simulation of its own (``pianobot.perform.hands.play_hands(..., together=False)``): what the
 hands lose by getting in each other's way. ``--thumb`` gives each hand its thumb as well
-(``pianobot play --thumb``): the scripted pianist alone plays, since the packaged general
-policies have no thumb.
+(``pianobot play --thumb``), and the general policy plays where one for that hand is packaged
+(else the scripted pianist alone plays); ``--general DIR`` names the general policy to play
+both hands.
 """
 
 from __future__ import annotations
@@ -38,6 +39,7 @@ import numpy as np
 import torch
 
 from benchmarks.hands import figures
+from pianobot.agent.general import left_hand_policy
 from pianobot.errors import PianobotError, PianobotWarning
 from pianobot.music.instrument import HandSpec
 from pianobot.music.load import LoadOptions
@@ -108,12 +110,18 @@ def write_excerpt(path: str, parts, first: int, out: Path) -> dict:
 
 
 def play_corpus(
-    folder: Path, only: tuple[str, ...] = (), together: bool = True, hand: HandSpec = HandSpec()
+    folder: Path,
+    only: tuple[str, ...] = (),
+    together: bool = True,
+    hand: HandSpec = HandSpec(),
+    general: Path | None = None,
 ) -> list[dict]:
     """Write the excerpts to ``folder`` and play each with both players (``together``: both hands
-    in one simulation, as ``pianobot play`` plays them; ``hand``: each hand's fingers, the general
-    policy only where they are the packaged policies' three); a row each."""
+    in one simulation, as ``pianobot play`` plays them; ``hand``: each hand's fingers; ``general``:
+    the general policy on both hands, default the packaged one for ``hand``, and where none is
+    packaged for it the scripted pianist alone plays); a row each."""
     folder.mkdir(parents=True, exist_ok=True)
+    plays = general is not None or left_hand_policy(None, None, hand) is not None
     rows = []
     for name, path, parts, first in EXCERPTS:
         if only and name not in only:
@@ -134,10 +142,10 @@ def play_corpus(
             continue
         with tempfile.TemporaryDirectory() as models:  # (an empty store: the packaged policies play)
             piece = reading.piece
-            general = figures(piece, "sac", models, together=together) if hand == HandSpec() else None
+            policy = figures(piece, "sac", models, general, together=together, hand=hand) if plays else None
             row.update(
                 notes=len(piece),
-                sac=general,
+                sac=policy,
                 scripted=figures(piece, "scripted", models, together=together, hand=hand),
             )
         rows.append(row)
@@ -192,8 +200,12 @@ def main() -> None:
     parser.add_argument("--only", nargs="+", default=(), help="only these excerpts (by name)")
     parser.add_argument("--json", type=Path, help="write every figure to this file")
     parser.add_argument("--apart", action="store_true", help="each hand in a simulation of its own")
+    parser.add_argument("--thumb", action="store_true", help="each hand with its thumb too")
     parser.add_argument(
-        "--thumb", action="store_true", help="each hand with its thumb too (the scripted pianist alone plays)"
+        "--general",
+        type=Path,
+        help="the general policy's folder, on both hands (default: the packaged one for the hand; "
+        "where none is packaged for it, the scripted pianist alone plays)",
     )
     args = parser.parse_args()
     torch.set_num_threads(1)  # (the simulation is the cost; torch's threads would only contend)
@@ -203,7 +215,7 @@ def main() -> None:
         parser.error('music21 is not installed: pip install -e ".[corpus]"')
     started = time.perf_counter()
     hand = HandSpec(fingers=(1, 2, 3, 4)) if args.thumb else HandSpec()
-    rows = play_corpus(args.out, tuple(args.only), together=not args.apart, hand=hand)
+    rows = play_corpus(args.out, tuple(args.only), together=not args.apart, hand=hand, general=args.general)
     seconds = time.perf_counter() - started
     print()
     print(table(rows))
@@ -214,6 +226,7 @@ def main() -> None:
             "music21": music21.__version__,
             "apart": args.apart,
             "thumb": args.thumb,
+            "general": None if args.general is None else str(args.general),
             "seconds": round(seconds),
             "rows": rows,
         }

@@ -188,3 +188,11 @@ def test_hands_far_apart_keep_the_fingering_each_was_given():
     assert {hand: plan.piece for hand, plan in finger_apart(parts).items()} == {
         hand: part for hand, (_, part) in parts.items()
     }
+
+
+def test_pianobot_finger_fingers_both_hands_to_keep_their_wrists_apart_as_play_does():
+    fingered = finger_hands(interleaved(), refinger=True)
+    right = {n.name: n.finger for n in fingered.piece.part("right").notes}
+    left = {n.name: n.finger for n in fingered.piece.part("left").notes}
+    assert right == {"G4": 2, "A#4": 3} and left == {"D#4": 2, "A#3": 3}  # (each alone: 3, 4 and 2, 4)
+    assert fingered.plans["right"].piece.has_fingering and fingered.plans["left"].piece.has_fingering

@@ -130,19 +130,27 @@ def test_the_corpus_options_reach_the_players(monkeypatch, tmp_path):
 
     asked = {}
 
-    def play_corpus(folder, only=(), together=True, hand=HandSpec()):
-        asked.update(folder=folder, only=only, together=together, hand=hand)
+    def play_corpus(folder, only=(), together=True, hand=HandSpec(), general=None):
+        asked.update(folder=folder, only=only, together=together, hand=hand, general=general)
         return []
 
     monkeypatch.setitem(sys.modules, "music21", types.SimpleNamespace(__version__="test"))
     monkeypatch.setattr(corpus, "play_corpus", play_corpus)
     out = tmp_path / "c.json"
     argv = ["corpus", "--out", str(tmp_path), "--only", "aloha-oe", "--apart", "--thumb", "--json", str(out)]
-    monkeypatch.setattr(sys, "argv", argv)
+    monkeypatch.setattr(sys, "argv", [*argv, "--general", str(tmp_path / "policy")])
     corpus.main()
-    assert asked == {"folder": tmp_path, "only": ("aloha-oe",), "together": False, "hand": HandSpec((1, 2, 3, 4))}
+    assert asked == {
+        "folder": tmp_path,
+        "only": ("aloha-oe",),
+        "together": False,
+        "hand": HandSpec((1, 2, 3, 4)),
+        "general": tmp_path / "policy",
+    }
     record = json.loads(out.read_text())
     assert record["apart"] is True and record["thumb"] is True and record["rows"] == []
+    assert record["general"] == str(tmp_path / "policy")
     monkeypatch.setattr(sys, "argv", ["corpus", "--out", str(tmp_path)])
     corpus.main()
     assert asked["together"] is True and asked["hand"] == HandSpec() and asked["only"] == ()
+    assert asked["general"] is None
