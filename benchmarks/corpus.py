@@ -149,8 +149,8 @@ def play_corpus(
                 scripted=figures(piece, "scripted", models, together=together, hand=hand),
             )
         rows.append(row)
-        general = f"{row['sac']['f1']:.3f}" if row["sac"] else "n/a"
-        print(f"{name}: general {general}, scripted {row['scripted']['f1']:.3f}", flush=True)
+        said = f"{row['sac']['f1']:.3f}" if row["sac"] else "n/a"
+        print(f"{name}: general {said}, scripted {row['scripted']['f1']:.3f}", flush=True)
     return rows
 
 

@@ -143,11 +143,13 @@ def play_set(
     parts=None,
     hold_guard: bool | None = None,
     keyboard: KeyboardSpec | None = None,
+    hand: HandSpec | None = None,
 ) -> list[dict]:
     """Every piece of a set played by both players: one row of figures per piece (``parts``: the
     parts policy, :func:`with_parts`; ``hold_guard``: the general policies through the hold guard,
     as ``pianobot play`` plays them; ``keyboard``: every part on these keys, as ``pianobot play
-    --lowest-note/--keys`` plays it, else each player's own)."""
+    --lowest-note/--keys`` plays it, else each player's own; ``hand``: each hand's fingers, as
+    ``pianobot play --thumb`` gives them)."""
     rows = []
     with tempfile.TemporaryDirectory() as models:
         for label, piece in pieces:
@@ -156,7 +158,7 @@ def play_set(
             policies = with_parts(piece, general, parts)
             row.update(
                 {
-                    player: figures(piece, player, models, policies, together, hold_guard, 0, keyboard)
+                    player: figures(piece, player, models, policies, together, hold_guard, 0, keyboard, hand=hand)
                     for player in PLAYERS
                 }
             )
@@ -165,26 +167,30 @@ def play_set(
     return rows
 
 
-def example_set(folder: Path) -> list[tuple[str, object]]:
-    """The files in ``folder`` that ``pianobot play`` plays with both hands, each as it reads them."""
+def example_set(folder: Path, hand: HandSpec | None = None) -> list[tuple[str, object]]:
+    """The files in ``folder`` that ``pianobot play`` plays with both hands, each as it reads them
+    (for ``hand``'s fingers, default three)."""
     out = []
     for path in sorted(folder.glob("*.mid")):
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", PianobotWarning)
-            reading = two_hands(path, LoadOptions())
+            reading = two_hands(path, LoadOptions(), hand or HandSpec())
         if reading is not None:
             out.append((path.stem, reading.piece))
     return out
 
 
-def play_examples(pieces, general=None, hold_guard: bool | None = None, starts=EXAMPLE_STARTS) -> list[dict]:
+def play_examples(
+    pieces, general=None, hold_guard: bool | None = None, starts=EXAMPLE_STARTS, hand: HandSpec | None = None
+) -> list[dict]:
     """Each two-hand example as ``pianobot play`` plays it: the general policies from each of
-    ``starts`` (hand starts: ``--seed``), the scripted pianist from 0; each play's figures."""
+    ``starts`` (hand starts: ``--seed``), the scripted pianist from 0 (``hand``: as :func:`play_set`'s);
+    each play's figures."""
     rows = []
     with tempfile.TemporaryDirectory() as models:
         for label, piece in pieces:
-            general_figures = [figures(piece, "sac", models, general, True, hold_guard, s) for s in starts]
-            scripted = figures(piece, "scripted", models)
+            general_figures = [figures(piece, "sac", models, general, True, hold_guard, s, hand=hand) for s in starts]
+            scripted = figures(piece, "scripted", models, hand=hand)
             rows.append({"piece": label, "notes": len(piece), "sac": general_figures, "scripted": scripted})
             f1s = ", ".join(f"{f['f1']:.3f}" for f in general_figures)
             print(f"{label}: general {f1s}; scripted {scripted['f1']:.3f}", flush=True)
@@ -255,8 +261,10 @@ def main() -> None:
         "--keys`), notes outside them left out; default: each player's own",
     )
     parser.add_argument("--keys", type=int, help="how many keys, from --lowest-note")
+    parser.add_argument("--thumb", action="store_true", help="each hand with its thumb too (as play --thumb)")
     parser.add_argument("--json", help="write every piece's figures here")
     args = parser.parse_args()
+    hand = HandSpec((1, 2, 3, 4)) if args.thumb else None
     if (args.lowest_note is None) != (args.keys is None):
         parser.error("--lowest-note and --keys go together")
     keyboard = KeyboardSpec(args.lowest_note, args.keys) if args.keys is not None else None
@@ -271,11 +279,11 @@ def main() -> None:
         if not pieces:
             continue
         general = {"right": args.general, "left": args.general_left} if args.general_left else args.general
-        results[name] = play_set(pieces, general, not args.apart, args.parts, args.hold_guard, keyboard)
+        results[name] = play_set(pieces, general, not args.apart, args.parts, args.hold_guard, keyboard, hand)
         print(table(name, results[name]), flush=True)
     if args.examples is not None:
         general = {"right": args.general, "left": args.general_left} if args.general_left else args.general
-        results["examples"] = play_examples(example_set(args.examples), general, args.hold_guard)
+        results["examples"] = play_examples(example_set(args.examples, hand), general, args.hold_guard, hand=hand)
         print(example_table(results["examples"]), flush=True)
     print(f"{time.perf_counter() - started:.0f} s")
     if args.json:

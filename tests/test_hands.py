@@ -194,5 +194,69 @@ def test_pianobot_finger_fingers_both_hands_to_keep_their_wrists_apart_as_play_d
     fingered = finger_hands(interleaved(), refinger=True)
     right = {n.name: n.finger for n in fingered.piece.part("right").notes}
     left = {n.name: n.finger for n in fingered.piece.part("left").notes}
-    assert right == {"G4": 2, "A#4": 3} and left == {"D#4": 2, "A#3": 3}  # (each alone: 3, 4 and 2, 4)
+    assert right == {"G4": 2, "A#4": 3} and left == {"D#4": 2, "A#3": 4}  # (the right hand alone: 3, 4)
     assert fingered.plans["right"].piece.has_fingering and fingered.plans["left"].piece.has_fingering
+
+
+def test_the_left_hand_moves_aside_where_the_right_hand_cannot():
+    from pianobot.sim.hand import HandConfig, thumb_side_reach
+
+    # a right-hand chord held under all three fingers, over the left hand of `interleaved`
+    notes = [Note(0.0, parse_pitch(x), 2.0, 80, hand="right") for x in ("F4", "G4", "A4")]
+    for i in range(8):
+        t = 0.25 * i
+        notes.append(Note(t, parse_pitch("D#4" if i % 2 == 0 else "A#3"), t + 0.25, 70, hand="left"))
+    parts = fingered_parts(Piece(tuple(sorted(notes, key=lambda n: (n.onset, n.pitch))), bpm=120))
+    alone = {hand: part for hand, (_, part) in parts.items()}
+    apart = {hand: plan.piece for hand, plan in finger_apart(parts).items()}
+    assert [n.finger for n in apart["right"].notes] == [n.finger for n in alone["right"].notes] == [2, 3, 4]
+    assert {n.finger for n in alone["left"].notes} == {2, 4} and {n.finger for n in apart["left"].notes} == {2, 3}
+    gap = 2 * thumb_side_reach(HandConfig())
+    assert least_gap(parts, alone) < gap - 0.01 and least_gap(parts, apart) >= gap - 0.001  # (within a millimetre)
+
+
+@pytest.mark.parametrize("fingers", [(2, 3, 4), (1, 2, 3, 4)])
+def test_where_finger_apart_puts_a_hand_is_where_the_world_puts_it(fingers):
+    """finger_apart's frames against the simulator's own (pianobot.sim.frame.HandView)."""
+    import numpy as np
+
+    from pianobot.env.hands import world_keyboard
+    from pianobot.pianist.fingering import Planner
+    from pianobot.pianist.hands import _frame, _world_x
+    from pianobot.sim.frame import HandView
+    from pianobot.sim.hand import FINGER_BASE_X, HandConfig
+    from pianobot.sim.keyboard import KeyboardConfig
+    from pianobot.sim.world import PianoWorld, WorldConfig
+
+    spec = HandSpec(fingers)
+    parts = fingered_parts(interleaved())
+    keyboard = world_keyboard([window for window, _ in parts.values()])
+    world = PianoWorld(
+        WorldConfig(keyboard=KeyboardConfig(spec=keyboard), hand=HandConfig(spec=spec)), hands=("right", "left")
+    )
+    try:
+        offset = world.boxes[0].center[0] - _world_x(keyboard.lowest)  # (the world's keys start at its lowest)
+        for index, hand in enumerate(("right", "left")):
+            window, part = parts[hand]
+            view = HandView(world, index, window)
+            planner = Planner(KeyboardConfig(spec=window.keyboard), HandConfig(spec=spec))
+            to_frame = _frame(window, part, planner)
+            for x in np.linspace(0.0, 1.0, 5):
+                assert to_frame(x) == pytest.approx(view.x(x + offset), abs=1e-9)
+            for (_, _, wrist), chord in zip(stands(window, part), part.chords()):
+                own = np.mean([planner.key_x[planner.spec.index(n.pitch)] - FINGER_BASE_X[n.finger] for n in chord])
+                assert view.world_x(own) - offset == pytest.approx(wrist, abs=1e-9)
+    finally:
+        world.close()
+
+
+def test_finger_apart_says_what_it_needs():
+    parts = fingered_parts(interleaved())
+    window, part = parts["left"]
+    with pytest.raises(ValueError, match="every note fingered"):
+        finger_apart({**parts, "left": (window, part.without_fingering())})
+    with pytest.raises(ValueError, match="both hands' parts"):
+        finger_apart({"right": parts["right"]})
+    # a hand that keeps its fingering (a file's): only the other is planned, around it
+    plans = finger_apart(parts, fixed=("right",))
+    assert plans["right"] is None and {n.finger for n in plans["left"].piece.notes} == {2, 3}

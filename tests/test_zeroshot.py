@@ -154,3 +154,24 @@ def test_the_corpus_options_reach_the_players(monkeypatch, tmp_path):
     corpus.main()
     assert asked["together"] is True and asked["hand"] == HandSpec() and asked["only"] == ()
     assert asked["general"] is None
+
+
+def test_benchmarks_hands_thumb_gives_every_player_and_the_examples_reading_each_hands_thumb(monkeypatch, tmp_path):
+    import sys
+
+    from benchmarks import hands
+    from pianobot.music.instrument import HandSpec
+
+    asked = []
+    monkeypatch.setattr(hands, "figures", lambda *args, hand=None, **kw: asked.append(hand) or {"f1": 1.0})
+    monkeypatch.setattr(hands, "table", lambda name, rows: "")
+    monkeypatch.setattr(hands, "example_table", lambda rows: "")
+    read = []
+    monkeypatch.setattr(hands, "two_hands", lambda path, options, spec: read.append(spec))
+    (tmp_path / "x.mid").write_bytes(b"")
+    argv = ["hands", "--duets", "1", "--polyphonic", "0", "--examples", str(tmp_path), "--thumb"]
+    monkeypatch.setattr(sys, "argv", argv)
+    hands.main()
+    thumb = HandSpec((1, 2, 3, 4))
+    assert read == [thumb]  # (the example file was read for that hand; here it is no two-hand file)
+    assert asked == [thumb, thumb]  # both players of the one duet

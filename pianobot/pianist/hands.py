@@ -35,7 +35,7 @@ hand keep it. Each hand's part is then reduced to what the hand can play and fin
 planner (:func:`finger_hands`; the left hand's part mirrored, planned as a right hand's, and
 mirrored back), the two fingerings chosen so that the wrists keep the distance the world keeps
 between them where they can (:func:`finger_apart`: two hands a third apart are fingered with
-their outer fingers rather than pushed aside as they play).
+the fingers on their thumbs' side rather than pushed aside as they play).
 """
 
 from __future__ import annotations
@@ -49,7 +49,7 @@ import numpy as np
 
 from pianobot.errors import PianobotError, PianobotWarning
 from pianobot.music import window as windows
-from pianobot.music.instrument import PIANO, HandSpec, KeyboardSpec, keyboard_for
+from pianobot.music.instrument import HandSpec, KeyboardSpec, keyboard_for
 from pianobot.music.load import CHORD_SPREAD, LEGATO_OVERLAP, LoadOptions, load_hands, thin_hand
 from pianobot.music.piece import Note, Piece, mirror_pitch
 from pianobot.pianist.fingering import SETTLE_TIME, FingeringPlan, Planner, ensure_fingering
@@ -343,8 +343,8 @@ def finger_hands(piece: Piece, spec: HandSpec = HandSpec(), refinger: bool = Fal
     """Each hand's part of ``piece`` (every note has a hand) thinned and reduced to what the hand
     can play (:func:`~pianobot.music.load.thin_hand`, :func:`~pianobot.pianist.reduce.reduce_part`,
     one warning per kind of change and hand) and fingered by the planner, both hands planned so
-    that their wrists keep apart where a fingering allows (:func:`finger_apart`; not where
-    ``refinger`` is False and a hand's part has the file's fingering). The left hand's part is
+    that their wrists keep apart where a fingering allows (:func:`finger_apart`; a hand's part that
+    keeps the file's fingering, ``refinger`` False, is not fingered again). The left hand's part is
     planned as its mirror image, a right hand's part, and mirrored back."""
     if any(n.hand is None for n in piece.notes):
         raise ValueError("finger_hands needs every note's hand: call assign_hands first")
@@ -360,9 +360,11 @@ def finger_hands(piece: Piece, spec: HandSpec = HandSpec(), refinger: bool = Fal
         fingered, plan = ensure_fingering(reduced, keyboard, spec, refinger=refinger)
         views[hand] = (windows.Window(hand, keyboard, 0), fingered)
         plans[hand] = plan
-    if len(views) == 2 and all(plans.values()):  # planned here: fingerings that keep the wrists apart
-        plans = finger_apart(views, spec)
-        views = {hand: (window, plans[hand].piece) for hand, (window, _) in views.items()}
+    if len(views) == 2 and any(plans.values()):  # fingerings planned here keep the wrists apart
+        kept = tuple(hand for hand, plan in plans.items() if plan is None)  # (the file's fingering)
+        apart = finger_apart(views, spec, fixed=kept)
+        plans = {hand: apart[hand] or plans[hand] for hand in plans}
+        views = {hand: (window, apart[hand].piece if apart[hand] else part) for hand, (window, part) in views.items()}
     for hand, (_, fingered) in views.items():
         fingered = fingered.with_hands("right")
         notes.extend((fingered.mirror() if hand == "left" else fingered).notes)
@@ -377,24 +379,30 @@ LINGER = 0.1
 
 
 def finger_apart(
-    parts: dict[str, tuple[windows.Window, Piece]], spec: HandSpec = HandSpec()
-) -> dict[str, FingeringPlan]:
+    parts: dict[str, tuple[windows.Window, Piece]], spec: HandSpec = HandSpec(), fixed: tuple[str, ...] = ()
+) -> dict[str, FingeringPlan | None]:
     """Both hands' parts, each in its window's keys (:class:`~pianobot.music.window.Window`:
     the left hand's mirrored) and fingered, fingered again so that the wrists keep the distance
     the world keeps between them (:attr:`~pianobot.sim.world.PianoWorld.min_separation`) where a
-    fingering allows: the right hand's part as it is fingered, the left hand's planned to keep
-    clear of it, then the right hand's planned again to keep clear of that (the planner's
-    ``room``, :meth:`~pianobot.pianist.fingering.Planner.plan`). A hand stands where its fingers
-    put the scripted pianist's wrist (straight over their keys, on average) from
-    :data:`~pianobot.pianist.fingering.SETTLE_TIME` before each chord until the next, or, idle
-    (:data:`IDLE`), until its notes end. Where no fingering keeps clear, the least crowding one
-    is taken (the world then pushes the hands apart as they play). Returns both hands' plans."""
+    fingering allows: the left hand's part planned to keep clear of the right hand's as it is
+    fingered, then the right hand's to keep clear of that, then the left hand's again (the
+    planner's ``room``, :meth:`~pianobot.pianist.fingering.Planner.plan`); the hands in ``fixed``
+    keep their fingering (their plan: None). A hand stands where its fingers put the scripted
+    pianist's wrist (straight over their keys, on average; the pianist may stand elsewhere where
+    held keys or the keyboard's end keep it) from :data:`~pianobot.pianist.fingering.SETTLE_TIME`
+    before each chord until the next, or, idle (:data:`IDLE`), until :data:`LINGER` after its
+    notes end. Where no fingering keeps clear, the least crowding one is taken (the world then
+    pushes the hands apart as they play)."""
     if set(parts) != {"right", "left"}:
         raise ValueError(f"finger_apart needs both hands' parts, not {', '.join(parts)}")
+    if any(not part.notes or not part.has_fingering for _, part in parts.values()):
+        raise ValueError("finger_apart needs both hands' parts with notes, every note fingered")
     gap = 2 * thumb_side_reach(HandConfig(spec=spec))
     fingered = {hand: part for hand, (_, part) in parts.items()}
-    plans = {}
-    for hand, other in (("left", "right"), ("right", "left")):
+    plans: dict[str, FingeringPlan | None] = dict.fromkeys(parts)
+    for hand, other in (("left", "right"), ("right", "left"), ("left", "right")):
+        if hand in fixed:
+            continue
         window, part = parts[hand]
         planner = Planner(KeyboardConfig(spec=window.keyboard), HandConfig(spec=spec))
         others = stands(parts[other][0], fingered[other])
@@ -414,11 +422,15 @@ def finger_apart(
 
 
 def _world_x(pitch: int) -> float:
-    """Where the key of ``pitch`` lies on the piano's 88 keys (m from the lowest)."""
-    return _PIANO_X[pitch - PIANO.lowest]
+    """Where the key of MIDI ``pitch`` lies along a keyboard of every pitch (m from C-1's octave;
+    only differences count): the keys repeat octave by octave, seven white keys each."""
+    octave, step = divmod(pitch, 12)
+    return float(_OCTAVE_X[step] + octave * 7 * _WHITE_PITCH)
 
 
-_PIANO_X = np.array([b.center[0] for b in key_boxes(KeyboardConfig(spec=PIANO))])
+_OCTAVE = KeyboardConfig(spec=KeyboardSpec(0, 12))
+_OCTAVE_X = np.array([b.center[0] for b in key_boxes(_OCTAVE)])
+_WHITE_PITCH = _OCTAVE.geometry.white_pitch
 
 
 def _frame(window: windows.Window, part: Piece, planner: Planner):
