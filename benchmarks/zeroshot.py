@@ -17,7 +17,9 @@ where ``play`` plays it through one, or as ``--hold-guard``/``--no-hold-guard`` 
   (:func:`pianobot.music.melodies.random_melody`, 60-144 bpm, velocities 20-127), drawn with
   generators seeded ``[--seed, index, draw]`` (no training run draws from these: the melody task
   family draws from the environment's generator, the melody benchmark from ``[tonic, index, draw]``),
-  fingered by the planner; a melody it says this hand cannot play at its tempo is drawn again;
+  fingered by the planner for the general policy's fingers (and the scripted pianist plays with
+  them: three, or four for a policy with the thumb); a melody it says this hand cannot play at its
+  tempo is drawn again;
 - ``articulation``: as many random melodies drawn the same way with slurs (notes written to last
   until the next one sounds; :data:`SLURS`), seeded ``[38, index, draw]``: how long notes are held;
 - ``tasks``: ``--per-task`` instances of each of the paper's task families (seeds 0, 1, ...).
@@ -48,6 +50,7 @@ import argparse
 import json
 import tempfile
 import time
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -114,7 +117,8 @@ def play_both(piece: Piece, general: Path, empty: Path, guard: bool = False, hol
     policy = perform(
         piece, lambda env: CompositionalController(env, assign(phrases, empty, general), guard, hold), env_config
     )
-    scripted = perform(piece, "scripted", PLAY_CONFIG)
+    hand = replace(PLAY_CONFIG.world.hand, spec=env_config.world.hand.spec)  # (the policy's fingers)
+    scripted = perform(piece, "scripted", replace(PLAY_CONFIG, world=replace(PLAY_CONFIG.world, hand=hand)))
     return {
         "notes": len(piece),
         "general": {**figures(policy), "hits": placed_hits(phrases, policy)},
@@ -139,20 +143,22 @@ def where_table(rows: list[dict]) -> str:
     return "\n".join(lines)
 
 
-def example_set(root: Path) -> list[tuple[str, Piece]]:
-    """The example songs as ``pianobot play`` reads them: their own fingering, else the planner's."""
+def example_set(root: Path, hand: HandSpec = HandSpec()) -> list[tuple[str, Piece]]:
+    """The example songs as ``pianobot play`` reads them: their own fingering, else the planner's for ``hand``."""
     pieces = [(name, load_piece(root / f"{name}.mid", LoadOptions())) for name in EXAMPLES]
-    return [(name, ensure_fingering(piece, KeyboardSpec(), HandSpec())[0]) for name, piece in pieces]
+    return [(name, ensure_fingering(piece, KeyboardSpec(), hand)[0]) for name, piece in pieces]
 
 
-def melody_set(count: int, seed: int, slurs: float = 0.0) -> tuple[list[tuple[str, Piece]], int]:
-    """``count`` playable random melodies (``slurs``: their chance of a slur at each note), and how
-    many draws the planner turned down."""
+def melody_set(
+    count: int, seed: int, slurs: float = 0.0, hand: HandSpec = HandSpec()
+) -> tuple[list[tuple[str, Piece]], int]:
+    """``count`` random melodies that ``hand`` can play (``slurs``: their chance of a slur at each
+    note), fingered for it, and how many draws the planner turned down."""
     out, rejected = [], 0
     for index in range(count):
         for draw in range(MELODY_DRAWS):
             piece = random_melody(np.random.default_rng([seed, index, draw]), KeyboardSpec(), slurs=slurs)
-            fingered, plan = ensure_fingering(piece, KeyboardSpec(), HandSpec())
+            fingered, plan = ensure_fingering(piece, KeyboardSpec(), hand)
             if plan is None or not plan.problems:
                 out.append((describe(fingered), fingered))
                 break
@@ -171,18 +177,18 @@ def task_set(per_task: int) -> list[tuple[str, Piece]]:
 
 
 def chosen_sets(
-    names: list[str], examples: Path, melodies: int, seed: int, per_task: int
+    names: list[str], examples: Path, melodies: int, seed: int, per_task: int, hand: HandSpec = HandSpec()
 ) -> tuple[dict[str, list[tuple[str, Piece]]], int]:
-    """The pieces of the sets ``names`` (in :data:`SETS` order), and how many melody draws the
-    planner turned down (0 without the melodies); a set left out is not even drawn."""
+    """The pieces of the sets ``names`` (in :data:`SETS` order), fingered for ``hand``, and how many
+    melody draws the planner turned down (0 without the melodies); a set left out is not even drawn."""
     sets, rejected = {}, 0
     for name in (n for n in SETS if n in names):
         if name == "examples":
-            sets[name] = example_set(examples)
+            sets[name] = example_set(examples, hand)
         elif name == "melodies":
-            sets[name], rejected = melody_set(melodies, seed)
+            sets[name], rejected = melody_set(melodies, seed, hand=hand)
         elif name == "articulation":
-            sets[name], _ = melody_set(melodies, ARTICULATION_SEED, SLURS)
+            sets[name], _ = melody_set(melodies, ARTICULATION_SEED, SLURS, hand)
         else:
             sets[name] = task_set(per_task)
     return sets, rejected
@@ -288,7 +294,8 @@ def main() -> None:
             f"no general policy in {args.models}: train one with `pianobot train --task melody` or give --general"
         )
     began = time.perf_counter()
-    sets, rejected = chosen_sets(args.sets, args.examples, args.melodies, args.seed, args.per_task)
+    hand = policy_configs(general)[0].world.hand.spec  # (one-hand sets are fingered for the policy's fingers)
+    sets, rejected = chosen_sets(args.sets, args.examples, args.melodies, args.seed, args.per_task, hand)
     results: dict[str, list[dict]] = {}
     with tempfile.TemporaryDirectory() as empty:
         for name, pieces in sets.items():

@@ -419,13 +419,15 @@ def test_the_packaged_left_hand_policy_plays_left_hands_only_while_the_store_has
     one hand; a general policy of the user's own plays both hands (none is offered then), and so
     does the packaged general policy where the left hand's cannot play the keys (fewer than its own)."""
     from pianobot.agent.general import LEFT_KEY, general_candidates, left_hand_policy
-    from pianobot.music.instrument import KeyboardSpec
+    from pianobot.music.instrument import HandSpec, KeyboardSpec
 
     empty = tmp_path / "empty"
     empty.mkdir()
     left = left_hand_policy(empty)
     assert left is not None and left.name.startswith(f"{LEFT_KEY}-") and PACKAGED in left.resolve().parents
-    assert [f.name.split("-")[1] for f in general_candidates(empty)] == ["melody"]  # the packaged general policy
+    # the packaged general policy, then the parts policies (for a hand the general policy does not fit: the thumb)
+    assert [f.name.split("-")[1] for f in general_candidates(empty)] == ["melody", "parts", "parts"]
+    assert left_hand_policy(empty, hand=HandSpec((1, 2, 3, 4))) not in (None, left)  # the thumb's
     assert left_hand_policy(empty, KeyboardSpec()) == left
     assert left_hand_policy(empty, KeyboardSpec(lowest=36, count=36)) == left  # it plays any wider keyboard
     assert left_hand_policy(empty, KeyboardSpec(lowest=60, count=12)) is None  # not a narrower one

@@ -10,6 +10,7 @@ import pytest
 import pianobot
 from pianobot.agent import store
 from pianobot.agent.general import GENERAL_KEY, PACKAGED
+from pianobot.agent.policy import policy_configs
 from pianobot.errors import PianobotError
 from pianobot.music.instrument import HandSpec, KeyboardSpec
 from pianobot.music.phrases import DEFAULT_MAX_NOTES, split_phrases
@@ -59,15 +60,19 @@ def test_one_player_plans_and_refusals(tmp_path):
     assert stretch.player is Player.SCRIPTED and stretch.policy is None
     with pytest.raises(PianobotError, match="controller 'sac2'"):
         plan_performance(piece, "sac2")
-    # with the thumb the packaged policy (three fingers) does not fit: nobody plays, said with where it
-    # looked and why the packaged one does not play it
+    # with the thumb the packaged melody policy (three fingers) does not fit, the packaged thumb's parts policy does
+    (stretch,) = plan_performance(piece, models=tmp_path, hand=HandSpec(fingers=(1, 2, 3, 4))).stretches
+    assert stretch.player is Player.GENERAL and stretch.policy.name.startswith("task-parts-")
+    assert policy_configs(stretch.policy)[0].world.hand.spec == HandSpec(fingers=(1, 2, 3, 4))
+    # a hand no packaged policy has: nobody plays, said with where it looked and why the packaged ones do not
     with pytest.raises(
         PianobotError,
         match=r"no general policy plays it \(looked there and in .*policies; the packaged general policies play "
-        r"with fingers 2 \(index\), 3 \(middle\), 4 \(ring\); this piece is read for fingers 1 \(thumb\).*"
-        r"\(hand.fingers\)\).*store.models",
+        r"with fingers 2 \(index\), 3 \(middle\), 4 \(ring\) or 1 \(thumb\), 2 \(index\), 3 \(middle\), "
+        r"4 \(ring\); this piece is read for fingers 1 \(thumb\), 2 \(index\), 3 \(middle\) \(hand.fingers\)\)"
+        r".*store.models",
     ):
-        plan_performance(piece, models=tmp_path, hand=HandSpec(fingers=(1, 2, 3, 4)))
+        plan_performance(piece, models=tmp_path, hand=HandSpec(fingers=(1, 2, 3)))
     assert passed_over(KeyboardSpec(), HandSpec()) == ""  # the packaged policies play these: nothing to say
     assert passed_over(KeyboardSpec(48, 36), HandSpec()) == ""  # (wider keyboards too)
     assert passed_over(KeyboardSpec(48, 20), HandSpec()).endswith("read for C3-G4 (20 keys) (keyboard.count)")

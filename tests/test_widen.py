@@ -80,7 +80,9 @@ def test_the_packaged_parts_policy_widens_to_a_hand_with_its_thumb(tmp_path):
     from pianobot.agent.policy import load_policy, policy_configs, policy_target
     from pianobot.agent.tasks import make_env
 
-    source = next(PACKAGED.glob("task-parts-*"))
+    source = next(
+        p for p in sorted(PACKAGED.glob("task-parts-*")) if policy_configs(p)[0].world.hand.spec.fingers == (2, 3, 4)
+    )
     folder = widen_policy(source, tmp_path / "wide", (1, 2, 3, 4))
     env, _ = policy_configs(folder)
     assert env.world.hand.spec.fingers == (1, 2, 3, 4)

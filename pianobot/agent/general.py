@@ -29,6 +29,7 @@ from pianobot.agent.policy import policy_configs
 from pianobot.config import to_dict
 from pianobot.env.piano import EnvConfig
 from pianobot.errors import PianobotError, SettingError
+from pianobot.music.instrument import HandSpec
 from pianobot.music.tasks import MELODY, PARTS
 
 if TYPE_CHECKING:
@@ -139,18 +140,20 @@ def explain(folder: Path, found: tuple[str, Any, Any], ours: str) -> str:
 
 def general_candidates(models: Path | None) -> list[Path]:
     """Every general policy there is: the newest first in ``models`` (the user's store), then the
-    packaged general policy (:data:`PACKAGED`'s ``task-melody`` folder; its left hand's policy
-    plays only where :func:`left_hand_policy` gives it)."""
+    packaged general policy (:data:`PACKAGED`'s ``task-melody`` folder), then the packaged
+    ``task-parts`` policies, which play a one-hand piece only where no policy before them fits it
+    (the packaged thumb's, for a hand with fingers 1-4; :func:`left_hand_policy` gives them both
+    hands of a two-hand piece)."""
     found = _newest_first(models) if models is not None else []
-    packaged = [p for p in _newest_first(PACKAGED, (GENERAL_KEY,)) if p.resolve() not in {f.resolve() for f in found}]
-    return found + packaged
+    packaged = _newest_first(PACKAGED, (GENERAL_KEY,)) + _newest_first(PACKAGED, (LEFT_KEY,))
+    return found + [p for p in packaged if p.resolve() not in {f.resolve() for f in found}]
 
 
-def left_hand_policy(models: Path | None, keyboard: Any = None, hand: Any = None) -> Path | None:
+def left_hand_policy(models: Path | None, keyboard: Any = None, hand: Any = HandSpec()) -> Path | None:
     """The general policy that plays both hands of a two-hand piece by default (one-hand pieces have
     the general policy, :func:`general_candidates`): the packaged ``parts`` policy, when the user's
-    store holds no general policy of its own for ``keyboard`` and ``hand`` (specs; None: any; such
-    a one plays both hands) and the packaged one plays them (:func:`plays_keyboard`). None: both hands have the
+    store holds no general policy of its own for ``keyboard`` and ``hand`` (specs; None: any; by
+    default the three-finger hand; such a one plays both hands) and the packaged one plays them (:func:`plays_keyboard`). None: both hands have the
     general policy. Measured (docs/benchmarks.md, "Two hands"): alone, the left hands of 50 random
     two-hand pieces at note F1 0.929 against the melody policy's 0.861; through the hold guard, the
     right hands at 0.933 against the melody policy's 0.923."""

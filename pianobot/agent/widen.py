@@ -111,6 +111,7 @@ def widen_policy(source: Path, destination: Path, fingers: tuple[int, ...]) -> P
         layouts.append(finger_layout(space))
         rests.append(sum(int(np.prod(space[k].shape)) for k in ("keys", "key_velocities") if k in space.spaces))
         instance.close()
+    torch.manual_seed(0)  # (the fresh encoder: the same file every time)
     fresh = make_agent(make_env(target, wide), sac).tensors(with_training_state=False)
     old_tensors = store.load_tensors(source / store.POLICY_FILE)
     slots = [sorted(fingers).index(f) for f in before]

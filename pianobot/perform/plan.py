@@ -310,10 +310,11 @@ def passed_over(keyboard: KeyboardSpec, hand: HandSpec) -> str:
     ):
         return ""
     world = policy_configs(packaged[0])[0].world
-    if world.hand.spec != hand:
+    hands = list(dict.fromkeys(policy_configs(f)[0].world.hand.spec for f in packaged))
+    if hand not in hands:
         return (
-            f"the packaged general policies play with fingers {world.hand.spec.describe()}; this piece is read for "
-            f"fingers {hand.describe()} (hand.fingers)"
+            f"the packaged general policies play with fingers {' or '.join(h.describe() for h in hands)}; this "
+            f"piece is read for fingers {hand.describe()} (hand.fingers)"
         )
     return (
         f"the packaged general policies play keyboards of {world.keyboard.spec.count} keys or more; this piece is "
