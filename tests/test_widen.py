@@ -41,8 +41,11 @@ def test_context_sources_put_each_old_value_in_its_fingers_new_place_and_leave_t
         assert np.all(new_blocks[1 + part * 4] == -1)  # the thumb's: nothing
         for i, slot in enumerate(SLOTS):
             assert np.array_equal(new_blocks[1 + part * 4 + slot], old_blocks[1 + part * 3 + i])
-    with pytest.raises(ValueError, match="alike"):
+    with pytest.raises(PianobotError, match="different joints or targets"):
         context_sources(OLD, FingerLayout(4, JOINTS, WIDTH + 1), SLOTS, rest=0)
+    # the keys' values, where observed, come after the fingers', in the same order
+    keyed = context_sources(OLD, NEW, SLOTS, rest=3)
+    assert list(keyed[-3:]) == [len(old) + k for k in range(3)] and list(keyed[:-3]) == list(sources)
 
 
 def test_a_widened_actor_moves_the_fingers_it_knew_and_the_wrist_as_before_whatever_the_new_finger_does():
@@ -99,3 +102,19 @@ def test_the_packaged_parts_policy_widens_to_a_hand_with_its_thumb(tmp_path):
         widen_policy(source, folder, (1, 2, 3, 4))
     with pytest.raises(PianobotError, match="do not add"):
         widen_policy(source, tmp_path / "same", (2, 3, 4))
+    with pytest.raises(PianobotError, match="the simulated hand has fingers 1,2,3,4"):
+        widen_policy(source, tmp_path / "five", (2, 3, 4, 5))
+    assert not (tmp_path / "same").exists() and not (tmp_path / "five").exists()
+
+
+def test_the_widen_command_says_bad_input_in_one_line_and_exits_2(tmp_path, capsys):
+    from pianobot.agent.widen import main
+
+    for argv, said in (
+        ([str(tmp_path), str(tmp_path / "out"), "--fingers", "1,two"], "--fingers 1,two: give finger numbers"),
+        ([str(tmp_path / "none"), str(tmp_path / "out")], "holds no manifest.json"),
+    ):
+        with pytest.raises(SystemExit) as exit:
+            main(argv)
+        assert exit.value.code == 2
+        assert said in capsys.readouterr().err.strip().splitlines()[-1]

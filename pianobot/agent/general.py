@@ -45,10 +45,12 @@ GENERAL_KEYS = (GENERAL_KEY, store.task_key(PARTS))
 folders, ``task-parts-``, ``task-parts-v2-``, ``task-parts-v3-``)."""
 PACKAGED = Path(__file__).resolve().parent.parent / "policies"
 """The policies that ship with pianobot (package data): the committed general policy (a
-``task-melody`` folder) and the left hand's (:func:`left_hand_policy`, a ``task-parts`` folder)."""
+``task-melody`` folder), and the ``task-parts`` folders: the three-finger hand's policy for both
+hands of a two-hand piece (:func:`left_hand_policy`) and the thumb's (fingers 1-4), which plays
+every piece read for that hand."""
 LEFT_KEY = store.task_key(PARTS)
-"""The packaged left hand's policy's key: the ``parts`` family's (any version), which learnt
-hands' whole parts (chords, held notes under a moving voice, bass lines)."""
+"""The packaged parts policies' key: the ``parts`` family's (any version), which learnt hands'
+whole parts (chords, held notes under a moving voice, bass lines)."""
 
 NETWORK_FIELDS = ("hidden", "actor", "score_input", "score_features", "tactile_channels", "tactile_features")
 """The :class:`SACConfig` fields that shape the networks: a start policy's must be the run's."""
@@ -151,16 +153,16 @@ def general_candidates(models: Path | None) -> list[Path]:
 
 def left_hand_policy(models: Path | None, keyboard: Any = None, hand: Any = HandSpec()) -> Path | None:
     """The general policy that plays both hands of a two-hand piece by default (one-hand pieces have
-    the general policy, :func:`general_candidates`): the packaged ``parts`` policy, when the user's
-    store holds no general policy of its own for ``keyboard`` and ``hand`` (specs; None: any; by
-    default the three-finger hand; such a one plays both hands) and the packaged one plays them (:func:`plays_keyboard`). None: both hands have the
-    general policy. Measured (docs/benchmarks.md, "Two hands"): alone, the left hands of 50 random
+    the general policy, :func:`general_candidates`): the packaged ``parts`` policy for ``hand``'s
+    fingers (a spec; default the three-finger hand), when the user's store holds no general policy
+    of its own for ``keyboard`` (a spec, None: any) and ``hand`` (such a one plays both hands) and
+    the packaged one plays them (:func:`plays_keyboard`). None: both hands have the general policy. Measured (docs/benchmarks.md, "Two hands"): alone, the left hands of 50 random
     two-hand pieces at note F1 0.929 against the melody policy's 0.861; through the hold guard, the
     right hands at 0.933 against the melody policy's 0.923."""
 
     def fits(folder: Path) -> bool:
         env, sac = policy_configs(folder)
-        return (keyboard is None or plays_keyboard(env, sac, keyboard)) and hand in (None, env.world.hand.spec)
+        return (keyboard is None or plays_keyboard(env, sac, keyboard)) and hand == env.world.hand.spec
 
     if models is not None and any(fits(folder) for folder in _newest_first(Path(models))):
         return None

@@ -31,6 +31,7 @@ from pianobot.agent.tasks import make_env
 from pianobot.config import to_dict
 from pianobot.errors import PianobotError
 from pianobot.music.instrument import HandSpec
+from pianobot.sim.hand import FINGER_BASE_X
 
 WIDENED = "widened"
 """A widened policy's manifest says ``"kept": "widened"``: it was not trained as it is."""
@@ -42,7 +43,10 @@ def context_sources(old: FingerLayout, new: FingerLayout, slots: list[int], rest
     the wrist (2), then joints, joint speeds and targets finger by finger, then ``rest`` more
     (the keys', where observed). ``slots[i]`` is the new slot of the old hand's finger ``i``."""
     if old.joints != new.joints or old.target_width != new.target_width:
-        raise ValueError("the hands' fingers must be alike: the same joints and target width")
+        raise PianobotError(
+            "the policy's fingers and the new hand's observe different joints or targets: widen a policy only "
+            "to the same environment with more fingers"
+        )
     sources = [0, 1]
     old_base, new_base = 2, 2
     for width in (old.joints, old.joints, old.target_width):
@@ -79,7 +83,10 @@ def widen_actor(
     first = tensors["actor.finger.0.weight"]
     old_context = 2 + old.fingers * (2 * old.joints + old.target_width) + rest
     if first.shape[1] != own_before + old.fingers + old_context:
-        raise ValueError(f"actor.finger.0.weight reads {first.shape[1]} values, not this hand's")
+        raise PianobotError(
+            f"the policy's actor.finger.0.weight reads {first.shape[1]} values where its manifest's environment "
+            f"gives {own_before + old.fingers + old_context}: the folder's files do not belong together"
+        )
     own = first[:, :own_before]
     onehot = first[:, own_before : own_before + old.fingers]
     new_onehot = _columns(onehot, index)
@@ -95,11 +102,21 @@ def widen_policy(source: Path, destination: Path, fingers: tuple[int, ...]) -> P
     with ``fingers`` (a superset of its own), and a manifest that says so (``"kept": "widened"``,
     no training of its own). Returns ``destination``."""
     env, sac = policy_configs(source)
-    if sac.actor != "fingers":
-        raise PianobotError(f"{source} has the {sac.actor!r} actor: only the 'fingers' actor reads every finger alike")
+    if sac.actor != "fingers" or sac.score_input:
+        raise PianobotError(
+            f"{source} has the {sac.actor!r} actor{' reading the score window' if sac.score_input else ''}: only "
+            "the 'fingers' actor without it (train.sac.actor fingers) reads every finger alike"
+        )
     before = env.world.hand.spec.fingers
+    if not set(fingers) <= set(FINGER_BASE_X):
+        raise PianobotError(
+            f"fingers {','.join(map(str, fingers))}: the simulated hand has fingers {','.join(map(str, FINGER_BASE_X))}"
+        )
     if not set(before) < set(fingers):
-        raise PianobotError(f"fingers {fingers} do not add to the policy's own, {before}")
+        raise PianobotError(
+            f"fingers {','.join(map(str, fingers))} do not add to the policy's own ({','.join(map(str, before))}): "
+            "name all of them, e.g. --fingers 1,2,3,4"
+        )
     if (destination / store.MANIFEST_FILE).exists():
         raise PianobotError(f"{destination} already holds a policy: name a new folder")
     wide = replace(env, world=replace(env.world, hand=replace(env.world.hand, spec=HandSpec(tuple(sorted(fingers))))))
@@ -107,12 +124,17 @@ def widen_policy(source: Path, destination: Path, fingers: tuple[int, ...]) -> P
     layouts, rests = [], []
     for config in (env, wide):
         instance = make_env(target, config)
-        space = instance.observation_space
-        layouts.append(finger_layout(space))
-        rests.append(sum(int(np.prod(space[k].shape)) for k in ("keys", "key_velocities") if k in space.spaces))
-        instance.close()
-    torch.manual_seed(0)  # (the fresh encoder: the same file every time)
-    fresh = make_agent(make_env(target, wide), sac).tensors(with_training_state=False)
+        try:
+            space = instance.observation_space
+            layouts.append(finger_layout(space))
+            rests.append(sum(int(np.prod(space[k].shape)) for k in ("keys", "key_velocities") if k in space.spaces))
+            if config is wide:
+                torch.manual_seed(0)  # (the fresh encoder: the same file every time)
+                fresh = make_agent(instance, sac).tensors(with_training_state=False)
+        finally:
+            instance.close()
+    if rests[0] != rests[1]:
+        raise PianobotError("the new hand observes the keys differently from the policy: widen on the same keyboard")
     old_tensors = store.load_tensors(source / store.POLICY_FILE)
     slots = [sorted(fingers).index(f) for f in before]
     actor = widen_actor({k: v for k, v in old_tensors.items() if k.startswith("actor.")}, *layouts, slots, rests[0])
@@ -129,7 +151,8 @@ def widen_policy(source: Path, destination: Path, fingers: tuple[int, ...]) -> P
         widened={"fingers_before": list(before), "fingers": sorted(fingers)},
     )
     manifest["config"]["env"] = to_dict(wide)
-    manifest.pop("format", None), manifest.pop("saved", None), manifest.pop("versions", None)
+    for field in ("format", "saved", "versions"):  # (save_policy writes them anew)
+        manifest.pop(field, None)
     store.save_policy(destination, tensors, manifest)
     return destination
 
@@ -141,8 +164,14 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--fingers", default="1,2,3,4", help="the new hand's fingers (default: 1,2,3,4)")
     args = parser.parse_args(argv)
     torch.set_num_threads(1)
-    fingers = tuple(int(f) for f in args.fingers.split(","))
-    print(widen_policy(args.source, args.destination, fingers))
+    try:
+        fingers = tuple(int(f) for f in args.fingers.split(","))
+    except ValueError:
+        parser.error(f"--fingers {args.fingers}: give finger numbers separated by commas, e.g. 1,2,3,4")
+    try:
+        print(widen_policy(args.source, args.destination, fingers))
+    except PianobotError as e:
+        parser.error(str(e))
 
 
 if __name__ == "__main__":
