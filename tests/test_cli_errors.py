@@ -92,3 +92,24 @@ def test_the_reading_options_are_declared_once_and_offered_where_they_apply():
     assert offered["export"] == set()
     help_text = runner.invoke(app, ["play", "--help"], env={"COLUMNS": "250"}).output
     assert "Reading the piece" in help_text and "Keyboard and hand" in help_text and "right|left" in help_text
+
+
+def test_no_output_option_writes_over_an_input_or_another_output(tmp_path):
+    """--json named like the input (or the performance, or its report) was written over it; now refused first."""
+    import shutil
+
+    song = tmp_path / "twinkle.mid"
+    shutil.copy(Path(__file__).parent.parent / "examples" / "midi" / "twinkle.mid", song)
+    before = song.read_bytes()
+    out = tmp_path / "out.mid"
+    scripted = ("--controller", "scripted")
+    cases = [
+        (["play", song, "-o", out, "--json", song, *scripted], "--json", "name it *.json"),
+        (["play", song, "-o", out, "--json", tmp_path / "out.report.json", *scripted], "would overwrite the report"),
+        (["play", song, "-o", out, "--json", tmp_path / "r.json", "--html", tmp_path / "r.json", *scripted], "--html"),
+        (["score", song, song, "--json", song], "name it *.json"),
+        (["inspect", song, "--json", song], "name it *.json"),
+    ]
+    for args, *words in cases:
+        assert_one_line_error(run(*args), *words)
+    assert song.read_bytes() == before and not out.exists() and not list(tmp_path.glob("*.json"))

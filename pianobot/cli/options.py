@@ -182,6 +182,23 @@ def check_midi_output(output: Path, song: Path, what: str) -> None:
         raise PianobotError(f"-o {output} would overwrite the input {song.name}: choose another file name")
 
 
+def check_files(inputs: dict[str, Path | None], outputs: dict[str, Path | None]) -> None:
+    """The files a command writes (``outputs``, by option; None: not asked for; '-': standard
+    output) are each a file of their own, none of them one it reads (``inputs``, by what the user
+    calls it), and --json names a *.json file: a run never writes over what the user had."""
+    json_path = outputs.get("--json")
+    if json_path is not None and str(json_path) != "-" and Path(json_path).suffix.lower() != ".json":
+        raise PianobotError(f"--json {json_path}: the figures are a JSON file, name it *.json")
+    seen: dict[str, str] = {os.path.realpath(path): name for name, path in inputs.items() if path is not None}
+    for option, path in outputs.items():
+        if path is None or str(path) == "-":
+            continue
+        where = os.path.realpath(path)  # (realpath: a symbolic-link loop is no crash)
+        if where in seen:
+            raise PianobotError(f"{option} {path} would overwrite {seen[where]}: choose another file name")
+        seen[where] = f"what {option} writes" if option.startswith("-") else option
+
+
 def check_html(path: Path | None) -> None:
     """--html must name an .html file."""
     if path is not None and path.suffix.lower() not in (".html", ".htm"):

@@ -11,6 +11,7 @@ from pianobot.cli.options import (
     AllRows,
     Reading,
     both_hands,
+    check_files,
     check_midi_output,
     reads,
 )
@@ -36,6 +37,7 @@ def finger(
     from pianobot.pianist.reduce import load_for_hand
 
     check_midi_output(output, song, "the fingered piece")
+    check_files({"the input": song, "the fingering file": reading.options.fingering}, {"-o": output})
     check_writable(output)
     keyboard, hand_spec = reading.keyboard, reading.hand
     hands = both_hands(song, reading)

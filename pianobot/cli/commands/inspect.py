@@ -14,6 +14,7 @@ from pianobot.cli.options import (
     PlayPhraseNotes,
     Reading,
     both_hands,
+    check_files,
     reads,
 )
 from pianobot.cli.terminal import err, out, said, write_json
@@ -46,6 +47,7 @@ def inspect(
 
     options, keyboard, hand_spec = reading.options, reading.keyboard, reading.hand
     to_stdout = json_path is not None and str(json_path) == "-"
+    check_files({"the input": song, "the fingering file": options.fingering}, {"--json": json_path})
     if json_path is not None and not to_stdout:
         check_writable(json_path)
     console = err if to_stdout else out  # standard output carries the JSON

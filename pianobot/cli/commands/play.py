@@ -19,6 +19,7 @@ from pianobot.cli.options import (
     PlayPhraseNotes,
     Reading,
     both_hands,
+    check_files,
     check_html,
     check_midi_output,
     read_song,
@@ -134,6 +135,10 @@ def play(
 
     check_midi_output(output, song, "the performance")
     report_path = output.with_suffix(".report.json")
+    check_files(
+        {"the input": song, "the fingering file": reading.options.fingering},
+        {"-o": output, "the report beside -o": report_path, "--json": json_path, "--html": html, "--wav": wav, "--video": video},
+    )
     to_stdout = json_path is not None and str(json_path) == "-"
     console = err if to_stdout else out  # standard output carries the JSON
     for target in (output, report_path, video, wav, html, None if to_stdout else json_path):

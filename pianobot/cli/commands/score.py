@@ -12,6 +12,7 @@ from pianobot.cli.options import (
     HtmlReport,
     Reading,
     both_hands,
+    check_files,
     check_html,
     reads,
 )
@@ -56,6 +57,10 @@ def score(
         raise PianobotError(f"--plot {plot}: the plot is a PNG image, name the file *.png")
     to_stdout = json_path is not None and str(json_path) == "-"
     check_html(html)
+    check_files(
+        {"the performance": played, "the reference": reference, "the fingering file": reading.options.fingering},
+        {"--json": json_path, "--plot": plot, "--html": html},
+    )
     for target in (None if to_stdout else json_path, plot, html):
         if target is not None:
             check_writable(target)
