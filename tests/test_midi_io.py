@@ -5,7 +5,7 @@ import pytest
 from conftest import lyric, midi_file, off, on
 
 from pianobot.errors import PianobotError, PianobotWarning
-from pianobot.music.midi_io import parse_finger_text, read_midi, write_midi
+from pianobot.music.midi_io import describe_tracks, parse_finger_text, read_midi, write_midi
 from pianobot.music.piece import Note, Piece
 
 
@@ -347,3 +347,21 @@ def test_a_one_track_files_name_is_its_title_not_a_hand(tmp_path):
     assert read_midi(write_midi(piece, tmp_path / "left.mid", name="left fingered by pianobot")) == piece
     only_right = piece.with_hands("right")  # one hand's notes with their hand: a type 1 file
     assert read_midi(write_midi(only_right, tmp_path / "right.mid")) == only_right
+
+
+def test_drums_on_channel_10_are_left_out_in_one_line(tmp_path):
+    """General MIDI's percussion (channel 10) was read as piano notes: a kick drum became a left hand."""
+    melody = [(i * 480, on(72 + i)) for i in range(4)] + [(i * 480 + 400, off(72 + i)) for i in range(4)]
+    kit = [(i * 240, on(36 if i % 2 == 0 else 42, 100, channel=9)) for i in range(8)]
+    kit += [(i * 240 + 100, off(36 if i % 2 == 0 else 42, channel=9)) for i in range(8)]
+    path = midi_file(tmp_path / "band.mid", [("Melody", melody), ("Drums", kit)])
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        piece = read_midi(path)
+    assert sorted(n.pitch for n in piece.notes) == [72, 73, 74, 75]
+    said = [str(w.message) for w in caught if "drum" in str(w.message)]
+    assert said == [
+        "band.mid: left out 8 drum note(s) on MIDI channel 10 (General MIDI's percussion): they are no piano keys"
+    ]
+    drums = next(t for t in describe_tracks(path) if t.name == "Drums")
+    assert drums.notes == 0 and drums.channels == ()  # (inspect lists the track with no piano notes)

@@ -191,11 +191,16 @@ class _TempoMap:
         return seconds + mido.tick2second(tick - tick0, self.tpb, tempo)
 
 
+PERCUSSION = 9
+"""MIDI channel 10 (9 counted from 0): General MIDI's drums, whose notes are no piano keys."""
+
+
 def list_tracks(midi: mido.MidiFile) -> list[TrackInfo]:
+    """Each track's name and notes (the drums' on channel 10 left out, as the reading leaves them)."""
     infos = []
     for i, track in enumerate(midi.tracks):
         name = _text(next((m.name for m in track if m.type == "track_name"), ""))
-        ons = [m for m in track if m.type == "note_on" and m.velocity > 0]
+        ons = [m for m in track if m.type == "note_on" and m.velocity > 0 and m.channel != PERCUSSION]
         pedal = sum(1 for m in track if m.type == "control_change" and m.control == 64 and m.value >= 64)
         pitches = [m.note for m in ons]
         infos.append(
@@ -271,6 +276,8 @@ def _track_notes(
             fingers = parse_finger_text(msg.text)
             if fingers is not None:
                 fingering[tick].extend(fingers)
+        elif msg.type in ("note_on", "note_off") and msg.channel == PERCUSSION:
+            continue  # (drums: read_midi says how many it left out)
         elif msg.type == "note_on" and msg.velocity > 0:
             open_notes[(msg.channel, msg.note)].append((tick, msg.velocity))
         elif msg.type in ("note_off", "note_on"):
@@ -321,9 +328,21 @@ def read_midi(
         snap = lambda tick: round(tick / step) * step  # noqa: E731
     notes: list[Note] = []
     names = [info.name if midi.type == 1 else "" for info in list_tracks(midi)]  # type 0: a title
-    for index, raw, fingering in _parts(
-        midi, tracks if tracks is not None else _select_tracks(midi, track, path), seconds, path
-    ):
+    chosen = tracks if tracks is not None else _select_tracks(midi, track, path)
+    drums = sum(
+        1
+        for index in chosen
+        for m in midi.tracks[index]
+        if m.type == "note_on" and m.velocity > 0 and m.channel == PERCUSSION
+    )
+    if drums:
+        warnings.warn(
+            PianobotWarning(
+                f"{path.name}: left out {drums} drum note(s) on MIDI channel 10 (General MIDI's percussion): "
+                "they are no piano keys"
+            )
+        )
+    for index, raw, fingering in _parts(midi, chosen, seconds, path):
         hand = track_hand(names[index]) if index is not None else None
         index = 0 if index is None else index  # (several tracks read as one: messages say track 0, as before)
         if grid is not None:

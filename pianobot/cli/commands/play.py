@@ -137,7 +137,14 @@ def play(
     report_path = output.with_suffix(".report.json")
     check_files(
         {"the input": song, "the fingering file": reading.options.fingering},
-        {"-o": output, "the report beside -o": report_path, "--json": json_path, "--html": html, "--wav": wav, "--video": video},
+        {
+            "-o": output,
+            "the report beside -o": report_path,
+            "--json": json_path,
+            "--html": html,
+            "--wav": wav,
+            "--video": video,
+        },
     )
     to_stdout = json_path is not None and str(json_path) == "-"
     console = err if to_stdout else out  # standard output carries the JSON
