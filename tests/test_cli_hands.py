@@ -417,3 +417,19 @@ def test_a_one_hand_file_with_chords_is_fingered_once(tmp_path, monkeypatch):
     result = run("inspect", song)
     assert result.exit_code == 0, result.output
     assert "playable" in result.stdout and len(calls) == 1, (calls, result.output)
+
+
+def test_a_two_hand_files_own_fingering_is_said_to_be_replaced_by_the_planners(tmp_path):
+    """Both hands are fingered by the planner (the robot's fingers, the hands kept apart): a file's own
+    fingering was dropped without a word; now it is said once, with how to play one hand as fingered."""
+    from conftest import lyric
+
+    right = RIGHT + [(round(beat * 480), lyric("3")) for beat in range(4)]
+    song = _duet(tmp_path / "fingered.mid", right=right)
+    quiet = run("play", song, "-o", tmp_path / "out.mid", "--controller", "scripted", "--quiet")
+    assert quiet.exit_code == 0, quiet.output
+    said = " ".join(quiet.stderr.split())
+    assert said.count("fingering (4 of 6 notes) is not used with both hands") == 1, said
+    assert "--hand right or --hand left" in said
+    plain = run("play", _duet(tmp_path / "plain.mid"), "-o", tmp_path / "p.mid", "--controller", "scripted", "-q")
+    assert "is not used with both hands" not in plain.stderr

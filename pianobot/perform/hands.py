@@ -395,6 +395,15 @@ def prepare_parts(
     warned (each said once more here). ``together``: both parts on one timeline, from the
     piece's first note (else each from its own); ``grow``: as :func:`prepare_part`'s."""
     offset = piece.notes[0].onset if together else None
+    fingered = sum(n.finger is not None for n in piece.notes)
+    if fingered:
+        warnings.warn(
+            PianobotWarning(
+                f"the piece's fingering ({fingered} of {len(piece)} notes) is not used with both hands: the fingering "
+                "planner fingers each hand's part for the robot's fingers, the hands kept apart (play one hand as "
+                "fingered with load.hand right or load.hand left)"
+            )
+        )
     parts = {}
     for name in (h for h in HANDS if h in piece.hands):
         with warnings.catch_warnings(record=True) as caught:
