@@ -65,7 +65,7 @@ def test_a_file_with_tracks_named_for_hands_plays_both_hands_one_track_each(tmp_
     near = lambda hz: spectrum[np.abs(frequencies - hz) < 2].max()  # noqa: E731
     assert near(130.8) > 5 * near(110.0)  # C3 against A2, which nobody played (right hand alone: 0.6)
     text = " ".join(result.stdout.split())
-    assert "both hands in one simulation" in text and "against the piece as written" in text
+    assert "both hands in one simulation" in text and "against the piece as read from the file" in text
     assert "right hand: 4 notes, C5-F5, named by its track" in text
     assert "left hand: 2 notes, C3-G3, named by its track" in text
     assert "whole piece" in text and "mirrored about D" in text  # the first screen's table of hands
@@ -433,3 +433,16 @@ def test_a_two_hand_files_own_fingering_is_said_to_be_replaced_by_the_planners(t
     assert "--hand right or --hand left" in said
     plain = run("play", _duet(tmp_path / "plain.mid"), "-o", tmp_path / "p.mid", "--controller", "scripted", "-q")
     assert "is not used with both hands" not in plain.stderr
+
+
+def test_finger_says_when_the_fingered_file_holds_fewer_notes_than_the_piece(tmp_path):
+    left = _track((36, 0, 2), (48, 0, 2), (43, 2, 4))  # a chord wider than the left hand reaches: one note goes
+    song = _duet(tmp_path / "wide.mid", left=left)
+    result = run("finger", song, "-o", tmp_path / "fingered.mid")
+    assert result.exit_code == 0, result.output
+    assert "(one track per hand; 6 of 7 notes, the others reduced away: the warnings say why)" in " ".join(
+        result.output.split()
+    )
+    assert len(read_midi(tmp_path / "fingered.mid").notes) == 6
+    whole = run("finger", _duet(tmp_path / "plain.mid"), "-o", tmp_path / "plain-fingered.mid")
+    assert "reduced away" not in whole.output

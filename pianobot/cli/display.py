@@ -133,7 +133,7 @@ def _figures(report: Report) -> list[str]:
 def hands_table(performance) -> Table:
     """A two-hand performance (:class:`~pianobot.perform.hands.HandsPerformance`): the whole piece
     and each hand, who played it and where, and its first figures."""
-    table = Table(title=f"both hands, {performance.simulated}")
+    table = Table(title=performance.simulated)
     columns = ("part", "played by", "played as", "notes given", "notes played", "note F1", "key-press F1 per step")
     for column in columns:
         table.add_column(column, justify="right" if column in ("note F1", "key-press F1 per step") else "left")

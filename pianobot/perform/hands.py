@@ -55,7 +55,9 @@ APART = "each hand in a simulation of its own"
 """How both hands play with ``together=False``: said wherever such a performance is reported."""
 TOGETHER = "both hands in one simulation"
 """How both hands play by default (:class:`~pianobot.env.hands.HandsEnv`)."""
-AGAINST = "figures against the piece as written (notes left out or reduced count as missed)"
+AGAINST = "figures against the piece as read from the file (notes left out or reduced for a hand count as missed)"
+"""What the figures of both hands are against: the file's notes, but for a chord of more notes than both
+hands have fingers, thinned as the file is read (said in its own line)."""
 """What a two-hand performance's figures are measured against."""
 
 

@@ -51,7 +51,13 @@ def finger(
             out.print(f"{hand} hand, fingers {hand_spec.describe()}: {travel} over {count} notes", soft_wrap=True)
             for problem in plan.problems if plan else ():
                 out.print(f"[yellow]cannot be played at this tempo:[/yellow] {said(phrase(problem))}")
-        out.print(f"fingering for both hands written to {said(output)} (one track per hand)")
+        kept = len(fingered.piece)
+        less = (
+            f"; {kept} of {len(hands.piece)} notes, the others reduced away: the warnings say why"
+            if kept < len(hands.piece)
+            else ""
+        )
+        out.print(f"fingering for both hands written to {said(output)} (one track per hand{less})", soft_wrap=True)
         return
     piece = load_for_hand(song, reading.options, keyboard, hand_spec)
     piece, plan = ensure_fingering(piece, keyboard, hand_spec, refinger=True)
