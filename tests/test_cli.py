@@ -68,7 +68,12 @@ def test_inspect_shows_the_phrase_split_play_uses_and_which_phrases_are_trained(
 
 def test_inspect_with_transpose_tempo_and_keyboard_options(tmp_path):
     low = write_midi(Piece((Note(0, 48, 1, 80, 2), Note(1, 50, 2, 80, 3)), bpm=60), tmp_path / "low.mid")
-    assert_one_line_error(run("inspect", low), "--transpose 12")
+    own = run("inspect", low)  # no keys named: the piece's own octaves, said in one line
+    assert own.exit_code == 0 and "lie off the default keys C4-B5 (24 keys): played on C3-B4 (24 keys)" in " ".join(
+        own.output.split()
+    )
+    assert "playable on C3-B4" in own.stdout
+    assert_one_line_error(run("inspect", low, "--lowest-note", "C5"), "--transpose 24")  # keys named: as named
     assert run("inspect", low, "--transpose", "12").exit_code == 0
     assert run("inspect", low, "--lowest-note", "C3").exit_code == 0
     slow = run("inspect", low, "--lowest-note", "C3", "--tempo", "30")
@@ -100,7 +105,11 @@ def test_track_option(tmp_path):
     text = " ".join(both.stdout.split())
     assert "right hand: 1 note, C4-C4" in text and "left hand: 1 note, C3-C3" in text, text
     assert run("inspect", tmp_path / "two.mid", "--track", "one").exit_code == 0
-    assert_one_line_error(run("inspect", tmp_path / "two.mid", "--track", "two"), "outside the keyboard", "C3")
+    two = run("inspect", tmp_path / "two.mid", "--track", "two")  # C3 alone: on its own octaves
+    assert two.exit_code == 0 and "played on C3-B4" in " ".join(two.output.split())
+    assert_one_line_error(
+        run("inspect", tmp_path / "two.mid", "--track", "two", "--keys", "12"), "outside the keyboard", "C3"
+    )
     assert_one_line_error(run("inspect", tmp_path / "two.mid", "--track", "9"), "no track '9'")
 
 

@@ -355,12 +355,15 @@ def test_the_parts_policy_plays_through_the_hold_guard_unless_told(tmp_path):
 
 
 def test_one_hand_of_a_part_wider_than_the_keyboard_names_the_keyboard_that_fits(tmp_path):
-    """--hand right of a part wider than the keyboard: the error says which keyboard plays it (not
+    """--hand right of a part wider than the keyboard: with no keys named it plays on the part's own
+    octaves, said in one line; with too few keys named, the error says which keyboard plays it (not
     to take one hand, which was asked already), and that keyboard does."""
     song = _duet(tmp_path / "wide.mid", right=_track((67, 0, 1), (99, 1, 2)))  # G4 and D#7
     out = tmp_path / "out.mid"
+    own = run("play", song, "--hand", "right", "-o", out, "--controller", "scripted")
+    assert own.exit_code == 0 and "played on C4-B7 (48 keys)" in " ".join(own.output.split()), own.output
     line = assert_one_line_error(
-        run("play", song, "--hand", "right", "-o", out, "--controller", "scripted"),
+        run("play", song, "--hand", "right", "--keys", "30", "-o", out, "--controller", "scripted"),
         "the right hand's part spans G4-D#7",
         "--lowest-note C4 --keys 48",
     )
@@ -372,10 +375,14 @@ def test_one_hand_of_a_part_wider_than_the_keyboard_names_the_keyboard_that_fits
 
 
 def test_a_melody_that_only_needs_transposing_stays_one_hands(tmp_path):
-    """One line of notes above the keyboard is one hand's: the error says which --transpose plays
-    it, rather than sharing the notes between two hands."""
+    """One line of notes above the default keys is one hand's, played on its own octaves (said in
+    one line), rather than shared between two hands; with keys named, the error says which
+    --transpose plays it."""
     song = _one_track(tmp_path / "high.mid", *((p, i, i + 1) for i, p in enumerate((72, 76, 79, 84, 88, 91, 95))))
-    line = assert_one_line_error(run("inspect", song), "outside the keyboard C4-B5", "--transpose -12")
+    own = run("inspect", song)
+    text = " ".join(own.output.split())
+    assert own.exit_code == 0 and "played on C5-B6 (24 keys)" in text and "right hand" not in text, text
+    line = assert_one_line_error(run("inspect", song, "--keys", "25"), "outside the keyboard C4-C6", "--transpose -12")
     assert "hand" not in line.split("outside")[0]
     assert run("inspect", song, "--transpose", "-12").exit_code == 0
 

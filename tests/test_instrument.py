@@ -72,3 +72,18 @@ def test_the_keyboard_a_piece_needs_is_its_range_rounded_out_to_octaves():
     assert (keyboard_for(piece).lowest, keyboard_for(piece).highest) == (48, 83)  # C3-B5
     wide = Piece((Note(0, 21, 1), Note(0, 108, 1)))  # the whole piano: its 88 keys, not C0-B8
     assert keyboard_for(wide) == PIANO
+
+
+def test_a_one_hand_piece_off_the_default_keys_gets_its_own_octaves_of_at_least_as_many_keys():
+    from pianobot.music.instrument import keys_for
+
+    def piece(*pitches):
+        return Piece(tuple(Note(i, p, i + 1) for i, p in enumerate(pitches)))
+
+    assert keys_for(piece(60, 83)) == KeyboardSpec()  # on C4-B5: the default
+    assert keys_for(piece(84, 91)) == KeyboardSpec(84, 24)  # C6-G6: C6-B7
+    assert keys_for(piece(48, 55)) == KeyboardSpec(48, 24)  # C3-G3: C3-B4
+    assert keys_for(piece(36, 91)) == KeyboardSpec(36, 60)  # wider: whole octaves C2-B6
+    assert keys_for(piece(103, 108)) == KeyboardSpec(85, 24)  # at the top: 24 keys ending at C8
+    assert keys_for(piece(12, 60)) == KeyboardSpec()  # a note beyond the piano: left for the reading to refuse
+    assert keys_for(piece(48), KeyboardSpec(60, 36)) == KeyboardSpec(48, 36)  # as many keys as the default asked

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import functools
 import inspect
 import os
@@ -125,6 +126,9 @@ class Reading:
     options: LoadOptions
     keyboard: KeyboardSpec
     hand: HandSpec
+    keyboard_named: bool = False
+    """Whether --lowest-note or --keys names other keys than the defaults (else :func:`fit_keyboard`
+    may choose the keys)."""
 
 
 def make_reading(**given) -> Reading:
@@ -144,6 +148,7 @@ def make_reading(**given) -> Reading:
         ),
         keyboard=KeyboardSpec(lowest=parse_pitch(values["lowest_note"]), count=values["keys"]),
         hand=HandSpec(fingers=(1,) + HandSpec.fingers if values["thumb"] else HandSpec.fingers),
+        keyboard_named=any(values[name] != READING[name][1].default for name in ("lowest_note", "keys")),
     )
 
 
@@ -203,6 +208,32 @@ def check_html(path: Path | None) -> None:
     """--html must name an .html file."""
     if path is not None and path.suffix.lower() not in (".html", ".htm"):
         raise PianobotError(f"--html {path}: the report is a web page, name it *.html")
+
+
+def fit_keyboard(song: Path, reading: Reading) -> Reading:
+    """``reading`` with the keys a one-hand piece needs where none were named (--lowest-note,
+    --keys): the default keys where its notes lie on them, else its own octaves
+    (:func:`~pianobot.music.instrument.keys_for`), said in one line."""
+    from pianobot.music.instrument import keys_for
+    from pianobot.music.load import load_part
+
+    if reading.keyboard_named:
+        return reading
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", PianobotWarning)  # (said when the piece is read for playing)
+        piece = load_part(song, reading.options, reading.hand)
+    keys = keys_for(piece, reading.keyboard)
+    if keys == reading.keyboard:
+        return reading
+    low, high = min(n.pitch for n in piece.notes), max(n.pitch for n in piece.notes)
+    warnings.warn(
+        PianobotWarning(
+            f"{song.name}: its notes ({pitch_name(low)}-{pitch_name(high)}) lie off the default keys "
+            f"{reading.keyboard.describe()}: played on {keys.describe()}, the piece's own octaves "
+            "(--lowest-note and --keys name other keys)"
+        )
+    )
+    return dataclasses.replace(reading, keyboard=keys)
 
 
 def read_song(song: Path, options: LoadOptions, keyboard: KeyboardSpec, hand: HandSpec) -> Piece:

@@ -73,6 +73,22 @@ def keyboard_for(piece: Piece) -> KeyboardSpec:
     return KeyboardSpec(low, high - low + 1)
 
 
+def keys_for(piece: Piece, default: KeyboardSpec = KeyboardSpec()) -> KeyboardSpec:
+    """The keys a one-hand piece is played on where none are named: ``default`` where every note
+    lies on it (or where a note lies beyond the piano's 88 keys, for the reading to refuse), else
+    the piece's own octaves (:func:`keyboard_for`), at least as many keys as ``default`` (a general
+    policy plays any keyboard of at least its own keys), within the piano."""
+    pitches = [n.pitch for n in piece.notes]
+    if not pitches or all(p in default for p in pitches) or not all(p in PIANO for p in pitches):
+        return default
+    own = keyboard_for(piece)
+    low, high = max(own.lowest, PIANO.lowest), min(own.highest, PIANO.highest)
+    if high - low + 1 < default.count:  # (grow up, then down, within the piano)
+        high = min(low + default.count - 1, PIANO.highest)
+        low = max(high - default.count + 1, PIANO.lowest)
+    return KeyboardSpec(low, high - low + 1)
+
+
 @dataclass(frozen=True)
 class HandSpec:
     """Which fingers the robot hand plays with, in pianists' numbering (1 thumb ... 5 little)."""

@@ -13,6 +13,7 @@ from pianobot.cli.options import (
     both_hands,
     check_files,
     check_midi_output,
+    fit_keyboard,
     reads,
 )
 from pianobot.cli.terminal import out, said
@@ -59,6 +60,7 @@ def finger(
         )
         out.print(f"fingering for both hands written to {said(output)} (one track per hand{less})", soft_wrap=True)
         return
+    keyboard = fit_keyboard(song, reading).keyboard
     piece = load_for_hand(song, reading.options, keyboard, hand_spec)
     piece, plan = ensure_fingering(piece, keyboard, hand_spec, refinger=True)
     write_midi(piece, output, name=f"{song.stem} fingered by pianobot")

@@ -15,6 +15,7 @@ from pianobot.cli.options import (
     Reading,
     both_hands,
     check_files,
+    fit_keyboard,
     reads,
 )
 from pianobot.cli.terminal import err, out, said, write_json
@@ -80,6 +81,7 @@ def inspect(
         return
     if len([t for t in tracks if t.notes]) > 1 and options.track is None and options.hand is None:
         console.print("[yellow]several tracks are merged; play one part with --track N or --hand right|left[/yellow]")
+    keyboard = fit_keyboard(song, reading).keyboard
     piece = load_for_hand(song, options, keyboard, hand_spec)
     line, data = _summary(piece, tempi)
     console.print(line)

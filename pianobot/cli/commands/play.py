@@ -22,6 +22,7 @@ from pianobot.cli.options import (
     check_files,
     check_html,
     check_midi_output,
+    fit_keyboard,
     read_song,
     reads,
 )
@@ -215,6 +216,7 @@ def play(
             shown=dict(console=console, notes=notes, every=every, quiet=quiet),
         )
         return
+    reading = fit_keyboard(song, reading)
     piece = read_song(song, reading.options, reading.keyboard, reading.hand)
     plan = plan_performance(
         piece,

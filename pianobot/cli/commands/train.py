@@ -23,6 +23,7 @@ from pianobot.cli.options import (
     Reward,
     Task,
     both_hands,
+    fit_keyboard,
     option,
     read_song,
     reads,
@@ -209,6 +210,9 @@ def train(
     console = err if json_path is not None and str(json_path) == "-" else out  # standard output carries the JSON
     if models.exists() and not models.is_dir():
         raise PianobotError(f"--models {models} is a file: give a folder")
+    hands = both_hands(song, reading) if song is not None else None
+    if song is not None and hands is None:  # (a one-hand piece off the default keys: its own octaves, as play does)
+        reading = fit_keyboard(song, reading)
     keyboard, hand = reading.keyboard, reading.hand
     with option("--control", control):
         world = WorldConfig(keyboard=KeyboardConfig(spec=keyboard), hand=HandConfig(spec=hand), control=control.value)
@@ -255,7 +259,6 @@ def train(
     # where the run begins, before its folders are named: a run from a policy takes its networks
     base = config
     config, start = general_start(config, models, general_policy, networks_given=actor is not None)
-    hands = both_hands(song, reading) if song is not None else None
     groups = []  # (hand or None, its config, the policy its phrases start from, its jobs)
     if task is not None:
         job = task_job(task.value, config, models)
