@@ -6,6 +6,7 @@ import shutil
 from pathlib import Path
 
 import pytest
+from conftest import run
 
 import pianobot
 from pianobot.agent import store
@@ -139,3 +140,13 @@ def test_the_library_names_settings_and_the_command_line_their_options(tmp_path)
     assert unreadable.value.field == "jobs.force" and phrase(unreadable.value).endswith(
         "retrain the phrase with --force"
     )
+
+
+def test_a_phrase_nobody_plays_with_the_general_policy_left_out_says_so(tmp_path):
+    """--no-general's refusal read as if no general policy had been found."""
+    piece = pianobot.load_piece(EXAMPLES / "mary.mid")
+    with pytest.raises(PianobotError, match=r"the general policy is left out \(play.general\)") as e:
+        plan_performance(piece, models=tmp_path, general=False)
+    assert "no general policy plays it" not in str(e.value)
+    result = run("play", EXAMPLES / "mary.mid", "-o", tmp_path / "out.mid", "--no-general", "--models", tmp_path)
+    assert "left out (--no-general)" in " ".join(result.stderr.split())

@@ -31,6 +31,7 @@ FLAGS = {
     "store.models": "--models",
     "general.path": "--general-policy",
     "play.controller": "--controller",
+    "play.general": "--no-general",
     "play.fallback": "--fallback",
     "train.env.tactile": "--tactile/--no-tactile",
     "train.env.actuated": "--joints",

@@ -214,21 +214,26 @@ def assign(
     models: Path,
     general: Path | None = None,
     fallback: bool = False,
-    passed_over: Callable[[], str] = lambda: "",
+    passed_over: Callable[[], str] | None = lambda: "",
 ) -> tuple[Stretch, ...]:
     """Who plays each phrase (the module's rule), as stretches in order. A phrase nobody can play
     is a :class:`PianobotError` naming it, where the store is, why the packaged general policy
-    does not play it (``passed_over()``, asked only then: :func:`passed_over`) and how to go on."""
+    does not play it (``passed_over()``, asked only then: :func:`passed_over`; None: the general
+    policy was left out) and how to go on."""
     index = store.general_plays(models)
     own = {p.index: f for p in phrases if (f := find_policy(models, p)) is not None and f.name not in index}
     for phrase in phrases:
         if phrase.index not in own and general is None and not fallback:
             notes = " ".join(n.name for n in phrase.notes)
             where = str(models) if Path(str(models)).is_absolute() else f"{models} ({Path(models).resolve()})"
-            why = f"looked there and in {PACKAGED}" + (f"; {reason}" if (reason := passed_over()) else "")
+            if passed_over is None:
+                general_said = "and the general policy is left out (play.general)"
+            else:
+                why = f"looked there and in {PACKAGED}" + (f"; {reason}" if (reason := passed_over()) else "")
+                general_said = f"and no general policy plays it ({why})"
             raise SettingError(
                 f"phrase {phrase.index} ({notes}) has no policy of its own in the model store {where} "
-                f"and no general policy plays it ({why}): "
+                f"{general_said}: "
                 "train it with `pianobot train` (same reading options), train a general policy with "
                 "`pianobot train --task parts`, name another store with store.models DIR, add play.fallback scripted, "
                 "or play with play.controller scripted",
@@ -364,9 +369,7 @@ def plan_performance(
     phrases = trained_split(models, piece, phrase_notes)
     env = _own_environment(models, phrases)
     folder = _general_for(models, env, keyboard, hand, general_policy) if general else None
-    stretches = assign(
-        phrases, models, folder, fallback, (lambda: passed_over(keyboard, hand)) if general else lambda: ""
-    )
+    stretches = assign(phrases, models, folder, fallback, (lambda: passed_over(keyboard, hand)) if general else None)
     if env is None and folder is not None:
         env = on_keyboard(*policy_configs(folder), keyboard)
     if env is None:  # the scripted pianist plays every phrase
