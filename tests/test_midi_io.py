@@ -365,3 +365,17 @@ def test_drums_on_channel_10_are_left_out_in_one_line(tmp_path):
     ]
     drums = next(t for t in describe_tracks(path) if t.name == "Drums")
     assert drums.notes == 0 and drums.channels == ()  # (inspect lists the track with no piano notes)
+
+
+def test_of_two_tempos_at_one_tick_the_later_holds_for_the_timing_and_for_what_inspect_says(tmp_path):
+    """At one tick the file's later set_tempo holds; the reading sorted them by value instead, and
+    inspect named the other one."""
+    from pianobot.music.midi_io import tempi
+
+    notes = [(0, on(60)), (480, off(60)), (480, on(62)), (960, off(62))]
+    path = midi_file(tmp_path / "two-tempos.mid", [("Piano", notes)], tempo_events=((0, 600_000), (0, 750_000)))
+    piece = read_midi(path)
+    assert piece.bpm == 80 and piece.notes[1].onset == 0.75  # 750000 us a beat: 80 bpm
+    assert tempi(path) == [80.0]
+    other = midi_file(tmp_path / "other.mid", [("Piano", notes)], tempo_events=((0, 750_000), (0, 600_000)))
+    assert read_midi(other).bpm == 100 and tempi(other) == [100.0]

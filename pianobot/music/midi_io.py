@@ -162,6 +162,13 @@ def _absolute(track: mido.MidiTrack) -> list[tuple[int, mido.Message]]:
     return sorted(out, key=order)
 
 
+def _tempo_changes(midi: mido.MidiFile) -> list[tuple[int, int]]:
+    """(tick, tempo) of every set_tempo event, in time order; events at one tick in the file's order,
+    so that the last of them holds from there."""
+    found = [(t, m.tempo) for track in midi.tracks for t, m in _absolute(track) if m.type == "set_tempo"]
+    return sorted(found, key=lambda change: change[0])
+
+
 class _TempoMap:
     """Ticks to seconds through a file's set_tempo events (default 120 bpm).
 
@@ -169,7 +176,7 @@ class _TempoMap:
     """
 
     def __init__(self, midi: mido.MidiFile, path: Path):
-        changes = sorted((t, m.tempo) for track in midi.tracks for t, m in _absolute(track) if m.type == "set_tempo")
+        changes = _tempo_changes(midi)
         self.tpb = midi.ticks_per_beat
         self.points: list[tuple[int, float, int]] = [(0, 0.0, 500_000)]  # (tick, seconds at tick, tempo from there)
         for change_tick, new_tempo in changes:
@@ -184,7 +191,8 @@ class _TempoMap:
                 (change_tick, seconds + mido.tick2second(change_tick - tick, self.tpb, tempo), new_tempo)
             )
         self.ticks = [point[0] for point in self.points]
-        self.first_tempo = changes[0][1] if changes and changes[0][0] == 0 else 500_000
+        at_start = [tempo for tick, tempo in changes if tick == 0]
+        self.first_tempo = at_start[-1] if at_start else 500_000  # (of several at once, the last holds)
 
     def seconds(self, tick: int) -> float:
         tick0, seconds, tempo = self.points[bisect.bisect_right(self.ticks, tick) - 1]
@@ -508,7 +516,10 @@ def tempi(path: str | Path) -> list[float]:
     """The tempos of a MIDI file in beats per minute, in the order they take effect (120 until its
     first set_tempo, where that is after the start), each change to another tempo once."""
     midi = _load(Path(path))
-    changes = sorted((t, m.tempo) for track in midi.tracks for t, m in _absolute(track) if m.type == "set_tempo")
+    changes = _tempo_changes(midi)
+    changes = [
+        c for i, c in enumerate(changes) if i + 1 == len(changes) or changes[i + 1][0] != c[0]
+    ]  # (the last at a tick)
     found = [] if changes and changes[0][0] == 0 else [120.0]
     for _, tempo in changes:
         bpm = round(mido.tempo2bpm(tempo), 3) if tempo > 0 else 0.0
