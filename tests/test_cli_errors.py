@@ -113,3 +113,17 @@ def test_no_output_option_writes_over_an_input_or_another_output(tmp_path):
     for args, *words in cases:
         assert_one_line_error(run(*args), *words)
     assert song.read_bytes() == before and not out.exists() and not list(tmp_path.glob("*.json"))
+
+
+def test_train_json_is_checked_like_the_others_and_a_hard_link_is_the_same_file(tmp_path):
+    import os
+    import shutil
+
+    song = tmp_path / "twinkle.mid"
+    shutil.copy(Path(__file__).parent.parent / "examples" / "midi" / "twinkle.mid", song)
+    before = song.read_bytes()
+    assert_one_line_error(run("train", song, "--json", song, "--models", tmp_path / "m"), "name it *.json")
+    linked = tmp_path / "linked.mid"
+    os.link(song, linked)  # (as another spelling of one file on a case-insensitive disk)
+    assert_one_line_error(run("finger", song, "-o", linked), "would overwrite the input")
+    assert song.read_bytes() == before and not (tmp_path / "m").exists()

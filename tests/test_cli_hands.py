@@ -383,6 +383,8 @@ def test_a_melody_that_only_needs_transposing_stays_one_hands(tmp_path):
     text = " ".join(own.output.split())
     assert own.exit_code == 0 and "played on C5-B6 (24 keys)" in text and "right hand" not in text, text
     line = assert_one_line_error(run("inspect", song, "--keys", "25"), "outside the keyboard C4-C6", "--transpose -12")
+    named = run("inspect", song, "--keys", "24")  # the default keys, named: as named
+    assert_one_line_error(named, "outside the keyboard C4-B5", "--transpose -12")
     assert "hand" not in line.split("outside")[0]
     assert run("inspect", song, "--transpose", "-12").exit_code == 0
 
@@ -453,3 +455,18 @@ def test_finger_says_when_the_fingered_file_holds_fewer_notes_than_the_piece(tmp
     assert len(read_midi(tmp_path / "fingered.mid").notes) == 6
     whole = run("finger", _duet(tmp_path / "plain.mid"), "-o", tmp_path / "plain-fingered.mid")
     assert "reduced away" not in whole.output
+
+
+def test_score_of_one_hands_part_off_the_default_keys_reduces_it_as_play_did(tmp_path):
+    """play --hand chose the part's own octaves and reduced it there; score reduced it on the default
+    keys (where nothing is reduced), so a note play had rightly left out counted as missed."""
+    right = _track((84, 0, 1), (91, 0, 1), (100, 0, 1), (86, 1, 2), (88, 2, 3))  # C6 G6 E7: wider than the hand
+    song = _duet(tmp_path / "high.mid", right=right)
+    out = tmp_path / "out.mid"
+    played = run("play", song, "--hand", "right", "-o", out, "--controller", "scripted")
+    assert played.exit_code == 0, played.output
+    report = json.loads(out.with_suffix(".report.json").read_text())
+    scored = run("score", out, song, "--hand", "right", "--json", tmp_path / "s.json")
+    assert scored.exit_code == 0, scored.output
+    again = json.loads((tmp_path / "s.json").read_text())
+    assert again["reference_notes"] == report["reference_notes"] == 4 and again["f1"] == report["f1"]

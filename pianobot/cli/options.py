@@ -112,8 +112,8 @@ READING = {  # parameter name: (type, option); the commands' --help shows them i
     "split": _reading(str, pitch_name(LoadOptions.split), "--split", "With --hand and no track named for it: lowest note of the right hand's part."),
     "quantize": _reading(Optional[str], None, "--quantize", "Move onsets and offsets to a grid, e.g. 1/16 (for recordings of human players)."),
     "refinger": _reading(bool, LoadOptions.refinger, "--refinger/--no-refinger", "Replace the file's fingering with the planner's (e.g. human fingering for five fingers)."),
-    "lowest_note": _reading(str, pitch_name(KeyboardSpec.lowest), "--lowest-note", "Lowest key of the keyboard (name like C4, or MIDI number).", INSTRUMENT),
-    "keys": _reading(int, KeyboardSpec.count, "--keys", "Number of keys on the keyboard.", INSTRUMENT),
+    "lowest_note": _reading(Optional[str], None, "--lowest-note", f"Lowest key of the keyboard (name like C4, or MIDI number); default {pitch_name(KeyboardSpec.lowest)}, or a piece's own octaves where its notes lie off the default keys.", INSTRUMENT),
+    "keys": _reading(Optional[int], None, "--keys", f"Number of keys on the keyboard; default {KeyboardSpec.count}, or as many as a piece's own octaves need.", INSTRUMENT),
     "thumb": _reading(bool, False, "--thumb/--no-thumb", "Let the hand use its thumb (finger 1) too.", INSTRUMENT),
 }
 # fmt: on
@@ -127,8 +127,8 @@ class Reading:
     keyboard: KeyboardSpec
     hand: HandSpec
     keyboard_named: bool = False
-    """Whether --lowest-note or --keys names other keys than the defaults (else :func:`fit_keyboard`
-    may choose the keys)."""
+    """Whether --lowest-note or --keys was given (else :func:`fit_keyboard` may choose the keys,
+    and both hands' parts go on their players' keys)."""
 
 
 def make_reading(**given) -> Reading:
@@ -146,9 +146,12 @@ def make_reading(**given) -> Reading:
             quantize=values["quantize"],
             refinger=values["refinger"],
         ),
-        keyboard=KeyboardSpec(lowest=parse_pitch(values["lowest_note"]), count=values["keys"]),
+        keyboard=KeyboardSpec(
+            lowest=KeyboardSpec.lowest if values["lowest_note"] is None else parse_pitch(values["lowest_note"]),
+            count=KeyboardSpec.count if values["keys"] is None else values["keys"],
+        ),
         hand=HandSpec(fingers=(1,) + HandSpec.fingers if values["thumb"] else HandSpec.fingers),
-        keyboard_named=any(values[name] != READING[name][1].default for name in ("lowest_note", "keys")),
+        keyboard_named=values["lowest_note"] is not None or values["keys"] is not None,
     )
 
 
@@ -199,9 +202,18 @@ def check_files(inputs: dict[str, Path | None], outputs: dict[str, Path | None])
         if path is None or str(path) == "-":
             continue
         where = os.path.realpath(path)  # (realpath: a symbolic-link loop is no crash)
-        if where in seen:
-            raise PianobotError(f"{option} {path} would overwrite {seen[where]}: choose another file name")
+        same = next((name for other, name in seen.items() if _same_file(where, other)), None)
+        if where in seen or same is not None:
+            raise PianobotError(f"{option} {path} would overwrite {seen.get(where, same)}: choose another file name")
         seen[where] = f"what {option} writes" if option.startswith("-") else option
+
+
+def _same_file(one: str, other: str) -> bool:
+    """Whether two existing paths are one file (another spelling on a case-insensitive disk, a hard link)."""
+    try:
+        return os.path.samefile(one, other)
+    except OSError:
+        return False
 
 
 def check_html(path: Path | None) -> None:
@@ -210,10 +222,10 @@ def check_html(path: Path | None) -> None:
         raise PianobotError(f"--html {path}: the report is a web page, name it *.html")
 
 
-def fit_keyboard(song: Path, reading: Reading) -> Reading:
+def fit_keyboard(song: Path, reading: Reading, quiet: bool = False) -> Reading:
     """``reading`` with the keys a one-hand piece needs where none were named (--lowest-note,
     --keys): the default keys where its notes lie on them, else its own octaves
-    (:func:`~pianobot.music.instrument.keys_for`), said in one line."""
+    (:func:`~pianobot.music.instrument.keys_for`), said in one line (not ``quiet``)."""
     from pianobot.music.instrument import keys_for
     from pianobot.music.load import load_part
 
@@ -223,8 +235,8 @@ def fit_keyboard(song: Path, reading: Reading) -> Reading:
         warnings.simplefilter("ignore", PianobotWarning)  # (said when the piece is read for playing)
         piece = load_part(song, reading.options, reading.hand)
     keys = keys_for(piece, reading.keyboard)
-    if keys == reading.keyboard:
-        return reading
+    if keys == reading.keyboard or quiet:
+        return dataclasses.replace(reading, keyboard=keys)
     low, high = min(n.pitch for n in piece.notes), max(n.pitch for n in piece.notes)
     warnings.warn(
         PianobotWarning(

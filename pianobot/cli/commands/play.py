@@ -200,7 +200,7 @@ def play(
             controller=controller.value,
             models=models,
             seed=seed,
-            keyboard=reading.keyboard,
+            keyboard=reading.keyboard if reading.keyboard_named else None,  # (none named: each player's own keys)
             hand=reading.hand,
             options=dict(
                 general=use_general,
@@ -289,7 +289,6 @@ def play_both(
 
     from pianobot.cli import display
     from pianobot.errors import PianobotWarning
-    from pianobot.music.instrument import KeyboardSpec
     from pianobot.music.midi_io import write_midi
     from pianobot.perform.audio import write_wav
     from pianobot.perform.hands import AGAINST, TOGETHER, play_hands
@@ -310,7 +309,7 @@ def play_both(
             models,
             seed,
             hand,
-            None if keyboard == KeyboardSpec() else keyboard,  # (the default: each player's own keys)
+            keyboard,
             on_step=on_step,
             video=files["video"] is not None,
             **options,

@@ -14,6 +14,7 @@ from pianobot.cli.options import (
     both_hands,
     check_files,
     check_html,
+    fit_keyboard,
     reads,
 )
 from pianobot.cli.terminal import err, out, said, write_json
@@ -69,8 +70,9 @@ def score(
     if hands is not None:
         reference_piece = hands.piece  # every note with its hand, as play scored it
     else:
+        keys = fit_keyboard(reference, reading, quiet=True).keyboard  # (the keys play chose: its reduction's)
         reference_piece = load_for_hand(
-            reference, reading.options, reading.keyboard, reading.hand, fit=False
+            reference, reading.options, keys, reading.hand, fit=False
         )  # with --hand, reduced as play reduces it
     played_piece = midi_io.read_midi(played)
     scores = compare_hands(reference_piece, played_piece, onset_tolerance=onset_tolerance)

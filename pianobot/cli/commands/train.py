@@ -23,6 +23,7 @@ from pianobot.cli.options import (
     Reward,
     Task,
     both_hands,
+    check_files,
     fit_keyboard,
     option,
     read_song,
@@ -205,6 +206,7 @@ def train(
                 f"--task trains one policy: --workers {workers} has nothing to share out (--envs steps several environments)"
             )
         )
+    check_files({"the input": song, "the fingering file": reading.options.fingering}, {"--json": json_path})
     if json_path is not None and str(json_path) != "-":
         check_writable(json_path)
     console = err if json_path is not None and str(json_path) == "-" else out  # standard output carries the JSON
@@ -277,7 +279,16 @@ def train(
         else:  # each hand's part as `play` gives it to its player, from the general policy play gives that hand
             piece = hands.piece
             parts, phrases, offered, groups = _hand_groups(
-                piece, song.name, models, base, general_policy, phrase_notes, keyboard, hand, actor is not None
+                piece,
+                song.name,
+                models,
+                base,
+                general_policy,
+                phrase_notes,
+                keyboard,
+                hand,
+                actor is not None,
+                reading.keyboard_named,
             )
             label = f"{song.name}: " + ", ".join(f"{len(p)} phrases of the {h} hand" for h, p in phrases.items())
         every_job = [job for *_, jobs in groups for job in jobs]
@@ -400,7 +411,16 @@ def train(
 
 
 def _hand_groups(
-    piece, name: str, models: Path, base, general_policy, phrase_notes, keyboard, hand, networks_given: bool
+    piece,
+    name: str,
+    models: Path,
+    base,
+    general_policy,
+    phrase_notes,
+    keyboard,
+    hand,
+    networks_given: bool,
+    keys_named: bool = False,
 ):
     """A two-hand piece's training, hand by hand: (each hand's part as ``play`` gives it to that hand
     (:func:`~pianobot.perform.hands.prepare_parts`), its phrases, the general policy ``play`` gives
@@ -410,11 +430,12 @@ def _hand_groups(
 
     from pianobot.agent.general import find_general
     from pianobot.learn.jobs import general_start, phrase_jobs
-    from pianobot.music.instrument import KeyboardSpec
     from pianobot.music.phrases import split_phrases
     from pianobot.perform.hands import hand_players, prepare_parts
 
-    parts = prepare_parts(piece, keyboard, hand, grow=keyboard == KeyboardSpec())  # (as play's default)
+    parts = prepare_parts(
+        piece, keyboard, hand, grow=not keys_named
+    )  # (as play's default: wider parts on their own octaves)
     named = {"general_policy": general_policy} if general_policy is not None else {}
     players = hand_players(parts, "sac", models, hand, named)
     phrases, offered, seen, groups = {}, {}, {}, []
