@@ -583,3 +583,16 @@ def test_inspect_says_when_the_file_changes_tempo(tmp_path):
     assert json.loads((tmp_path / "i.json").read_text())["tempi"] == [100.0, 120.0]
     steady = run("inspect", song, "--tempo", "90")
     assert "s at 90 bpm;" in " ".join(steady.stdout.split())
+
+
+def test_a_suggested_transposition_counts_the_one_already_given(tmp_path):
+    """After --transpose 12 the hint named the shift from the moved notes (-24), not the one to give (-12)."""
+    high = write_midi(Piece((Note(0, 84, 1, 80, 2), Note(1, 86, 2, 80, 3)), bpm=60), tmp_path / "high.mid")
+    for command in ("inspect", "finger"):
+        extra = ("-o", tmp_path / "f.mid") if command == "finger" else ()
+        assert_one_line_error(run(command, high, "--keys", "24", *extra), "use --transpose -12")
+        assert_one_line_error(run(command, high, "--keys", "24", "--transpose", "12", *extra), "use --transpose -12")
+    line = assert_one_line_error(
+        run("play", high, "--keys", "24", "--transpose", "12", "-o", tmp_path / "o.mid"), "use --transpose -12"
+    )
+    assert "-24" not in line

@@ -255,6 +255,7 @@ def read_song(song: Path, options: LoadOptions, keyboard: KeyboardSpec, hand: Ha
     from pianobot.pianist.reduce import load_for_hand
 
     piece = load_for_hand(song, options, keyboard, hand)  # with --hand, reduced to what the hand can play
+    check_playable(piece.without_fingering(), keyboard, hand, options.transpose)  # (its hint: the whole shift)
     piece, plan = ensure_fingering(piece, keyboard, hand, options.refinger)
     if plan is not None:
         why = "--refinger" if options.refinger else "it has notes without fingering"

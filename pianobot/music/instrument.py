@@ -122,12 +122,13 @@ def suggest_transpose(piece: Piece, keyboard: KeyboardSpec) -> int | None:
     return min(octaves or fits, key=abs)
 
 
-def check_playable(piece: Piece, keyboard: KeyboardSpec, hand: HandSpec) -> None:
+def check_playable(piece: Piece, keyboard: KeyboardSpec, hand: HandSpec, transposed: int = 0) -> None:
     """Raise a one-line :class:`PianobotError` if this hand cannot play ``piece`` on ``keyboard``.
 
     Checks: at least one note; every note on the keyboard; no more notes sounding at once than
     the hand has fingers; every finger number one the hand has; no finger holding two notes
-    at once.
+    at once. ``transposed``: the semitones the piece was already moved by (``load.transpose``),
+    which a suggested transposition adds to.
     """
     if not piece.notes:
         raise PianobotError("the piece has no notes: give a MIDI file with at least one note")
@@ -137,7 +138,7 @@ def check_playable(piece: Piece, keyboard: KeyboardSpec, hand: HandSpec) -> None
         shift = suggest_transpose(piece, keyboard)
         low, high = min(n.pitch for n in piece.notes), max(n.pitch for n in piece.notes)
         fix = (
-            f"use load.transpose {shift}"
+            f"use load.transpose {shift + transposed}"
             if shift is not None
             else f"the piece spans {pitch_name(low)}-{pitch_name(high)}, more than the keyboard: if it holds both "
             "hands' parts, play one with load.hand right (or load.hand left)"

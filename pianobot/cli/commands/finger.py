@@ -31,6 +31,7 @@ def finger(
     """Plan a fingering for the robot hand (least wrist travel within its reach) and write it to a MIDI file;
     for a two-hand file (as `play` reads it), each hand's, one track per hand."""
     from pianobot.cli import display
+    from pianobot.music.instrument import check_playable
     from pianobot.music.midi_io import write_midi
     from pianobot.music.phrases import split_phrases
     from pianobot.pianist.fingering import ensure_fingering
@@ -62,6 +63,7 @@ def finger(
         return
     keyboard = fit_keyboard(song, reading).keyboard
     piece = load_for_hand(song, reading.options, keyboard, hand_spec)
+    check_playable(piece.without_fingering(), keyboard, hand_spec, reading.options.transpose)  # (the whole shift)
     piece, plan = ensure_fingering(piece, keyboard, hand_spec, refinger=True)
     write_midi(piece, output, name=f"{song.stem} fingered by pianobot")
     out.print(display.notes_table(piece, split_phrases(piece, DEFAULT_MAX_NOTES), None if all_rows else display.ROWS))

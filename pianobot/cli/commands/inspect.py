@@ -85,6 +85,8 @@ def inspect(
     piece = load_for_hand(song, options, keyboard, hand_spec)
     line, data = _summary(piece, tempi)
     console.print(line)
+    # the keyboard and the chords, before the split (a transposition it suggests counts --transpose in)
+    check_playable(piece.without_fingering(), keyboard, hand_spec, options.transpose)
     piece, plan = ensure_fingering(piece, keyboard, hand_spec, options.refinger)
     if plan is not None:
         console.print(
@@ -92,7 +94,6 @@ def inspect(
         )
         for problem in plan.problems:
             console.print(f"[yellow]{said(phrase(problem))}[/yellow]")
-    check_playable(piece.without_fingering(), keyboard, hand_spec)  # the keyboard and the chords, before the split
     phrases = trained_split(models, piece, phrase_notes)
     rows = None if all_rows else display.ROWS
     console.print(display.notes_table(piece, phrases, rows))
