@@ -400,11 +400,15 @@ def finger_apart(
     gap = 2 * thumb_side_reach(HandConfig(spec=spec))
     fingered = {hand: part for hand, (_, part) in parts.items()}
     plans: dict[str, FingeringPlan | None] = dict.fromkeys(parts)
+    planners = {
+        hand: Planner(KeyboardConfig(spec=window.keyboard), HandConfig(spec=spec))
+        for hand, (window, _) in parts.items()
+    }
     for hand, other in (("left", "right"), ("right", "left"), ("left", "right")):
         if hand in fixed:
             continue
         window, part = parts[hand]
-        planner = Planner(KeyboardConfig(spec=window.keyboard), HandConfig(spec=spec))
+        planner = planners[hand]
         others = stands(parts[other][0], fingered[other])
         to_frame = _frame(window, part, planner)
         room = []
