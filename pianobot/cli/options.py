@@ -72,8 +72,8 @@ GeneralPolicy = typer.Option(
     "--general-policy",
     help="The general policy's folder (any trained policy; default: the newest `pianobot train --task melody` or `--task parts` "
     "policy in --models whose environment fits, else the packaged one). On a two-hand file it plays both hands "
-    "unless --left-policy names the left's (by default the left hand, and a right hand a tenth of whose notes sound "
-    "with another, have the packaged left hand's policy).",
+    "unless --left-policy names the left's (by default both hands of a two-hand file have the packaged left hand's "
+    "policy, a `--task parts` one, unless --models holds a general policy that fits).",
 )
 PlayPhraseNotes = typer.Option(
     None,

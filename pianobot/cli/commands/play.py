@@ -69,8 +69,8 @@ def play(
     use_general: bool = typer.Option(
         True,
         "--general/--no-general",
-        help="Play phrases without a policy of their own with the general policy (the newest `pianobot train --task "
-        "melody` policy in --models, or --general-policy), when there is one.",
+        help="Play phrases without a policy of their own with the general policy (--general-policy, else the newest "
+        "`pianobot train --task melody` or `--task parts` policy in --models, else the packaged one), when there is one.",
     ),
     general_policy: Optional[Path] = GeneralPolicy,
     left_policy: Optional[Path] = typer.Option(
