@@ -131,6 +131,25 @@ def test_what_a_hand_is_given_is_said_once_per_kind(tmp_path):
     assert "warning: the left hand's part has chords wider" in " ".join(quiet.stderr.split())
 
 
+def test_play_says_how_many_more_notes_the_thumbs_would_keep(tmp_path):
+    """A right-hand chord of four notes: three fingers keep three of them, the thumb the fourth;
+    play says so in one line, and --thumb plays them all."""
+    right = _track((72, 0, 2), (76, 0, 2), (79, 0, 2), (84, 0, 2), (81, 2, 4))
+    song = _duet(tmp_path / "four.mid", right=right)
+    result = run("play", song, "-o", tmp_path / "out.mid", "--controller", "scripted")
+    assert result.exit_code == 0, result.output
+    hints = [line for line in result.stdout.splitlines() if "--thumb" in line]
+    assert hints == [
+        "with --thumb the hands would be given 7 of the notes instead of 6: their thumbs keep notes three fingers leave out"
+    ]
+    thumbs = run("play", song, "-o", tmp_path / "thumbs.mid", "--controller", "scripted", "--thumb")
+    assert thumbs.exit_code == 0, thumbs.output
+    assert "would be given" not in thumbs.stdout
+    assert json.loads((tmp_path / "thumbs.report.json").read_text())["f1"] == 1.0
+    whole = _duet(tmp_path / "whole.mid")  # every note given: nothing to say
+    assert "--thumb" not in run("play", whole, "-o", tmp_path / "w.mid", "--controller", "scripted").stdout
+
+
 def test_what_both_hands_cannot_do_yet_is_one_line(tmp_path, monkeypatch):
     monkeypatch.setenv("DISPLAY", ":0")  # (as on a desktop: the two hands are what --gui refuses)
     song = _duet(tmp_path / "duet.mid")

@@ -354,6 +354,27 @@ def prepare_part(
     return window, fingered, start, left_out
 
 
+THUMB = HandSpec(fingers=(1,) + HandSpec.fingers)
+"""A hand with its thumb too (``--thumb``)."""
+
+
+def given_with_thumbs(
+    path: str | Path, options: LoadOptions, reading_keyboard: KeyboardSpec, keyboard: KeyboardSpec | None, grow: bool
+) -> int | None:
+    """How many of the file's notes both hands would be given with their thumbs too, read and
+    reduced as ``--thumb`` reads and reduces them (``reading_keyboard``: :func:`two_hands`'; the rest
+    :func:`prepare_part`'s); None where, with thumbs, one hand's reading plays the file. Nothing is said."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        try:
+            hands = two_hands(path, options, THUMB, reading_keyboard)
+            if hands is None:
+                return None
+            return sum(len(prepare_part(hands.piece, h, keyboard, THUMB, None, grow)[1]) for h in hands.piece.hands)
+        except PianobotError:
+            return None
+
+
 def play_hands(
     piece: Piece,
     controller: str = "sac",
