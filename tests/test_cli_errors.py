@@ -41,6 +41,34 @@ def test_a_value_outside_the_choices_is_typers_one_line_and_exit_2(args, option,
     assert "Usage" not in line
 
 
+@pytest.mark.parametrize(
+    "args, option",
+    [
+        (("play", SONG, "-o", "x.mid", "--seed", "-1"), "--seed"),
+        (("train", SONG, "--seed", "-1"), "--seed"),
+        (("play", SONG, "-o", "x.mid", "--phrase-notes", "0"), "--phrase-notes"),
+        (("inspect", SONG, "--phrase-notes", "0"), "--phrase-notes"),
+        (("train", SONG, "--phrase-notes", "0"), "--phrase-notes"),
+    ],
+)
+def test_a_number_below_its_least_is_one_line_and_exit_2(args, option, tmp_path, monkeypatch):
+    """A negative seed reached gymnasium's reset as a traceback; no phrase of 0 notes is played."""
+    monkeypatch.chdir(tmp_path)
+    assert_one_line_error(run(*args), f"'{option}'", "greater than or equal to")
+    assert not (tmp_path / "x.mid").exists()
+
+
+def test_a_pig_file_plays_one_hand_from_its_channel(tmp_path):
+    pig_file = tmp_path / "duet.txt"
+    pig_file.write_text("0 0.0 0.5 C5 80 80 0 3\n1 0.0 0.5 C3 80 80 1 -3\n2 0.5 1.0 D5 80 80 0 4\n")
+    for hand, pitches in (("right", [72, 74]), ("left", [48])):
+        result = run("play", pig_file, "-o", tmp_path / f"{hand}.mid", "--controller", "scripted", "--hand", hand)
+        assert result.exit_code == 0, result.output
+        assert [n.pitch for n in read_midi(tmp_path / f"{hand}.mid").notes] == pitches
+    quantized = run("play", pig_file, "-o", tmp_path / "q.mid", "--quantize", "1/16")
+    assert_one_line_error(quantized, "--quantize needs a MIDI file")
+
+
 def test_the_choices_come_from_the_library_and_show_in_help():
     assert [c.value for c in Controller] == list(CONTROLLERS) and [c.value for c in Learner] == list(LEARNERS)
     wide = {"COLUMNS": "250"}
@@ -71,9 +99,6 @@ def test_a_library_error_names_the_field_and_the_cli_names_the_option(tmp_path):
         run("finger", SONG, "-o", tmp_path / "f.mid", "--keys", "100"), "--keys 100: a keyboard has 1 to 88 keys"
     )
     assert_one_line_error(run("score", SONG, SONG, "--quantize", "1/0"), "--quantize 1/0: give a note value")
-    assert_one_line_error(
-        run("inspect", SONG, "--phrase-notes", "0"), "--phrase-notes 0: a phrase needs at least one note"
-    )
 
 
 def test_the_flag_table_phrases_every_field_and_nothing_else():

@@ -66,7 +66,9 @@ def value(choice: StrEnum | None) -> str | None:
 
 
 # -- shared options --------------------------------------------------------------------------
-PhraseNotes = typer.Option(DEFAULT_MAX_NOTES, "--phrase-notes", help="Most notes in one phrase (one policy each).")
+PhraseNotes = typer.Option(
+    DEFAULT_MAX_NOTES, "--phrase-notes", help="Most notes in one phrase (one policy each).", min=1
+)
 GeneralPolicy = typer.Option(
     None,
     "--general-policy",
@@ -79,6 +81,7 @@ PlayPhraseNotes = typer.Option(
     None,
     "--phrase-notes",
     help=f"Most notes in one phrase (default: the longest phrases, up to {DEFAULT_MAX_NOTES} notes, whose policies are all trained).",
+    min=1,
 )
 HtmlReport = typer.Option(
     None,

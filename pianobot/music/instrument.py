@@ -155,8 +155,8 @@ def check_playable(piece: Piece, keyboard: KeyboardSpec, hand: HandSpec, transpo
         sounding = [n.name for n in piece.notes if n.onset <= when < n.offset]
         raise SettingError(
             f"{polyphony} notes sound at once at {when:.3f} s ({', '.join(sounding)}) but the hand has "
-            f"{len(hand.fingers)} fingers: drop notes from that chord (e.g. with load.track) or enable the thumb with "
-            "hand.fingers",
+            f"{len(hand.fingers)} fingers: drop notes from that chord (e.g. with load.track)"
+            + (" or enable the thumb with hand.fingers" if 1 not in hand.fingers else ""),
             "hand.fingers",
             "load.track",
         )
@@ -164,8 +164,9 @@ def check_playable(piece: Piece, keyboard: KeyboardSpec, hand: HandSpec, transpo
         if note.finger is not None and note.finger not in hand.fingers:
             raise PianobotError(
                 f"{note.describe()} is fingered {note.finger} ({FINGER_NAMES[note.finger]}) but the hand "
-                f"plays with fingers {hand.describe()}: change that note's fingering"
-                + (" or enable the thumb with hand.fingers" if note.finger == 1 else "")
+                f"plays with fingers {hand.describe()}: change that note's fingering, or let the fingering planner "
+                "finger the piece with load.refinger"
+                + (", or enable the thumb with hand.fingers" if note.finger == 1 else "")
             )
     busy: dict[int, float] = {}
     for note in piece.notes:

@@ -144,9 +144,13 @@ def load_piece(path: str | Path, options: LoadOptions = LoadOptions()) -> Piece:
             )
         if options.fingering is not None:
             raise SettingError("a PIG file carries its own fingering: drop load.fingering", "load.fingering")
-        if options.hand is not None or options.quantize is not None:
-            raise SettingError("load.hand and load.quantize need a MIDI file", "load.hand", "load.quantize")
-        piece = pig.read_pig(path)
+        if options.quantize is not None:
+            raise SettingError(
+                "load.quantize needs a MIDI file: a PIG file's onsets are already in seconds", "load.quantize"
+            )
+        if options.hand is not None and options.hand not in HANDS:
+            raise SettingError(f"load.hand {quote(options.hand)}: choose right or left", "load.hand")
+        piece = pig.read_pig(path, hand=options.hand or "right")  # (its channel: 0 right, 1 left)
     elif options.tempo is not None and options.fingering is None and not pig.sidecar_for(path).exists():
         piece = _read_midi(path, options, bpm=options.tempo)  # the file's tempo map is never needed
     else:

@@ -100,7 +100,10 @@ def play(
     ),
     phrase_notes: Optional[int] = PlayPhraseNotes,
     seed: int = typer.Option(
-        0, "--seed", help="Seed of the simulation (the hand's start position) and of the random controller."
+        0,
+        "--seed",
+        help="Seed of the simulation (the hand's start position) and of the random controller.",
+        min=0,
     ),
     video: Optional[Path] = typer.Option(None, "--video", help="Also record the performance to this .mp4 file."),
     wav: Optional[Path] = typer.Option(None, "--wav", help="Also synthesise what was played to this .wav file."),

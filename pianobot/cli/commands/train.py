@@ -62,7 +62,10 @@ def train(
         help="Environment steps per phrase (of all --envs together), exploration included.",
     ),
     seed: int = typer.Option(
-        TrainConfig.seed, "--seed", help="Seed of the simulation, the exploration and the networks."
+        TrainConfig.seed,
+        "--seed",
+        help="Seed of the simulation, the exploration and the networks.",
+        min=0,
     ),
     learner: Learner = typer.Option(
         TrainConfig.learner,
