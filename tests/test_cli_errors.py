@@ -5,7 +5,7 @@ from pathlib import Path
 
 import pytest
 import typer.main
-from conftest import assert_one_line_error, run
+from conftest import assert_one_line_error, midi_file, off, on, run
 from typer.testing import CliRunner
 
 from pianobot.cli import flags
@@ -56,6 +56,16 @@ def test_a_number_below_its_least_is_one_line_and_exit_2(args, option, tmp_path,
     monkeypatch.chdir(tmp_path)
     assert_one_line_error(run(*args), f"'{option}'", "greater than or equal to")
     assert not (tmp_path / "x.mid").exists()
+
+
+def test_a_warning_is_said_once_though_the_file_is_read_twice(tmp_path):
+    """inspect reads a file for its tracks and again for its hands: a note that never ends was
+    said twice."""
+    song = midi_file(tmp_path / "open.mid", [("Piano", [(0, on(60)), (480, on(64)), (960, off(64))])])
+    result = run("inspect", song)
+    assert result.exit_code == 0, result.output
+    lines = [line for line in result.stderr.splitlines() if "never ends" in line]
+    assert lines == ["warning: track 1: C4 never ends; it ends with the track"], result.stderr
 
 
 def test_a_pig_file_plays_one_hand_from_its_channel(tmp_path):

@@ -109,14 +109,16 @@ def friendly(command):
                 error, code = None, 130
                 err.print("[yellow]interrupted[/yellow]")
             finally:
-                for w in caught:  # the warnings first: the error, last, is what stopped the command
-                    if issubclass(w.category, PianobotWarning):
-                        err.print(
-                            f"[yellow]warning:[/yellow] {said(phrase(w.message))}",
-                            highlight=False,
-                            emoji=False,
-                            soft_wrap=True,
-                        )
+                lines = dict.fromkeys(  # (a file read twice warns twice: each line is said once)
+                    phrase(w.message) for w in caught if issubclass(w.category, PianobotWarning)
+                )
+                for line in lines:  # the warnings first: the error, last, is what stopped the command
+                    err.print(
+                        f"[yellow]warning:[/yellow] {said(line)}",
+                        highlight=False,
+                        emoji=False,
+                        soft_wrap=True,
+                    )
         if error is not None:
             err.print(f"[red]error:[/red] {said(error)}", highlight=False, emoji=False, soft_wrap=True)
         raise typer.Exit(code) from None
