@@ -86,3 +86,24 @@ def test_a_repeated_key_is_let_go_later_than_one_the_finger_must_leave():
     assert planner.plan(repeat, repeat[0], tips)[finger].phase == "hold"
     assert planner.plan(hop, hop[0], tips)[finger].phase != "hold"
     assert planner.release_steps(5, 5, 64) < planner.release_steps(5, 7, 64) <= planner.hop_steps(5, 7, 64)
+
+
+def test_a_note_let_go_before_its_end_is_not_pressed_again():
+    """A left hand holds C3 and G3 and strikes C3 again under the held G3 (a new user's organ
+    file): the pianist let go of G3 for the repeat, then pressed it again while it was still
+    written to sound, a second G3 (and, with the finger off its key, an F3) that nobody wrote."""
+    from pianobot.perform.hands import play_hands
+
+    beat = 60 / 72
+
+    def note(pitch, start, end, hand, velocity=60):
+        return Note(start * beat, pitch, end * beat, velocity, hand=hand)
+
+    left = [note(48, 0, 2, "left"), note(55, 0, 4, "left"), note(48, 2, 6, "left")]
+    left += [note(43, 4, 8, "left"), note(50, 4, 8, "left")]
+    right = [note(67, 0, 1, "right", 80), note(67, 1, 3, "right", 70), note(69, 3, 4.5, "right")]
+    right += [note(72, 4, 5, "right", 80), note(71, 5, 6, "right", 70), note(67, 6, 8, "right", 70)]
+    piece = Piece(tuple(sorted(left + right, key=lambda n: (n.onset, n.pitch))))
+    performance = play_hands(piece, "scripted")
+    report = performance.report("left")
+    assert report.f1 == 1.0, [(r.played.name, round(r.played.onset, 2)) for r in report.rows if r.reference is None]

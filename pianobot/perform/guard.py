@@ -117,6 +117,9 @@ class HoldGuard:
         holding = np.flatnonzero(observation["targets"][:, -1] > 0)
         if holding.size:
             self.teacher.previous_row = self._before(observation["score"][0], holding)
+            # (nor what it let go: the policy moves the wrist, and remembered, a key let go for one
+            # step stayed up; measured on the validation pieces, per-step F1 0.873 -> 0.806)
+            self.teacher.released = frozenset()
             taught = self.teacher.act(observation)
             for slot in holding:
                 action[self.joints_of[slot]] = taught[self.joints_of[slot]]

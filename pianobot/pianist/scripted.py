@@ -48,6 +48,8 @@ class ScriptedPianist:
         """Forget the previous step: the next observation starts an episode."""
         self.previous_row: np.ndarray | None = None
         """The score row of the previous step: a note on in it too began earlier (hold, do not strike)."""
+        self.released: frozenset[tuple[int, int]] = frozenset()
+        """(finger, key) of the notes let go before their written end (not pressed again while they last)."""
 
     def act(self, observation: dict) -> np.ndarray:
         """One action from the score window, the wrist position and the joint angles."""
@@ -55,6 +57,13 @@ class ScriptedPianist:
         joints = np.asarray(observation["joints"], dtype=float).reshape(len(self.fingers), 4)
         wrist = (float(observation["wrist"][0]) + 1) / 2 * self.layout.width
         tips = {finger: self.motion.tip(q) for finger, q in zip(self.fingers, joints)}
-        plans = self.strikes.plan(score, self.previous_row, tips, wrist)
+        plans = self.strikes.plan(score, self.previous_row, tips, wrist, self.released)
+        held = self.strikes.held(score, self.previous_row)  # (a note let go stays let go until it ends)
+        self.released = frozenset(
+            (finger, key)
+            for finger, key in held.items()
+            if (finger, key) in self.released
+            or not (finger in plans and plans[finger].phase == "hold" and plans[finger].key == key)
+        )
         self.previous_row = score[0].copy()
         return self.motion.command(plans, joints, wrist)[self.actuated]

@@ -105,21 +105,39 @@ class StrikePlanner:
         self.max_wrist_speed = world.hand.max_wrist_speed
 
     def plan(
-        self, score: np.ndarray, previous_row: np.ndarray | None, tips: dict[int, Tip], wrist: float | None = None
+        self,
+        score: np.ndarray,
+        previous_row: np.ndarray | None,
+        tips: dict[int, Tip],
+        wrist: float | None = None,
+        released: frozenset[tuple[int, int]] = frozenset(),
     ) -> dict[int, Plan]:
         """The plan of every finger that has something to do, by finger.
 
         ``previous_row`` is the score row of the previous step (None at the first step): it tells a
         note that began earlier, to hold, from one to strike now. ``tips``: where each fingertip is, by
-        finger; ``wrist``: where the wrist is (m; None: wherever a strike needs it).
+        finger; ``wrist``: where the wrist is (m; None: wherever a strike needs it); ``released``:
+        (finger, key) of the notes that began earlier and were let go before their written end
+        (:meth:`held` tells them): they are not pressed again, which would sound them twice.
         """
         plans: dict[int, Plan] = {}
         for slot, finger in enumerate(self.fingers):
-            plan = self._plan_finger(score, slot, previous_row, tips[finger])
+            plan = self._plan_finger(score, slot, previous_row, tips[finger], released)
             if plan is not None:
                 plans[finger] = plan
         self._let_go(plans, tips, wrist)
         return plans
+
+    def held(self, score: np.ndarray, previous_row: np.ndarray | None) -> dict[int, int]:
+        """Each finger's note that began earlier and is written to sound now, by finger: its key."""
+        out = {}
+        if previous_row is None:
+            return out
+        for slot, finger in enumerate(self.fingers):
+            for run in finger_runs(score, slot):
+                if run.start == 0 and previous_row[run.key, NOTE] > 0.5 and previous_row[run.key, FINGER + slot] > 0.5:
+                    out[finger] = run.key
+        return out
 
     # -- speed, depth and timing of one strike -----------------------------------------------------
     def tip_speed(self, key: int, velocity: float) -> float:
@@ -207,17 +225,27 @@ class StrikePlanner:
         return max(prepare, self.positioning_steps(self._pressed(from_key), to_key, height)) + lead
 
     # -- plans ----------------------------------------------------------------------------------
-    def _plan_finger(self, score: np.ndarray, slot: int, previous_row: np.ndarray | None, tip: Tip) -> Plan | None:
-        """What one finger should do now, or None when it has nothing to do (``tip``: where its tip is)."""
+    def _plan_finger(
+        self,
+        score: np.ndarray,
+        slot: int,
+        previous_row: np.ndarray | None,
+        tip: Tip,
+        released: frozenset[tuple[int, int]] = frozenset(),
+    ) -> Plan | None:
+        """What one finger should do now, or None when it has nothing to do (``tip``: where its tip is;
+        ``released``: as :meth:`plan`'s)."""
         runs = finger_runs(score, slot)
         current = next((r for r in runs if r.start == 0), None)
         upcoming = next((r for r in runs if r.start > 0), None)
-        if current is None:
-            return self._approach(upcoming, tip) if upcoming is not None else None
-        key = current.key
-        began_earlier = previous_row is not None and (
-            previous_row[key, NOTE] > 0.5 and previous_row[key, FINGER + slot] > 0.5
+        key = current.key if current is not None else -1
+        began_earlier = (
+            current is not None
+            and previous_row is not None
+            and (previous_row[key, NOTE] > 0.5 and previous_row[key, FINGER + slot] > 0.5)
         )
+        if current is None or (began_earlier and (self.fingers[slot], key) in released):
+            return self._approach(upcoming, tip) if upcoming is not None else None
         if not began_earlier:
             return self._approach(current, tip)  # the onset step itself: strike now
         tip_height = tip.height - self.layout.key_top[key]
