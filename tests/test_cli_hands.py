@@ -150,6 +150,23 @@ def test_play_says_how_many_more_notes_the_thumbs_would_keep(tmp_path):
     assert "--thumb" not in run("play", whole, "-o", tmp_path / "w.mid", "--controller", "scripted").stdout
 
 
+def test_track_names_the_staves_both_hands_play(tmp_path):
+    """A song's voice over two piano staves: --track picks the staves (by indices, or by the name
+    they share), the hands play them, the voice is left out; one track is one hand's part."""
+    voice = _track((79, 0, 4))
+    song = midi_file(tmp_path / "song.mid", [("Voice", voice), ("Piano", RIGHT), ("Piano", LEFT)])
+    for track in ("2,3", "Piano"):
+        result = run("play", song, "-o", tmp_path / "out.mid", "--controller", "scripted", "--track", track)
+        assert result.exit_code == 0, result.output
+        assert "both hands" in result.stdout and "right hand: 4 notes, C5-F5" in " ".join(result.stdout.split())
+        played = read_midi(tmp_path / "out.mid")
+        assert sorted(n.pitch for n in played.notes) == [48, 55, 72, 74, 76, 77]  # (the voice's G5 left out)
+    one = run("play", song, "-o", tmp_path / "one.mid", "--controller", "scripted", "--track", "3")
+    assert one.exit_code == 0, one.output
+    assert "both hands" not in one.stdout and [n.pitch for n in read_midi(tmp_path / "one.mid").notes] == [48, 55]
+    assert_one_line_error(run("inspect", song, "--track", "2,9"), "no track '9'", "separate them with commas")
+
+
 def test_what_both_hands_cannot_do_yet_is_one_line(tmp_path, monkeypatch):
     monkeypatch.setenv("DISPLAY", ":0")  # (as on a desktop: the two hands are what --gui refuses)
     song = _duet(tmp_path / "duet.mid")

@@ -107,7 +107,7 @@ def _reading(kind, default, flag: str, text: str, panel: str = PIECE) -> tuple:
 
 # fmt: off
 READING = {  # parameter name: (type, option); the commands' --help shows them in two panels of their own
-    "track": _reading(Optional[str], None, "--track", "Read only this track (index or name); default: merge all tracks."),
+    "track": _reading(Optional[str], None, "--track", "Read only this track (index or name), or these tracks, separated by commas (e.g. 2,3: two or more are played with both hands); default: all tracks."),
     "tempo": _reading(Optional[float], None, "--tempo", "Re-time the piece at this constant tempo in bpm (the paper uses 60)."),
     "transpose": _reading(int, LoadOptions.transpose, "--transpose", "Shift every note by this many semitones."),
     "fingering": _reading(Optional[Path], None, "--fingering", "PIG fingering file for the notes (default: <song>_fingering.txt beside the .mid, if any)."),

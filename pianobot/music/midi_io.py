@@ -246,23 +246,33 @@ def parse_grid(text: str) -> float:
     return top / bottom
 
 
+def selected_tracks(path: str | Path, track: str | int | None) -> list[int]:
+    """The tracks ``track`` names in the file at ``path`` (as :func:`read_midi` reads them), by index."""
+    path = Path(path)
+    return _select_tracks(_load(path), track, path)
+
+
 def _select_tracks(midi: mido.MidiFile, track: str | int | None, path: Path) -> list[int]:
+    """The tracks ``track`` names: an index or a name (every track of that name), or several of
+    these separated by commas ('2,3', 'Piano'); None: all."""
     infos = list_tracks(midi)
     if track is None:
         return [t.index for t in infos]
     with_notes = ", ".join(f"{t.index} '{quote(t.name, 30)}'" if t.name else str(t.index) for t in infos if t.notes)
     with_notes = quote(with_notes, 200)
-    key = str(track).strip()
-    if key.isdigit():
-        if int(key) < len(infos):
-            return [int(key)]
-    else:
-        hits = [t.index for t in infos if t.name.strip().lower() == key.lower()]
-        if hits:
-            return hits
-    raise PianobotError(
-        f"{path} has no track '{quote(str(track))}': choose one of the tracks with notes: {with_notes or 'none'}"
-    )
+    chosen: list[int] = []
+    for key in (part.strip() for part in str(track).split(",")):
+        if key.isdigit() and int(key) < len(infos):
+            hits = [int(key)]
+        else:
+            hits = [t.index for t in infos if key and t.name.strip().lower() == key.lower()]
+        if not hits:
+            raise PianobotError(
+                f"{path} has no track '{quote(key)}': choose one of the tracks with notes: {with_notes or 'none'} "
+                "(several: separate them with commas)"
+            )
+        chosen += [index for index in hits if index not in chosen]
+    return sorted(chosen)
 
 
 def _track_notes(

@@ -108,12 +108,17 @@ def read_hands(path: str | Path, options: LoadOptions = LoadOptions(), spec: Han
     return HandsReading(piece, named, "the PIG channel" if Path(path).suffix.lower() == ".txt" else "its track")
 
 
-def names_hands(path: str | Path) -> bool:
-    """Whether the file says which hand plays its notes: a track named for a hand, or a PIG file."""
+def names_hands(path: str | Path, track: str | None = None) -> bool:
+    """Whether the file says which hand plays its notes: a track named for a hand (of those
+    ``track`` names, :func:`~pianobot.music.midi_io.read_midi`'s; None: all), or a PIG file."""
     path = Path(path)
     if path.suffix.lower() == ".txt":
         return True
-    return any(t.notes and midi_io.track_hand(t.name) for t in midi_io.describe_tracks(path))
+    read = None if track is None else set(midi_io.selected_tracks(path, track))
+    return any(
+        t.notes and midi_io.track_hand(t.name) and (read is None or t.index in read)
+        for t in midi_io.describe_tracks(path)
+    )
 
 
 def two_hands(
@@ -122,7 +127,8 @@ def two_hands(
     """Both hands of the file at ``path`` where ``pianobot play`` plays both, else None: read it
     as one hand, as before two hands.
 
-    Both hands: without ``options.hand`` and ``options.track``, a file whose tracks are named for
+    Both hands: without ``options.hand``, and with ``options.track`` naming two or more tracks of
+    notes or none (then only those tracks are read), a file whose tracks are named for
     hands (the notes of others given hands by the fingering planner), or a PIG file, with notes
     for both hands; or a file that cannot be one hand's, whose notes the fingering planner gives
     to both hands: its notes span more keys than one hand's ``keyboard`` has, or, unfingered,
@@ -132,12 +138,24 @@ def two_hands(
     reading's warnings are said only where both hands play (or where it refuses the file: notes
     beyond the piano)."""
     path = Path(path)
-    if options.hand is not None or options.track is not None:
+    if options.hand is not None:
         return None
+    if options.track is not None and (
+        path.suffix.lower() == ".txt"
+        or len(
+            [
+                t
+                for t in midi_io.describe_tracks(path)
+                if t.notes and t.index in midi_io.selected_tracks(path, options.track)
+            ]
+        )
+        < 2
+    ):
+        return None  # (one track: one hand's part, as before two hands)
     if path.suffix.lower() == ".txt" and (options.tempo or options.fingering or options.quantize):
         return None  # (one hand's reading refuses them in its own words)
     one_hand_refuses = ""
-    if not names_hands(path):
+    if not names_hands(path, options.track):
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # said when the piece is read
             piece = load_piece(path, options)
