@@ -68,6 +68,17 @@ def test_a_warning_is_said_once_though_the_file_is_read_twice(tmp_path):
     assert lines == ["warning: track 1: C4 never ends; it ends with the track"], result.stderr
 
 
+def test_a_model_store_that_is_not_there_is_one_line(tmp_path, monkeypatch):
+    """A mistyped --models played the packaged policies without a word."""
+    monkeypatch.chdir(tmp_path)  # (no models/ here: the default store may be absent)
+    missing = tmp_path / "modles"
+    assert_one_line_error(run("play", SONG, "-o", "x.mid", "--models", missing), f"--models {missing}: does not exist")
+    assert_one_line_error(run("inspect", SONG, "--models", SONG), "is not a folder")
+    assert not (tmp_path / "x.mid").exists()
+    assert run("play", SONG, "-o", "x.mid", "--quiet").exit_code == 0  # the default store, absent: packaged policies
+    assert run("play", SONG, "-o", "y.mid", "--models", missing, "--controller", "scripted").exit_code == 0
+
+
 def test_a_pig_file_plays_one_hand_from_its_channel(tmp_path):
     pig_file = tmp_path / "duet.txt"
     pig_file.write_text("0 0.0 0.5 C5 80 80 0 3\n1 0.0 0.5 C3 80 80 1 -3\n2 0.5 1.0 D5 80 80 0 4\n")

@@ -193,6 +193,22 @@ def check_midi_output(output: Path, song: Path, what: str) -> None:
         raise PianobotError(f"-o {output} would overwrite the input {song.name}: choose another file name")
 
 
+DEFAULT_STORE = Path("models")
+"""--models' default: the model store in the working folder (may be absent: the packaged policies play)."""
+
+
+def check_models(models: Path) -> None:
+    """One line where ``--models`` names a store that is not there: a mistyped path would otherwise
+    play with the packaged policies without a word (the default, ``models``, may be absent)."""
+    if models.is_dir() or (models == DEFAULT_STORE and not models.exists()):
+        return
+    what = "is not a folder" if models.exists() else "does not exist"
+    raise PianobotError(
+        f"--models {models}: {what}; name the folder `pianobot train` wrote its policies to, "
+        "or leave --models out to play with the packaged policies"
+    )
+
+
 def check_files(inputs: dict[str, Path | None], outputs: dict[str, Path | None]) -> None:
     """The files a command writes (``outputs``, by option; None: not asked for; '-': standard
     output) are each a file of their own, none of them one it reads (``inputs``, by what the user

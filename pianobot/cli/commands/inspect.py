@@ -10,11 +10,13 @@ import typer
 
 from pianobot.cli.flags import phrase
 from pianobot.cli.options import (
+    DEFAULT_STORE,
     AllRows,
     PlayPhraseNotes,
     Reading,
     both_hands,
     check_files,
+    check_models,
     fit_keyboard,
     reads,
 )
@@ -29,7 +31,7 @@ def inspect(
     song: Path = typer.Argument(..., help="A .mid file (or a PIG fingering .txt file)."),
     phrase_notes: Optional[int] = PlayPhraseNotes,
     models: Path = typer.Option(
-        Path("models"), "--models", help="Model store whose trained phrase split to show (as play uses it)."
+        DEFAULT_STORE, "--models", help="Model store whose trained phrase split to show (as play uses it)."
     ),
     all_rows: bool = AllRows,
     json_path: Optional[Path] = typer.Option(
@@ -49,6 +51,7 @@ def inspect(
     options, keyboard, hand_spec = reading.options, reading.keyboard, reading.hand
     to_stdout = json_path is not None and str(json_path) == "-"
     check_files({"the input": song, "the fingering file": options.fingering}, {"--json": json_path})
+    check_models(models)
     if json_path is not None and not to_stdout:
         check_writable(json_path)
     console = err if to_stdout else out  # standard output carries the JSON

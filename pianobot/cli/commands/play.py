@@ -11,6 +11,7 @@ from typing import Optional
 import typer
 
 from pianobot.cli.options import (
+    DEFAULT_STORE,
     AllFigures,
     Controller,
     Fallback,
@@ -22,6 +23,7 @@ from pianobot.cli.options import (
     check_files,
     check_html,
     check_midi_output,
+    check_models,
     fit_keyboard,
     read_song,
     reads,
@@ -59,7 +61,7 @@ def play(
         "--controller",
         help="Who plays: 'sac' (each phrase's trained policy, else the general policy), 'scripted' (the hand-written pianist) or 'random'.",
     ),
-    models: Path = typer.Option(Path("models"), "--models", help="Folder of the model store (for --controller sac)."),
+    models: Path = typer.Option(DEFAULT_STORE, "--models", help="Folder of the model store (for --controller sac)."),
     fallback: Optional[Fallback] = typer.Option(
         None,
         "--fallback",
@@ -138,6 +140,8 @@ def play(
     from pianobot.perform.plan import Player, perform_plan, plan_performance
 
     check_midi_output(output, song, "the performance")
+    if controller == "sac":
+        check_models(models)
     report_path = output.with_suffix(".report.json")
     check_files(
         {"the input": song, "the fingering file": reading.options.fingering},
