@@ -167,6 +167,18 @@ def test_track_names_the_staves_both_hands_play(tmp_path):
     assert_one_line_error(run("inspect", song, "--track", "2,9"), "no track '9'", "separate them with commas")
 
 
+def test_inspect_of_one_hand_says_how_many_of_its_notes_the_hand_is_given(tmp_path):
+    """A chord wider than the hand reaches loses its lower note: the summary counted only what the
+    hand is given (2 notes) and said nothing of the part's 3."""
+    song = _duet(tmp_path / "wide.mid", right=_track((60, 0, 1), (79, 0, 1), (72, 1, 2)))
+    result = run("inspect", song, "--hand", "right")
+    assert result.exit_code == 0, result.output
+    text = " ".join(result.stdout.split())
+    assert "2 notes," in text and "the right hand's part has 3 notes: the hand is given 2 of them" in text
+    whole = run("inspect", _duet(tmp_path / "fits.mid"), "--hand", "right")
+    assert "the hand is given" not in whole.stdout
+
+
 def test_what_both_hands_cannot_do_yet_is_one_line(tmp_path, monkeypatch):
     monkeypatch.setenv("DISPLAY", ":0")  # (as on a desktop: the two hands are what --gui refuses)
     song = _duet(tmp_path / "duet.mid")

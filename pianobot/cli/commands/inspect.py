@@ -88,6 +88,20 @@ def inspect(
     piece = load_for_hand(song, options, keyboard, hand_spec)
     line, data = _summary(piece, tempi)
     console.print(line)
+    if options.hand is not None:
+        import warnings
+
+        from pianobot.music.load import load_piece
+
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # (said as the part was read)
+            written = len(load_piece(song, options))
+        if written > len(piece):
+            console.print(
+                f"[yellow]the {options.hand} hand's part has {written} notes: the hand is given {len(piece)} "
+                "of them, the others left out or reduced (the warnings say which)[/yellow]"
+            )
+            data["part_notes"] = written
     # the keyboard and the chords, before the split (a transposition it suggests counts --transpose in)
     check_playable(piece.without_fingering(), keyboard, hand_spec, options.transpose)
     piece, plan = ensure_fingering(piece, keyboard, hand_spec, options.refinger)
