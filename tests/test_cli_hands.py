@@ -383,6 +383,7 @@ def test_the_parts_policy_plays_through_the_hold_guard_unless_told(tmp_path):
     from pianobot.agent.general import PACKAGED
 
     song = _duet(tmp_path / "duet.mid")
+    (tmp_path / "empty").mkdir()  # an empty model store
     melody = ("--left-policy", next(PACKAGED.glob("task-melody-*")))
     expected = {
         (): (True, True),
