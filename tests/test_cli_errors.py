@@ -77,6 +77,9 @@ def test_a_model_store_that_is_not_there_is_one_line(tmp_path, monkeypatch):
     assert not (tmp_path / "x.mid").exists()
     assert run("play", SONG, "-o", "x.mid", "--quiet").exit_code == 0  # the default store, absent: packaged policies
     assert run("play", SONG, "-o", "y.mid", "--models", missing, "--controller", "scripted").exit_code == 0
+    (tmp_path / "models").write_text("not a store")  # the default store, a file: not "leave --models out"
+    line = assert_one_line_error(run("play", SONG, "-o", "z.mid"), "the model store models/ here is a file")
+    assert "leave --models out" not in line
 
 
 def test_a_pig_file_plays_one_hand_from_its_channel(tmp_path):
@@ -88,6 +91,8 @@ def test_a_pig_file_plays_one_hand_from_its_channel(tmp_path):
         assert [n.pitch for n in read_midi(tmp_path / f"{hand}.mid").notes] == pitches
     quantized = run("play", pig_file, "-o", tmp_path / "q.mid", "--quantize", "1/16")
     assert_one_line_error(quantized, "--quantize needs a MIDI file")
+    for args in (("--track", "0,1"), ("--track", "0", "--hand", "left")):  # (it was ignored: channel 0 played)
+        assert_one_line_error(run("play", pig_file, "-o", tmp_path / "t.mid", *args), "--track needs a MIDI file")
 
 
 def test_the_choices_come_from_the_library_and_show_in_help():

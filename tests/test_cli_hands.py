@@ -164,7 +164,11 @@ def test_track_names_the_staves_both_hands_play(tmp_path):
     one = run("play", song, "-o", tmp_path / "one.mid", "--controller", "scripted", "--track", "3")
     assert one.exit_code == 0, one.output
     assert "both hands" not in one.stdout and [n.pitch for n in read_midi(tmp_path / "one.mid").notes] == [48, 55]
-    assert_one_line_error(run("inspect", song, "--track", "2,9"), "no track '9'", "separate them with commas")
+    assert_one_line_error(run("inspect", song, "--track", "2,9"), "no track '9' (in '2,9')", "separate them with")
+    named = midi_file(tmp_path / "named.mid", [("Voice", voice), ("Piano, right", RIGHT), ("Piano, left", LEFT)])
+    right = run("play", named, "-o", tmp_path / "r.mid", "--controller", "scripted", "--track", "Piano, right")
+    assert right.exit_code == 0, right.output  # (a name with a comma, as a whole)
+    assert [n.pitch for n in read_midi(tmp_path / "r.mid").notes] == [72, 74, 76, 77]
 
 
 def test_inspect_of_one_hand_says_how_many_of_its_notes_the_hand_is_given(tmp_path):

@@ -107,7 +107,7 @@ def _reading(kind, default, flag: str, text: str, panel: str = PIECE) -> tuple:
 
 # fmt: off
 READING = {  # parameter name: (type, option); the commands' --help shows them in two panels of their own
-    "track": _reading(Optional[str], None, "--track", "Read only this track (index or name), or these tracks, separated by commas (e.g. 2,3: two or more are played with both hands); default: all tracks."),
+    "track": _reading(Optional[str], None, "--track", "Read only this track (index or name), or these tracks, separated by commas (e.g. 2,3); two or more are read as a whole file is (both hands where tracks are named for them or one hand cannot play the notes); one is one hand's part; default: all tracks."),
     "tempo": _reading(Optional[float], None, "--tempo", "Re-time the piece at this constant tempo in bpm (the paper uses 60)."),
     "transpose": _reading(int, LoadOptions.transpose, "--transpose", "Shift every note by this many semitones."),
     "fingering": _reading(Optional[Path], None, "--fingering", "PIG fingering file for the notes (default: <song>_fingering.txt beside the .mid, if any)."),
@@ -202,6 +202,10 @@ def check_models(models: Path) -> None:
     play with the packaged policies without a word (the default, ``models``, may be absent)."""
     if models.is_dir() or (models == DEFAULT_STORE and not models.exists()):
         return
+    if models == DEFAULT_STORE:
+        raise PianobotError(
+            f"the model store {models}/ here is a file, not a folder: move it, or name the store with --models"
+        )
     what = "is not a folder" if models.exists() else "does not exist"
     raise PianobotError(
         f"--models {models}: {what}; name the folder `pianobot train` wrote its policies to, "

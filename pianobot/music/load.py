@@ -148,6 +148,11 @@ def load_piece(path: str | Path, options: LoadOptions = LoadOptions()) -> Piece:
             raise SettingError(
                 "load.quantize needs a MIDI file: a PIG file's onsets are already in seconds", "load.quantize"
             )
+        if options.track is not None:
+            raise SettingError(
+                "load.track needs a MIDI file: a PIG file's channels are its hands (play one with load.hand)",
+                "load.track",
+            )
         if options.hand is not None and options.hand not in HANDS:
             raise SettingError(f"load.hand {quote(options.hand)}: choose right or left", "load.hand")
         piece = pig.read_pig(path, hand=options.hand or "right")  # (its channel: 0 right, 1 left)
@@ -220,6 +225,8 @@ def load_hands(path: str | Path, options: LoadOptions = LoadOptions()) -> Piece:
                 "load.fingering",
                 "load.quantize",
             )
+        if options.track is not None:
+            raise SettingError("load.track needs a MIDI file: a PIG file's channels are its hands", "load.track")
         piece = pig.read_pig(path, hand=None).transpose(options.transpose)
     else:
         piece = load_piece(path, options)

@@ -260,16 +260,21 @@ def _select_tracks(midi: mido.MidiFile, track: str | int | None, path: Path) -> 
         return [t.index for t in infos]
     with_notes = ", ".join(f"{t.index} '{quote(t.name, 30)}'" if t.name else str(t.index) for t in infos if t.notes)
     with_notes = quote(with_notes, 200)
+    whole = str(track).strip()
+    named = [t.index for t in infos if whole and t.name.strip().lower() == whole.lower()]
+    if named:  # (a name may hold a comma: the whole value first)
+        return named
     chosen: list[int] = []
-    for key in (part.strip() for part in str(track).split(",")):
+    for key in (part.strip() for part in whole.split(",")):
         if key.isdigit() and int(key) < len(infos):
             hits = [int(key)]
         else:
             hits = [t.index for t in infos if key and t.name.strip().lower() == key.lower()]
         if not hits:
             raise PianobotError(
-                f"{path} has no track '{quote(key)}': choose one of the tracks with notes: {with_notes or 'none'} "
-                "(several: separate them with commas)"
+                f"{path} has no track '{quote(key)}'"
+                + (f" (in '{quote(whole)}')" if key != whole else "")
+                + f": choose one of the tracks with notes: {with_notes or 'none'} (several: separate them with commas)"
             )
         chosen += [index for index in hits if index not in chosen]
     return sorted(chosen)

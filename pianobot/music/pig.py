@@ -98,7 +98,10 @@ def read_pig(path: str | Path, *, hand: str | None = "right") -> Piece:
     channel = CHANNELS[hand]
     notes = [note for note, ch in rows if ch == channel]
     if not notes:
-        raise PianobotError(f"{path} has no {hand}-hand notes (channel {channel}): choose the other hand")
+        other = "left" if hand == "right" else "right"
+        raise PianobotError(
+            f"{path} has no {hand}-hand notes (channel {channel}): play the other hand with load.hand {other}"
+        )
     return Piece(tuple(notes))
 
 

@@ -140,18 +140,12 @@ def two_hands(
     path = Path(path)
     if options.hand is not None:
         return None
-    if options.track is not None and (
-        path.suffix.lower() == ".txt"
-        or len(
-            [
-                t
-                for t in midi_io.describe_tracks(path)
-                if t.notes and t.index in midi_io.selected_tracks(path, options.track)
-            ]
-        )
-        < 2
-    ):
-        return None  # (one track: one hand's part, as before two hands)
+    if options.track is not None:
+        if path.suffix.lower() == ".txt":
+            return None  # (one hand's reading refuses --track on a PIG file)
+        read = set(midi_io.selected_tracks(path, options.track))
+        if len([t for t in midi_io.describe_tracks(path) if t.notes and t.index in read]) < 2:
+            return None  # (one track: one hand's part, as before two hands)
     if path.suffix.lower() == ".txt" and (options.tempo or options.fingering or options.quantize):
         return None  # (one hand's reading refuses them in its own words)
     one_hand_refuses = ""
