@@ -257,7 +257,9 @@ def test_train_bad_requests_answer_with_one_line(tmp_path):
     assert_one_line_error(run("train"), "--task")
     assert_one_line_error(run("train", song, "--task", "one-note"), "not both")
     assert_one_line_error(run("train", "--task", "sonata"), "'--task'", "'sonata'", "'melody'")
-    assert_one_line_error(run("train", song, "--steps", "100"), "100 steps must exceed the 15000 exploration steps")
+    line = assert_one_line_error(run("train", song, "--steps", "100"), "--steps 100: SAC learns only after its 15000")
+    assert "--exploration-steps" in line and "--learner dagger" in line
+    assert_one_line_error(run("train", song, "--steps", "-5"), "'--steps'", "greater than or equal to 1")
     assert_one_line_error(
         run("train", song, "--control", "joint"), "'--control'", "'joint'", "'velocity', 'position', 'torque'"
     )
@@ -596,3 +598,25 @@ def test_a_suggested_transposition_counts_the_one_already_given(tmp_path):
         run("play", high, "--keys", "24", "--transpose", "12", "-o", tmp_path / "o.mid"), "use --transpose -12"
     )
     assert "-24" not in line
+
+
+def test_a_melody_written_legato_plays_as_one_hand(tmp_path):
+    """Each note of a scale up and down lasting 0.1 s into the next (a player's legato, as a
+    recording writes it): the planner refused it (E4 still down when F4 is struck, and no fingering
+    of three fingers goes on from there) and advised --hand; each note now ends where the next
+    begins, as with --hand, and the melody plays and scores whole."""
+    pitches = [60, 62, 64, 65, 67, 65, 64, 62, 60]
+    notes = tuple(Note(0.667 * i, p, 0.667 * i + 0.767, 80) for i, p in enumerate(pitches))
+    song = write_midi(Piece(notes, bpm=90), tmp_path / "legato.mid")
+    result = run("play", song, "-o", tmp_path / "out.mid", "--controller", "scripted", "--json", tmp_path / "r.json")
+    assert result.exit_code == 0, result.output
+    assert json.loads((tmp_path / "r.json").read_text())["f1"] == 1.0
+    scored = run("score", tmp_path / "out.mid", song, "--json", tmp_path / "s.json")
+    assert scored.exit_code == 0 and json.loads((tmp_path / "s.json").read_text())["f1"] == 1.0
+    from pianobot.music.load import end_legato
+
+    ended = end_legato(Piece(notes))
+    assert [n.offset for n in ended.notes[:-1]] == [n.onset for n in notes[1:]]
+    assert ended.notes[-1] == notes[-1]  # (the last overlaps nothing)
+    held = Piece((Note(0.0, 60, 2.0, 80), Note(0.5, 64, 1.0, 80)))  # a note held under another: kept
+    assert end_legato(held) is held

@@ -178,3 +178,23 @@ def test_train_json_is_checked_like_the_others_and_a_hard_link_is_the_same_file(
     os.link(song, linked)  # (as another spelling of one file on a case-insensitive disk)
     assert_one_line_error(run("finger", song, "-o", linked), "would overwrite the input")
     assert song.read_bytes() == before and not (tmp_path / "m").exists()
+
+
+def test_an_interrupted_train_says_how_to_go_on(capsys):
+    """Ctrl-C: exit 130, and train says that the same command goes on from the checkpoints."""
+    import typer
+
+    from pianobot.cli.app import friendly
+
+    def train():
+        raise KeyboardInterrupt
+
+    def play():
+        raise KeyboardInterrupt
+
+    for command, words in ((train, "run the same command again to go on"), (play, "")):
+        with pytest.raises(typer.Exit) as stopped:
+            friendly(command)()
+        assert stopped.value.exit_code == 130
+        said = capsys.readouterr().err.strip()
+        assert said.startswith("interrupted") and words in said and ("checkpoint" in said) == bool(words)

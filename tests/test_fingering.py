@@ -228,6 +228,9 @@ def test_finger_command_writes_a_fingered_file_and_inspect_explains_a_recording(
     fingered = read_midi(out)
     assert fingered.has_fingering and all(n.finger in (2, 3, 4) for n in fingered.notes)
     assert fingered == plan_fingering(read_midi(song)).piece
+    assert "replaced" not in result.output  # (the file had no fingering of its own)
+    again = runner.invoke(app, ["finger", str(out), "-o", str(tmp_path / "again.mid")])  # a fingered file
+    assert "the file's own fingering (11 of 11 notes) was replaced by the planner's" in " ".join(again.output.split())
 
     recording = _recording(tmp_path / "r.mid", jitter=10)
     result = runner.invoke(app, ["inspect", str(recording)])

@@ -27,6 +27,7 @@ from pianobot.cli.flags import phrase
 from pianobot.cli.terminal import err, out, said
 from pianobot.errors import QUOTE_LIMIT, PianobotError, PianobotWarning, quote
 from pianobot.files import why
+from pianobot.learn.config import TrainConfig
 
 EXIT_BAD_INPUT = 2
 USAGE_ERROR = typer.BadParameter.__base__  # click's UsageError (typer re-exports only its subclass)
@@ -86,6 +87,13 @@ app = typer.Typer(
 )
 
 
+INTERRUPTED = {
+    "train": ": run the same command again to go on; a phrase's run resumes from its last checkpoint "
+    f"(every {TrainConfig.checkpoint_every} steps), and one without a checkpoint yet starts again",
+}
+"""What an interrupted command adds to the line that says so."""
+
+
 def friendly(command):
     """Turn PianobotError into one red line + exit 2, and show warnings in yellow; either names
     the settings it mentions by their options (:func:`pianobot.cli.flags.phrase`).
@@ -107,7 +115,7 @@ def friendly(command):
                 error, code = (f"{e.filename}: " if e.filename else "") + why(e), EXIT_BAD_INPUT
             except KeyboardInterrupt:
                 error, code = None, 130
-                err.print("[yellow]interrupted[/yellow]")
+                err.print(f"[yellow]interrupted[/yellow]{INTERRUPTED.get(command.__name__, '')}")
             finally:
                 lines = dict.fromkeys(  # (a file read twice warns twice: each line is said once)
                     phrase(w.message) for w in caught if issubclass(w.category, PianobotWarning)

@@ -41,6 +41,9 @@ FLAGS = {
     "train.env.reward.kind": "--reward",
     "train.env.reward.fingering_gate": "--fingering-gate/--no-fingering-gate",
     "train.sac.actor": "--actor",
+    "train.sac.exploration_steps": "--exploration-steps",
+    "train.steps": "--steps",
+    "train.learner": "--learner",
     "train.sac": "the agent's network settings (SACConfig)",
 }
 """Setting (its dotted field path) -> the option that sets it. Training fields are ``train.``

@@ -17,10 +17,10 @@ import typer
 
 from pianobot.agent.config import ACTORS, DEVICES
 from pianobot.env.rewards import REWARDS
-from pianobot.errors import PianobotError, PianobotWarning, quote
+from pianobot.errors import PianobotError, PianobotWarning, SettingError, quote
 from pianobot.learn.config import LEARNERS
 from pianobot.learn.explore import EXPLORATIONS
-from pianobot.music.instrument import HandSpec, KeyboardSpec
+from pianobot.music.instrument import PIANO, HandSpec, KeyboardSpec
 from pianobot.music.load import HANDS, LoadOptions
 from pianobot.music.phrases import DEFAULT_MAX_NOTES
 from pianobot.music.piece import Piece, parse_pitch, pitch_name
@@ -138,6 +138,18 @@ def make_reading(**given) -> Reading:
     """The :class:`Reading` of the reading options' values; an option a command does not offer
     keeps its default."""
     values = {name: option.default for name, (_, option) in READING.items()} | given
+    named = values["lowest_note"] is not None or values["keys"] is not None
+    keyboard = KeyboardSpec(
+        lowest=KeyboardSpec.lowest if values["lowest_note"] is None else parse_pitch(values["lowest_note"]),
+        count=KeyboardSpec.count if values["keys"] is None else values["keys"],
+    )
+    if named and not (PIANO.lowest <= keyboard.lowest and keyboard.highest <= PIANO.highest):
+        raise SettingError(
+            f"the keyboard {keyboard.describe()} goes past the piano's 88 keys {PIANO.describe()}: "
+            "choose keyboard.lowest and keyboard.count within them",
+            "keyboard.lowest",
+            "keyboard.count",
+        )
     return Reading(
         options=LoadOptions(
             track=values["track"],
@@ -149,12 +161,9 @@ def make_reading(**given) -> Reading:
             quantize=values["quantize"],
             refinger=values["refinger"],
         ),
-        keyboard=KeyboardSpec(
-            lowest=KeyboardSpec.lowest if values["lowest_note"] is None else parse_pitch(values["lowest_note"]),
-            count=KeyboardSpec.count if values["keys"] is None else values["keys"],
-        ),
+        keyboard=keyboard,
         hand=HandSpec(fingers=(1,) + HandSpec.fingers if values["thumb"] else HandSpec.fingers),
-        keyboard_named=values["lowest_note"] is not None or values["keys"] is not None,
+        keyboard_named=named,
     )
 
 

@@ -101,7 +101,8 @@ class TrainConfig:
             )
         if self.learner == "sac" and not 0 <= self.sac.exploration_steps < self.steps:
             raise ValueError(
-                f"{self.steps} steps must exceed the {self.sac.exploration_steps} exploration steps, or nothing is learnt"
+                f"train.steps {self.steps}: SAC learns only after its {self.sac.exploration_steps} exploration steps: give "
+                "more train.steps, fewer train.sac.exploration_steps, or train.learner dagger (which learns from the first)"
             )
         for stop in (self.until_f1, self.finetune_until_f1):
             if stop is not None and not 0.0 < stop <= 1.0:

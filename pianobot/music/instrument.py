@@ -56,7 +56,7 @@ class KeyboardSpec:
         return pitch % 12 in _BLACK
 
     def describe(self) -> str:
-        return f"{pitch_name(self.lowest)}-{pitch_name(self.highest)} ({self.count} keys)"
+        return f"{pitch_name(self.lowest)}-{pitch_name(self.highest)} ({self.count} key{'s' * (self.count != 1)})"
 
 
 PIANO = KeyboardSpec(21, 88)

@@ -182,9 +182,24 @@ def load_piece(path: str | Path, options: LoadOptions = LoadOptions()) -> Piece:
 
 def load_part(path: str | Path, options: LoadOptions, hand: HandSpec) -> Piece:
     """:func:`load_piece`; with ``options.hand``, also thin chords to what ``hand`` can hold
-    (:func:`pianobot.pianist.reduce.load_for_hand` goes on to what it can reach in time)."""
+    (:func:`pianobot.pianist.reduce.load_for_hand` goes on to what it can reach in time); without
+    it, a note lasting at most :data:`LEGATO_OVERLAP` into a later onset ends there (a player's
+    legato, which a hand cannot play as two keys down at once where they lie apart)."""
     piece = load_piece(path, options)
-    return piece if options.hand is None else thin_hand(piece, options.hand, hand)
+    return end_legato(piece) if options.hand is None else thin_hand(piece, options.hand, hand)
+
+
+def end_legato(piece: Piece) -> Piece:
+    """``piece`` with every note that lasts at most :data:`LEGATO_OVERLAP` past a later onset
+    (and begins before it) ending at that onset; the piece itself where none does."""
+    onsets = sorted({n.onset for n in piece.notes})
+    notes, changed = [], False
+    for note in piece.notes:
+        later = [t for t in onsets if note.onset < t < note.offset <= t + LEGATO_OVERLAP + 1e-9]
+        if later:
+            note, changed = replace(note, offset=later[0]), True
+        notes.append(note)
+    return Piece(tuple(notes), bpm=piece.bpm) if changed else piece
 
 
 def thin_hand(piece: Piece, name: str, hand: HandSpec, kept: str = "highest") -> Piece:

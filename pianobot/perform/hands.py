@@ -41,7 +41,7 @@ from pianobot.errors import PianobotError, PianobotWarning, SettingError
 from pianobot.music import midi_io
 from pianobot.music.hand_scores import HandsReport, compare_hands
 from pianobot.music.instrument import HandSpec, KeyboardSpec, check_playable, suggest_transpose
-from pianobot.music.load import LoadOptions, load_hands, load_piece, thin_hand
+from pianobot.music.load import LoadOptions, end_legato, load_hands, load_piece, thin_hand
 from pianobot.music.metrics import Report
 from pianobot.music.piece import HANDS, Note, Piece, pitch_name
 from pianobot.music.window import Window, window_for
@@ -152,7 +152,7 @@ def two_hands(
     if not names_hands(path, options.track):
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # said when the piece is read
-            piece = load_piece(path, options)
+            piece = end_legato(load_piece(path, options))  # (as one hand's reading reads it)
         pitches = [n.pitch for n in piece.notes]
         if max(pitches) - min(pitches) < keyboard.count:
             if any(n.finger is not None for n in piece.notes):

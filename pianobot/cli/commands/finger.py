@@ -49,7 +49,11 @@ def finger(
         out.print(display.notes_table(fingered.piece, [], None if all_rows else display.ROWS))
         for hand, plan in fingered.plans.items():
             count = len(fingered.piece.part(hand))
-            travel = f"wrist travel {plan.travel * 100:.1f} cm in {plan.moves} moves" if plan else "as the file had it"
+            travel = (
+                f"wrist travel {plan.travel * 100:.1f} cm in {plan.moves} move{'s' * (plan.moves != 1)}"
+                if plan
+                else "as the file had it"
+            )
             out.print(f"{hand} hand, fingers {hand_spec.describe()}: {travel} over {count} notes", soft_wrap=True)
             for problem in plan.problems if plan else ():
                 out.print(f"[yellow]cannot be played at this tempo:[/yellow] {said(phrase(problem))}")
@@ -64,12 +68,19 @@ def finger(
     keyboard = fit_keyboard(song, reading).keyboard
     piece = load_for_hand(song, reading.options, keyboard, hand_spec)
     check_playable(piece.without_fingering(), keyboard, hand_spec, reading.options.transpose)  # (the whole shift)
+    had = sum(n.finger is not None for n in piece.notes)
     piece, plan = ensure_fingering(piece, keyboard, hand_spec, refinger=True)
     write_midi(piece, output, name=f"{song.stem} fingered by pianobot")
     out.print(display.notes_table(piece, split_phrases(piece, DEFAULT_MAX_NOTES), None if all_rows else display.ROWS))
     out.print(
         f"fingering for fingers {hand_spec.describe()} written to {said(output)}: wrist travel {plan.travel * 100:.1f} cm "
-        f"in {plan.moves} moves over {len(piece)} notes"
+        f"in {plan.moves} move{'s' * (plan.moves != 1)} over {len(piece)} notes"
     )
     for problem in plan.problems:
         out.print(f"[yellow]cannot be played at this tempo:[/yellow] {said(phrase(problem))}")
+    if had:
+        out.print(
+            f"[yellow]the file's own fingering ({had} of {len(piece)} notes) was replaced by the planner's[/yellow] "
+            "(play the file itself to play as it is fingered)",
+            soft_wrap=True,
+        )

@@ -107,7 +107,7 @@ def inspect(
     piece, plan = ensure_fingering(piece, keyboard, hand_spec, options.refinger)
     if plan is not None:
         console.print(
-            f"fingering planned for fingers {hand_spec.describe()}: wrist travel {plan.travel * 100:.1f} cm in {plan.moves} moves"
+            f"fingering planned for fingers {hand_spec.describe()}: wrist travel {plan.travel * 100:.1f} cm in {plan.moves} move{'s' * (plan.moves != 1)}"
         )
         for problem in plan.problems:
             console.print(f"[yellow]{said(phrase(problem))}[/yellow]")
@@ -153,7 +153,7 @@ def _summary(piece, tempi: list[float] | None = None) -> tuple[str, dict]:
     if tempi and len(tempi) > 1:
         tempo += f", then {len(tempi) - 1} other tempo{'s' * (len(tempi) > 2)} ({min(tempi):.0f}-{max(tempi):.0f} bpm)"
     line = (
-        f"{len(piece)} notes, {piece.duration:.2f} s at {tempo}; range {pitch_name(low)}-{pitch_name(high)} "
+        f"{len(piece)} note{'s' * (len(piece) != 1)}, {piece.duration:.2f} s at {tempo}; range {pitch_name(low)}-{pitch_name(high)} "
         f"({high - low} semitones); at most {polyphony} note{'s' * (polyphony != 1)} at once; velocities {velocities[0]}-{velocities[-1]}; "
         f"{given}/{len(piece)} notes fingered in the file"
     )

@@ -60,6 +60,7 @@ def train(
         TrainConfig.steps,
         "--steps",
         help="Environment steps per phrase (of all --envs together), exploration included.",
+        min=1,
     ),
     seed: int = typer.Option(
         TrainConfig.seed,
