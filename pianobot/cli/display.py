@@ -73,11 +73,13 @@ def notes_table(piece: Piece, phrases: list[Phrase], rows: int | None = ROWS) ->
     return table
 
 
-def phrases_table(phrases: list[Phrase], trained: set[int] | None = None, rows: int | None = ROWS) -> Table:
-    """The phrases (the first ``rows``; None: all); with ``trained`` (indices of the phrases with
-    a stored policy), a column saying which are trained."""
+def phrases_table(phrases: list[Phrase], players: dict[int, str] | None = None, rows: int | None = ROWS) -> Table:
+    """The phrases (the first ``rows``; None: all); with ``players`` (who plays each phrase, by
+    index: :func:`~pianobot.perform.compose.phrase_players`), a column saying so."""
     table = Table(title=f"{len(phrases)} phrase{'s' * (len(phrases) != 1)}")
-    columns = ("phrase", "hash", "notes", "start s", "end s", "pitches") + (("policy",) if trained is not None else ())
+    columns = ("phrase", "hash", "notes", "start s", "end s", "pitches") + (
+        ("played by",) if players is not None else ()
+    )
     for column in columns:
         table.add_column(column)
     for p in phrases[: _shown(table, len(phrases), rows, "phrases")]:
@@ -89,8 +91,9 @@ def phrases_table(phrases: list[Phrase], trained: set[int] | None = None, rows: 
             f"{p.end:.3f}",
             " ".join(n.name for n in p.notes),
         ]
-        if trained is not None:
-            row.append("trained" if p.index in trained else "[yellow]none[/yellow]")
+        if players is not None:
+            who = players[p.index]
+            row.append(who if who == "own policy" else f"[yellow]{who}[/yellow]")
         table.add_row(*row)
     return table
 

@@ -83,6 +83,22 @@ def missing_phrases(models: Path, phrases: list[Phrase]) -> list[Phrase]:
     return [p for p in phrases if p.hash not in covered]
 
 
+def phrase_players(models: Path, phrases: list[Phrase]) -> dict[int, str]:
+    """Who the store says plays each phrase, by index, in words: 'own policy', 'general policy
+    (judged better)' where the store's index says the general policy plays it (training kept the
+    general policy, or the phrase's own policy made its piece play worse), else 'general policy
+    (untrained)'. A policy of its own is a folder for the phrase, of any configuration."""
+    own, general = store.trained_keys(models), {key.rsplit("-", 1)[0] for key in store.general_plays(models)}
+    return {
+        p.index: "general policy (judged better)"
+        if p.hash in general
+        else "own policy"
+        if p.hash in own
+        else "general policy (untrained)"
+        for p in phrases
+    }
+
+
 def trained_split(models: Path, piece: Piece, phrase_notes: int | None) -> list[Phrase]:
     """The piece's phrases for compositional play.
 

@@ -44,7 +44,7 @@ def inspect(
     from pianobot.music import midi_io
     from pianobot.music.instrument import check_playable
     from pianobot.music.load import HANDS, hand_tracks
-    from pianobot.perform.compose import missing_phrases, trained_split
+    from pianobot.perform.compose import missing_phrases, phrase_players, trained_split
     from pianobot.pianist.fingering import ensure_fingering
     from pianobot.pianist.reduce import load_for_hand
 
@@ -115,7 +115,8 @@ def inspect(
     rows = None if all_rows else display.ROWS
     console.print(display.notes_table(piece, phrases, rows))
     missing = {p.index for p in missing_phrases(models, phrases)}
-    console.print(display.phrases_table(phrases, {p.index for p in phrases} - missing, rows))
+    players = phrase_players(models, phrases)
+    console.print(display.phrases_table(phrases, players, rows))
     check_playable(piece, keyboard, hand_spec)
     console.print(f"[green]playable[/green] on {keyboard.describe()} with fingers {hand_spec.describe()}")
     if json_path is not None:
@@ -135,6 +136,7 @@ def inspect(
                         "start": p.start,
                         "end": p.end,
                         "trained": p.index not in missing,
+                        "played_by": players[p.index],
                     }
                     for p in phrases
                 ],
