@@ -25,8 +25,20 @@ def test_train_json_to_standard_output_and_a_summary_that_keeps_whole_paths(tmp_
     folder = Path(policies[0]["folder"])
     assert folder.parent == models and (folder / "training.csv").exists() and Path(policies[0]["plot"]).exists()
     assert "…" not in result.stderr  # no path cut short in the summary
+    assert "learning curves: training.csv" in " ".join(result.stderr.split())
     again = run("train", EXAMPLES / "one-note.mid", *QUICK, "--models", models, "--json", tmp_path / "t.json")
     assert again.exit_code == 0 and json.loads((tmp_path / "t.json").read_text())["policies"][0]["trained_now"] is False
+    assert "already trained in" in again.output
+    # the store's index says the general policy plays the phrase (no folder): said so, not "trained in" a
+    # folder that is not there, and no learning curves are promised
+    import shutil
+
+    shutil.rmtree(folder)
+    (models / "general-plays.json").write_text(json.dumps({folder.name: {"why": "kept its start"}}))
+    judged = run("train", EXAMPLES / "one-note.mid", *QUICK, "--models", models)
+    text = " ".join(judged.output.split())
+    assert judged.exit_code == 0 and "played by the general policy" in text and "already trained" not in text
+    assert "learning curves" not in text
 
 
 def test_train_warns_about_more_threads_than_cores_and_workers_with_a_task(tmp_path, monkeypatch):

@@ -317,8 +317,13 @@ def train(
         done = [job for *_, jobs in planned for job in jobs]
     models.mkdir(parents=True, exist_ok=True)
     for job in done:
+        where = (
+            f"already trained in {said(job.folder)}"
+            if store.is_trained(job.folder)
+            else f"played by the general policy, as {said(models)}'s index ({store.GENERAL_INDEX}) says"
+        )
         console.print(
-            f"phrase {job.key} ({', '.join(map(str, job.phrases))}) already trained in {said(job.folder)}: skipped (--force retrains)"
+            f"phrase {job.key} ({', '.join(map(str, job.phrases))}) {where}: skipped (--force retrains)", soft_wrap=True
         )
     console.print(f"training {len(todo)} polic{'y' if len(todo) == 1 else 'ies'} for {said(label)}, {steps} steps each")
     returns: dict[str, float] = {}
@@ -368,7 +373,8 @@ def train(
 
     trained = [(job, manifest(job)) for job in done + todo]
     console.print(display.training_table(trained))
-    console.print(f"learning curves: {LOG_FILE} and {PLOT_FILE} in each policy's folder")
+    if any((job.folder / LOG_FILE).exists() for job, _ in trained):
+        console.print(f"learning curves: {LOG_FILE} and {PLOT_FILE} in each policy's folder")
     verdict = None
     judges = {}  # the general policy each hand's phrases are judged beside: the one they started from, else play's
     if task is None and todo:
@@ -394,8 +400,20 @@ def train(
         before, after = sum(verdict.before) / len(JUDGE_SEEDS), sum(verdict.after) / len(JUDGE_SEEDS)
         console.print(
             f"{said(song.name)}: note F1 {before:.3f} with the general polic{'y' if hands is None else 'ies'} alone, "
-            f"{after:.3f} as it plays now (own policies for phrases {', '.join(map(str, verdict.used)) or 'none'})"
+            f"{after:.3f} as it plays now ("
+            + (
+                f"own policies for phrases {', '.join(map(str, verdict.used))}"
+                if verdict.used
+                else "no phrase policy of its own"
+            )
+            + ")"
         )
+        if not verdict.used and after < 1.0 and all(m.get("kept") == "start" for job, m in trained if job in todo):
+            console.print(
+                "[yellow]every phrase played well enough from a fresh start, so none was trained; played whole, the "
+                "hand goes on from where each phrase left it, which the phrase-by-phrase evaluation does not see[/yellow]",
+                soft_wrap=True,
+            )
         for number, why in verdict.dropped.items():
             console.print(f"[yellow]phrase {number}'s own policy is not used: {said(why)}[/yellow]")
     if json_path is not None:
