@@ -627,3 +627,16 @@ def test_a_melody_written_legato_plays_as_one_hand(tmp_path):
     assert ended.notes[-1] == notes[-1]  # (the last overlaps nothing)
     held = Piece((Note(0.0, 60, 2.0, 80), Note(0.5, 64, 1.0, 80)))  # a note held under another: kept
     assert end_legato(held) is held
+
+
+def test_score_says_which_option_a_low_score_may_lack(tmp_path):
+    """A performance played with --transpose 5 (or --tempo 40) scored without it read 0 of 14 notes
+    and said nothing; score now names the option. A performance scored as played gets no hint."""
+    song = EXAMPLES / "twinkle.mid"
+    for option, value, words in (("--transpose", "5", "lie 5 semitones above"), ("--tempo", "40", "lasts 24.0 s")):
+        played = tmp_path / f"{option[2:]}.mid"
+        assert run("play", song, "-o", played, "--controller", "scripted", option, value, "--quiet").exit_code == 0
+        bare = " ".join(run("score", played, song, "--no-notes").output.split())
+        assert words in bare and f"played with {option}" in bare, bare
+        same = run("score", played, song, option, value, "--no-notes").output
+        assert "score it with the same option" not in same

@@ -80,6 +80,9 @@ def score(
     if scores.hands:
         console.print(display.hands_scores_table(scores))
     display.print_all(console, display.report_tables(report, every, None if notes else 0))
+    hint = mismatch_hint(reference_piece, played_piece, report.f1, onset_tolerance)
+    if hint:
+        console.print(f"[yellow]{hint}[/yellow]", soft_wrap=True)
     if json_path is not None:
         hands = {"hands": {hand: r.summary() for hand, r in scores.hands.items()}} if scores.hands else {}
         write_json(json_path, {**report.to_dict(), **hands})
@@ -93,3 +96,37 @@ def score(
 
         write_html(html, report, f"{played.name} against {reference.name}", scores=scores)
         console.print(f"report to open in a browser written to {said(html)}")
+
+
+def mismatch_hint(reference, played, f1: float, tolerance: float) -> str:
+    """Where a performance scores low against its reference (note F1 under 0.5), what reading
+    option may differ: every note shifted by the same interval (``--transpose``), or a performance
+    much longer or shorter than the reference (``--tempo``); '' where neither."""
+    if f1 >= 0.5 or not reference.notes or not played.notes:
+        return ""
+    import bisect
+
+    onsets = sorted((n.onset, n.pitch) for n in reference.notes)
+    times = [t for t, _ in onsets]
+
+    def matched(shift: int) -> int:
+        count = 0
+        for note in played.notes:
+            low = bisect.bisect_left(times, note.onset - tolerance)
+            high = bisect.bisect_right(times, note.onset + tolerance)
+            count += any(pitch == note.pitch - shift for _, pitch in onsets[low:high])
+        return count
+
+    best = max(range(-48, 49), key=lambda shift: (matched(shift), -abs(shift)))
+    if best != 0 and matched(best) >= 0.8 * min(len(played), len(reference)):
+        return (
+            f"{matched(best)} of the {len(played)} played notes lie {abs(best)} semitones {'above' if best > 0 else 'below'} "
+            f"the reference's: if the piece was played with --transpose {best}, score it with the same option"
+        )
+    ratio = played.duration / reference.duration if reference.duration else 1.0
+    if not 0.8 <= ratio <= 1.25:
+        return (
+            f"the performance lasts {played.duration:.1f} s and the reference {reference.duration:.1f} s: if the "
+            "piece was played with --tempo, score it with the same option"
+        )
+    return ""
