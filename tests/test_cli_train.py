@@ -187,3 +187,27 @@ def test_a_ray_worker_killed_mid_phrase_is_run_again_from_its_checkpoint(tmp_pat
     assert resumed and resumed[0] >= 50  # the second run began at the checkpoint, not at step 0
     manifest = results[job.key]
     assert manifest["steps"] >= 150 and (job.folder / store.POLICY_FILE).exists()
+
+
+def test_train_says_why_nothing_was_trained_where_the_whole_piece_still_loses_notes(tmp_path, monkeypatch):
+    """Every phrase plays at its stop F1 from a fresh start, so none is trained; where the piece
+    played whole still loses notes (here made so), one line says what the phrase-by-phrase
+    evaluation does not see, where before the run ended in silence (a new user's trial)."""
+    import dataclasses
+
+    import pianobot.learn.accept as accept
+
+    settle = accept.settle_piece
+
+    def losing(*args, **kwargs):
+        verdict = settle(*args, **kwargs)
+        return dataclasses.replace(verdict, before=(0.9,) * len(verdict.before), after=(0.9,) * len(verdict.after))
+
+    monkeypatch.setattr(accept, "settle_piece", losing)
+    args = ("train", EXAMPLES / "c-major-scale.mid", "--steps", "60", "--learner", "dagger", "--round-steps", "30")
+    result = run(*args, "--models", tmp_path)
+    text = " ".join(result.output.split())
+    assert result.exit_code == 0, result.output
+    assert "no phrase policy of its own" in text and "so none was trained" in text
+    monkeypatch.setattr(accept, "settle_piece", settle)  # the piece as it plays: whole, nothing to say
+    assert "so none was trained" not in run(*args, "--models", tmp_path / "again").output
