@@ -130,13 +130,19 @@ class StrikePlanner:
 
     def held(self, score: np.ndarray, previous_row: np.ndarray | None) -> dict[int, int]:
         """Each finger's note that began earlier and is written to sound now, by finger: its key."""
-        out = {}
         if previous_row is None:
-            return out
+            return {}
+        now, before = score[0], previous_row  # (only the first row counts: no need to read the window's runs)
+        out = {}
         for slot, finger in enumerate(self.fingers):
-            for run in finger_runs(score, slot):
-                if run.start == 0 and previous_row[run.key, NOTE] > 0.5 and previous_row[run.key, FINGER + slot] > 0.5:
-                    out[finger] = run.key
+            keys = np.flatnonzero(
+                (now[:, NOTE] > 0.5)
+                & (now[:, FINGER + slot] > 0.5)
+                & (before[:, NOTE] > 0.5)
+                & (before[:, FINGER + slot] > 0.5)
+            )
+            if keys.size:
+                out[finger] = int(keys[-1])
         return out
 
     # -- speed, depth and timing of one strike -----------------------------------------------------
