@@ -261,6 +261,10 @@ def find_policies(root: Path, key: str) -> list[Path]:
     return sorted(found, key=saved_at, reverse=True)
 
 
+DEFAULT_STORE = Path("models")
+"""The model store commands read and write by default (``--models``): ``models`` in the working folder,
+which may be absent (the packaged policies then play)."""
+
 GENERAL_INDEX = "general-plays.json"
 """The store's index of the phrases the general policy plays (:func:`general_plays`)."""
 

@@ -16,6 +16,7 @@ from typing import Optional
 import typer
 
 from pianobot.agent.config import ACTORS, DEVICES
+from pianobot.agent.store import DEFAULT_STORE
 from pianobot.env.rewards import REWARDS
 from pianobot.errors import PianobotError, PianobotWarning, SettingError, quote
 from pianobot.learn.config import LEARNERS
@@ -200,10 +201,6 @@ def check_midi_output(output: Path, song: Path, what: str) -> None:
         raise PianobotError(f"-o {output}: {what} is a MIDI file, name it *.mid")
     if os.path.realpath(output) == os.path.realpath(song):  # (realpath: a symbolic-link loop is no crash)
         raise PianobotError(f"-o {output} would overwrite the input {song.name}: choose another file name")
-
-
-DEFAULT_STORE = Path("models")
-"""--models' default: the model store in the working folder (may be absent: the packaged policies play)."""
 
 
 def check_models(models: Path) -> None:

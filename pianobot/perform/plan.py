@@ -44,7 +44,7 @@ from pianobot.sim.hand import HandConfig
 from pianobot.sim.keyboard import KeyboardConfig
 from pianobot.sim.world import WorldConfig
 
-DEFAULT_MODELS = Path("models")
+DEFAULT_MODELS = store.DEFAULT_STORE
 """The model store when none is named: ``models`` in the current folder (where ``pianobot train``
 writes). The general policy that ships with pianobot is found from anywhere besides."""
 

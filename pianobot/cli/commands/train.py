@@ -12,6 +12,7 @@ import typer
 
 from pianobot.agent.config import ACTORS, SACConfig
 from pianobot.cli.options import (
+    DEFAULT_STORE,
     Actor,
     Cluster,
     Control,
@@ -158,7 +159,7 @@ def train(
         help="Reward a key only when the score's finger pressed it (the paper's fingering indicator).",
     ),
     force: bool = typer.Option(False, "--force", help="Retrain phrases that already have a stored policy."),
-    models: Path = typer.Option(Path("models"), "--models", help="Folder of the model store."),
+    models: Path = typer.Option(DEFAULT_STORE, "--models", help="Folder of the model store."),
     cluster: Cluster = typer.Option(
         "local",
         "--cluster",
