@@ -41,7 +41,7 @@ import torch
 from benchmarks.hands import figures
 from pianobot.agent.general import left_hand_policy
 from pianobot.errors import PianobotError, PianobotWarning
-from pianobot.music.instrument import HandSpec
+from pianobot.music.instrument import THUMB, HandSpec
 from pianobot.music.load import LoadOptions
 from pianobot.perform.hands import two_hands
 
@@ -214,7 +214,7 @@ def main() -> None:
     except ImportError:
         parser.error('music21 is not installed: pip install -e ".[corpus]"')
     started = time.perf_counter()
-    hand = HandSpec(fingers=(1, 2, 3, 4)) if args.thumb else HandSpec()
+    hand = THUMB if args.thumb else HandSpec()
     rows = play_corpus(args.out, tuple(args.only), together=not args.apart, hand=hand, general=args.general)
     seconds = time.perf_counter() - started
     print()

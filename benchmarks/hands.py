@@ -50,7 +50,7 @@ import torch
 
 from pianobot.errors import PianobotWarning
 from pianobot.music.duets import duet_set, random_duet
-from pianobot.music.instrument import HandSpec, KeyboardSpec
+from pianobot.music.instrument import THUMB, HandSpec, KeyboardSpec
 from pianobot.music.load import LoadOptions
 from pianobot.music.piece import parse_pitch
 from pianobot.perform.hands import play_hands, two_hands
@@ -264,7 +264,7 @@ def main() -> None:
     parser.add_argument("--thumb", action="store_true", help="each hand with its thumb too (as play --thumb)")
     parser.add_argument("--json", help="write every piece's figures here")
     args = parser.parse_args()
-    hand = HandSpec((1, 2, 3, 4)) if args.thumb else None
+    hand = THUMB if args.thumb else None
     if (args.lowest_note is None) != (args.keys is None):
         parser.error("--lowest-note and --keys go together")
     keyboard = KeyboardSpec(args.lowest_note, args.keys) if args.keys is not None else None

@@ -21,7 +21,7 @@ from pianobot.env.rewards import REWARDS
 from pianobot.errors import PianobotError, PianobotWarning, SettingError, quote
 from pianobot.learn.config import LEARNERS
 from pianobot.learn.explore import EXPLORATIONS
-from pianobot.music.instrument import PIANO, HandSpec, KeyboardSpec
+from pianobot.music.instrument import PIANO, THUMB, HandSpec, KeyboardSpec
 from pianobot.music.load import HANDS, LoadOptions
 from pianobot.music.phrases import DEFAULT_MAX_NOTES
 from pianobot.music.piece import Piece, parse_pitch, pitch_name
@@ -163,7 +163,7 @@ def make_reading(**given) -> Reading:
             refinger=values["refinger"],
         ),
         keyboard=keyboard,
-        hand=HandSpec(fingers=(1,) + HandSpec.fingers if values["thumb"] else HandSpec.fingers),
+        hand=THUMB if values["thumb"] else HandSpec(),
         keyboard_named=named,
     )
 

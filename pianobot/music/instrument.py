@@ -111,6 +111,10 @@ class HandSpec:
         return ", ".join(f"{f} ({FINGER_NAMES[f]})" for f in self.fingers)
 
 
+THUMB = HandSpec(fingers=(1,) + HandSpec.fingers)
+"""The hand with its thumb too (``--thumb``: fingers 1-4)."""
+
+
 def suggest_transpose(piece: Piece, keyboard: KeyboardSpec) -> int | None:
     """The smallest shift (octaves preferred) that brings every note onto the keyboard, if any."""
     low = min(n.pitch for n in piece.notes)

@@ -40,7 +40,7 @@ from pianobot.agent.general import left_hand_policy
 from pianobot.errors import PianobotError, PianobotWarning, SettingError
 from pianobot.music import midi_io
 from pianobot.music.hand_scores import HandsReport, compare_hands
-from pianobot.music.instrument import HandSpec, KeyboardSpec, check_playable, suggest_transpose
+from pianobot.music.instrument import THUMB, HandSpec, KeyboardSpec, check_playable, suggest_transpose
 from pianobot.music.load import LoadOptions, end_legato, load_hands, load_piece, thin_hand
 from pianobot.music.metrics import Report
 from pianobot.music.piece import HANDS, Note, Piece, pitch_name
@@ -364,10 +364,6 @@ def prepare_part(
     reduced = reduce_hand(thinned, window.keyboard, fingers, hand)
     fingered, _ = ensure_fingering(reduced, window.keyboard, fingers, refinger=True)
     return window, fingered, start, left_out
-
-
-THUMB = HandSpec(fingers=(1,) + HandSpec.fingers)
-"""A hand with its thumb too (``--thumb``)."""
 
 
 def given_with_thumbs(
