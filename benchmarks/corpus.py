@@ -20,10 +20,12 @@ has fingers) count as missed. ``notes`` is the file as ``pianobot play`` reads i
 more notes than two hands have fingers thinned), ``notes given`` how many of them the hands were
 given to play after that reduction: the most a player can strike. ``--apart`` plays each hand in a
 simulation of its own (``pianobot.perform.hands.play_hands(..., together=False)``): what the
-hands lose by getting in each other's way. ``--thumb`` gives each hand its thumb as well
-(``pianobot play --thumb``), and the general policy plays where one for that hand is packaged
-(else the scripted pianist alone plays); ``--general DIR`` names the general policy to play
-both hands.
+hands lose by getting in each other's way. The hands' fingers are chosen per file as ``pianobot
+play`` chooses them (:func:`pianobot.perform.hands.fingers_for_file`: the thumbs too where they
+keep notes three fingers leave out; the row's ``fingers``); ``--thumb`` gives each hand its thumb
+everywhere (``pianobot play --thumb``), ``--no-thumb`` three fingers everywhere; the general
+policy plays where one for that hand is packaged (else the scripted pianist alone plays);
+``--general DIR`` names the general policy to play both hands.
 """
 
 from __future__ import annotations
@@ -43,7 +45,7 @@ from pianobot.agent.general import left_hand_policy
 from pianobot.errors import PianobotError, PianobotWarning
 from pianobot.music.instrument import THUMB, HandSpec
 from pianobot.music.load import LoadOptions
-from pianobot.perform.hands import two_hands
+from pianobot.perform.hands import fingers_for_file, two_hands
 
 EXCERPTS = (
     # (name, music21 corpus path, the parts that are the piano's staves (None: all), first measure)
@@ -113,25 +115,28 @@ def play_corpus(
     folder: Path,
     only: tuple[str, ...] = (),
     together: bool = True,
-    hand: HandSpec = HandSpec(),
+    hand: HandSpec | None = None,
     general: Path | None = None,
 ) -> list[dict]:
     """Write the excerpts to ``folder`` and play each with both players (``together``: both hands
-    in one simulation, as ``pianobot play`` plays them; ``hand``: each hand's fingers; ``general``:
+    in one simulation, as ``pianobot play`` plays them; ``hand``: each hand's fingers, default
+    chosen per file as ``pianobot play`` chooses them; ``general``:
     the general policy on both hands, default the packaged one for ``hand``, and where none is
     packaged for it the scripted pianist alone plays); a row each."""
     folder.mkdir(parents=True, exist_ok=True)
-    plays = general is not None or left_hand_policy(None, None, hand) is not None
     rows = []
     for name, path, parts, first in EXCERPTS:
         if only and name not in only:
             continue
         file = folder / f"{name}.mid"
         row = {"piece": name, **write_excerpt(path, parts, first, file)}
+        fingers = hand if hand is not None else fingers_for_file(file, LoadOptions())[0]
+        plays = general is not None or left_hand_policy(None, None, fingers) is not None
+        row["fingers"] = list(fingers.fingers)
         try:
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore", PianobotWarning)
-                reading = two_hands(file, LoadOptions(), hand)
+                reading = two_hands(file, LoadOptions(), fingers)
         except PianobotError as error:  # (refused: the row says why)
             rows.append({**row, "refused": str(error)})
             print(f"{name}: refused: {error}", flush=True)
@@ -142,11 +147,11 @@ def play_corpus(
             continue
         with tempfile.TemporaryDirectory() as models:  # (an empty store: the packaged policies play)
             piece = reading.piece
-            policy = figures(piece, "sac", models, general, together=together, hand=hand) if plays else None
+            policy = figures(piece, "sac", models, general, together=together, hand=fingers) if plays else None
             row.update(
                 notes=len(piece),
                 sac=policy,
-                scripted=figures(piece, "scripted", models, together=together, hand=hand),
+                scripted=figures(piece, "scripted", models, together=together, hand=fingers),
             )
         rows.append(row)
         said = f"{row['sac']['f1']:.3f}" if row["sac"] else "n/a"
@@ -158,23 +163,24 @@ def table(rows: list[dict]) -> str:
     """The rows as Markdown; "notes given" as the general policy was given them (the scripted
     pianist's where the general policy did not play: ``--thumb``)."""
     lines = [
-        "| piece | corpus path (measures) | notes | notes given | note F1, general policy | right | left | "
+        "| piece | corpus path (measures) | fingers | notes | notes given | note F1, general policy | right | left | "
         "per-step F1, general policy | note F1, scripted pianist | general / scripted |",
-        "| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |",
+        "| --- | --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |",
     ]
     played = [r for r in rows if "refused" not in r]
     for r in rows:
         where = f"`{r['source']}` ({r['measures']})"
         if "refused" in r:
-            lines.append(f"| {r['piece']} | {where} | | | refused: {r['refused']} | | | | | |")
+            lines.append(f"| {r['piece']} | {where} | | | | refused: {r['refused']} | | | | | |")
             continue
         g, s = r["sac"], r["scripted"]
         general = (
             f"{g['f1']:.3f} | {g['f1_right']:.3f} | {g['f1_left']:.3f} | {g['step_f1']:.3f}" if g else "n/a | | | n/a"
         )
         share = _share(g["f1"], s["f1"]) if g else "n/a"
+        fingers = "-".join(str(f) for f in r["fingers"][:: len(r["fingers"]) - 1]) if r.get("fingers") else ""
         lines.append(
-            f"| {r['piece']} | {where} | {r['notes']} | {(g or s)['given']} | {general} | {s['f1']:.3f} | {share} |"
+            f"| {r['piece']} | {where} | {fingers} | {r['notes']} | {(g or s)['given']} | {general} | {s['f1']:.3f} | {share} |"
         )
     if played:
         given = sum((r["sac"] or r["scripted"])["given"] for r in played) / sum(r["notes"] for r in played)
@@ -183,7 +189,7 @@ def table(rows: list[dict]) -> str:
         general = np.mean([r["sac"]["f1"] for r in with_general]) if with_general else None
         steps = np.mean([r["sac"]["step_f1"] for r in with_general]) if with_general else None
         lines.append(
-            f"| mean ({len(played)} played) | | | {given:.0%} given | "
+            f"| mean ({len(played)} played) | | | | {given:.0%} given | "
             + (f"{general:.3f} | | | {steps:.3f}" if general is not None else "n/a | | | n/a")
             + f" | {scripted:.3f} | {_share(general, scripted) if general is not None else 'n/a'} |"
         )
@@ -200,7 +206,9 @@ def main() -> None:
     parser.add_argument("--only", nargs="+", default=(), help="only these excerpts (by name)")
     parser.add_argument("--json", type=Path, help="write every figure to this file")
     parser.add_argument("--apart", action="store_true", help="each hand in a simulation of its own")
-    parser.add_argument("--thumb", action="store_true", help="each hand with its thumb too")
+    fingers = parser.add_mutually_exclusive_group()
+    fingers.add_argument("--thumb", action="store_true", help="each hand with its thumb too, in every file")
+    fingers.add_argument("--no-thumb", action="store_true", help="three fingers in every file")
     parser.add_argument(
         "--general",
         type=Path,
@@ -214,18 +222,19 @@ def main() -> None:
     except ImportError:
         parser.error('music21 is not installed: pip install -e ".[corpus]"')
     started = time.perf_counter()
-    hand = THUMB if args.thumb else HandSpec()
+    hand = THUMB if args.thumb else HandSpec() if args.no_thumb else None  # (None: as play chooses)
     rows = play_corpus(args.out, tuple(args.only), together=not args.apart, hand=hand, general=args.general)
     seconds = time.perf_counter() - started
     print()
     print(table(rows))
-    how = ("each hand apart; " if args.apart else "") + ("with thumbs; " if args.thumb else "")
+    chosen = "with thumbs; " if args.thumb else "three fingers; " if args.no_thumb else "fingers as play chooses; "
+    how = ("each hand apart; " if args.apart else "") + chosen
     print(f"\nmusic21 {music21.__version__}; {how}{seconds:.0f} s")
     if args.json:
         record = {
             "music21": music21.__version__,
             "apart": args.apart,
-            "thumb": args.thumb,
+            "thumb": True if args.thumb else False if args.no_thumb else "as play chooses",
             "general": None if args.general is None else str(args.general),
             "seconds": round(seconds),
             "rows": rows,

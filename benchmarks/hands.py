@@ -3,7 +3,8 @@ beside the scripted pianist, against the pieces as written.
 
     python -m benchmarks.hands [--duets 50] [--seed 35] [--polyphonic 20] [--general DIR]
                                [--general-left DIR] [--parts DIR] [--apart] [--hold-guard | --no-hold-guard]
-                               [--examples [FOLDER]] [--lowest-note C2 --keys 48] [--json out.json]
+                               [--examples [FOLDER]] [--lowest-note C2 --keys 48] [--thumb | --no-thumb]
+                               [--json out.json]
 
 (``python -m benchmarks.zeroshot --sets duets polyphonic`` plays the same sets beside the
 one-hand ones.)
@@ -27,7 +28,10 @@ is an empty folder;
 left's; ``--parts`` the parts policy, in its place on the hands it plays; through the hold guard,
 as ``play`` plays them, unless ``--no-hold-guard``) and by the scripted pianist; each part on
 the keys its player takes (the general policy's 24, or a wider part's own octaves; the scripted
-pianist's own), or with ``--lowest-note``/``--keys`` on those keys for both players.
+pianist's own), or with ``--lowest-note``/``--keys`` on those keys for both players. Both hands
+take their thumbs where that gives them more of the notes than three fingers, as ``pianobot play``
+chooses (:func:`pianobot.perform.hands.thumbs_keep_more`; a polyphonic part: for the part alone;
+each row's ``fingers``), everywhere with ``--thumb``, nowhere with ``--no-thumb``.
 A polyphonic part is played as ``play`` plays that hand of a two-hand file: by the parts policy (the
 packaged left hand's), the left hands and the right hands alike (``pianobot play`` of a one-hand
 file gives the melody policy a right hand, polyphonic or not). Prints a
@@ -53,7 +57,7 @@ from pianobot.music.duets import duet_set, random_duet
 from pianobot.music.instrument import THUMB, HandSpec, KeyboardSpec
 from pianobot.music.load import LoadOptions
 from pianobot.music.piece import parse_pitch
-from pianobot.perform.hands import play_hands, two_hands
+from pianobot.perform.hands import fingers_for_file, play_hands, two_hands
 
 PLAYERS = ("sac", "scripted")
 POLYPHONIC = ("block", "voices", "right-voices")
@@ -88,6 +92,7 @@ def figures(
         "f1_offsets": whole.f1_with_offsets,
         "left_out": sum(h.left_out for h in performance.hands),
         "given": sum(len(h.part) for h in performance.hands),  # (what the reduction left the hands to play)
+        "fingers": list(performance.hands[0].performance.plan.config.world.hand.spec.fingers),
     }
     for hand in piece.hands:
         out[f"f1_{hand}"] = performance.report(hand).f1
@@ -149,7 +154,8 @@ def play_set(
     parts policy, :func:`with_parts`; ``hold_guard``: the general policies through the hold guard,
     as ``pianobot play`` plays them; ``keyboard``: every part on these keys, as ``pianobot play
     --lowest-note/--keys`` plays it, else each player's own; ``hand``: each hand's fingers, as
-    ``pianobot play --thumb`` gives them)."""
+    ``pianobot play --thumb`` gives them; default: as :func:`~pianobot.perform.hands.play_hands`
+    chooses them for each piece)."""
     rows = []
     with tempfile.TemporaryDirectory() as models:
         for label, piece in pieces:
@@ -167,28 +173,28 @@ def play_set(
     return rows
 
 
-def example_set(folder: Path, hand: HandSpec | None = None) -> list[tuple[str, object]]:
-    """The files in ``folder`` that ``pianobot play`` plays with both hands, each as it reads them
-    (for ``hand``'s fingers, default three)."""
+def example_set(folder: Path, hand: HandSpec | None = None) -> list[tuple[str, object, HandSpec]]:
+    """The files in ``folder`` that ``pianobot play`` plays with both hands, each as it reads them,
+    with the hands' fingers: ``hand``'s, default as ``pianobot play`` chooses them for the file
+    (:func:`~pianobot.perform.hands.fingers_for_file`)."""
     out = []
     for path in sorted(folder.glob("*.mid")):
+        fingers = hand if hand is not None else fingers_for_file(path, LoadOptions())[0]
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", PianobotWarning)
-            reading = two_hands(path, LoadOptions(), hand or HandSpec())
+            reading = two_hands(path, LoadOptions(), fingers)
         if reading is not None:
-            out.append((path.stem, reading.piece))
+            out.append((path.stem, reading.piece, fingers))
     return out
 
 
-def play_examples(
-    pieces, general=None, hold_guard: bool | None = None, starts=EXAMPLE_STARTS, hand: HandSpec | None = None
-) -> list[dict]:
-    """Each two-hand example as ``pianobot play`` plays it: the general policies from each of
-    ``starts`` (hand starts: ``--seed``), the scripted pianist from 0 (``hand``: as :func:`play_set`'s);
-    each play's figures."""
+def play_examples(pieces, general=None, hold_guard: bool | None = None, starts=EXAMPLE_STARTS) -> list[dict]:
+    """Each two-hand example (:func:`example_set`'s: with its hands' fingers) as ``pianobot play``
+    plays it: the general policies from each of ``starts`` (hand starts: ``--seed``), the scripted
+    pianist from 0; each play's figures."""
     rows = []
     with tempfile.TemporaryDirectory() as models:
-        for label, piece in pieces:
+        for label, piece, hand in pieces:
             general_figures = [figures(piece, "sac", models, general, True, hold_guard, s, hand=hand) for s in starts]
             scripted = figures(piece, "scripted", models, hand=hand)
             rows.append({"piece": label, "notes": len(piece), "sac": general_figures, "scripted": scripted})
@@ -261,10 +267,12 @@ def main() -> None:
         "--keys`), notes outside them left out; default: each player's own",
     )
     parser.add_argument("--keys", type=int, help="how many keys, from --lowest-note")
-    parser.add_argument("--thumb", action="store_true", help="each hand with its thumb too (as play --thumb)")
+    fingers = parser.add_mutually_exclusive_group()
+    fingers.add_argument("--thumb", action="store_true", help="each hand with its thumb too (as play --thumb)")
+    fingers.add_argument("--no-thumb", action="store_true", help="three fingers on each hand (as play --no-thumb)")
     parser.add_argument("--json", help="write every piece's figures here")
     args = parser.parse_args()
-    hand = THUMB if args.thumb else None
+    hand = THUMB if args.thumb else HandSpec() if args.no_thumb else None  # (None: as play_hands chooses)
     if (args.lowest_note is None) != (args.keys is None):
         parser.error("--lowest-note and --keys go together")
     keyboard = KeyboardSpec(args.lowest_note, args.keys) if args.keys is not None else None
@@ -283,7 +291,7 @@ def main() -> None:
         print(table(name, results[name]), flush=True)
     if args.examples is not None:
         general = {"right": args.general, "left": args.general_left} if args.general_left else args.general
-        results["examples"] = play_examples(example_set(args.examples, hand), general, args.hold_guard, hand=hand)
+        results["examples"] = play_examples(example_set(args.examples, hand), general, args.hold_guard)
         print(example_table(results["examples"]), flush=True)
     print(f"{time.perf_counter() - started:.0f} s")
     if args.json:

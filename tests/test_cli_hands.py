@@ -117,37 +117,48 @@ def test_a_one_hand_melody_in_one_unnamed_track_plays_as_before(tmp_path):
 
 
 def test_what_a_hand_is_given_is_said_once_per_kind(tmp_path):
-    """A left-hand chord wider than the hand reaches: one line on the first screen, none twice."""
+    """A left-hand chord wider than three fingers reach (--no-thumb: with the thumb the hand spans
+    the octave): one line on the first screen, none twice."""
     left = _track((36, 0, 2), (48, 0, 2), (43, 2, 4))
     song = _duet(tmp_path / "wide.mid", left=left)
-    result = run("play", song, "-o", tmp_path / "out.mid", "--controller", "scripted")
+    result = run("play", song, "-o", tmp_path / "out.mid", "--controller", "scripted", "--no-thumb")
     assert result.exit_code == 0, result.output
     lines = [line for line in result.output.splitlines() if "chords wider than this hand reaches" in line]
     assert len(lines) == 1 and lines[0].startswith("left out or reduced: the left hand's part"), result.output
     assert "kept their lowest notes" in lines[0]  # the written bass, not the mirror image's top
     report = json.loads((tmp_path / "out.report.json").read_text())
     assert report["hands"]["left"]["given_to_the_hand"] == 2 and report["hands"]["left"]["recall"] == 2 / 3
-    quiet = run("play", song, "-o", tmp_path / "out.mid", "--controller", "scripted", "--quiet")
+    quiet = run("play", song, "-o", tmp_path / "out.mid", "--controller", "scripted", "--quiet", "--no-thumb")
     assert "warning: the left hand's part has chords wider" in " ".join(quiet.stderr.split())
 
 
-def test_play_says_how_many_more_notes_the_thumbs_would_keep(tmp_path):
-    """A right-hand chord of four notes: three fingers keep three of them, the thumb the fourth;
-    play says so in one line, and --thumb plays them all."""
+def test_both_hands_take_their_thumbs_where_they_keep_more_notes(tmp_path):
+    """A right-hand chord of four notes: three fingers keep three of them, the thumb the fourth.
+    By default both hands take their thumbs, said in one line, and every note plays; --no-thumb
+    plays with three fingers (six notes) and says nothing; a file three fingers play whole keeps them."""
     right = _track((72, 0, 2), (76, 0, 2), (79, 0, 2), (84, 0, 2), (81, 2, 4))
     song = _duet(tmp_path / "four.mid", right=right)
     result = run("play", song, "-o", tmp_path / "out.mid", "--controller", "scripted")
     assert result.exit_code == 0, result.output
-    hints = [line for line in result.stdout.splitlines() if "--thumb" in line]
-    assert hints == [
-        "with --thumb the hands would be given 7 of the notes instead of 6: their thumbs keep notes three fingers leave out"
-    ]
-    thumbs = run("play", song, "-o", tmp_path / "thumbs.mid", "--controller", "scripted", "--thumb")
-    assert thumbs.exit_code == 0, thumbs.output
-    assert "would be given" not in thumbs.stdout
-    assert json.loads((tmp_path / "thumbs.report.json").read_text())["f1"] == 1.0
-    whole = _duet(tmp_path / "whole.mid")  # every note given: nothing to say
-    assert "--thumb" not in run("play", whole, "-o", tmp_path / "w.mid", "--controller", "scripted").stdout
+    lines = [line for line in " ".join(result.output.split()).split("warning: ") if "thumbs" in line]
+    assert len(lines) == 1 and lines[0].startswith(
+        "four.mid: both hands play with their thumbs too: they are given 7 of the notes, three fingers 6 "
+        "(--no-thumb plays with three)"
+    ), result.output
+    report = json.loads((tmp_path / "out.report.json").read_text())
+    assert report["f1"] == 1.0 and report["hands"]["right"]["given_to_the_hand"] == 5
+    assert report["hands"]["right"]["fingers"] == report["hands"]["left"]["fingers"] == [1, 2, 3, 4]
+    three = run("play", song, "-o", tmp_path / "three.mid", "--controller", "scripted", "--no-thumb")
+    assert three.exit_code == 0, three.output
+    assert "thumbs" not in three.output
+    three = json.loads((tmp_path / "three.report.json").read_text())["hands"]["right"]
+    assert three["given_to_the_hand"] == 4 and three["fingers"] == [2, 3, 4]
+    inspected = " ".join(run("inspect", song).output.split())
+    assert "both hands play with their thumbs too: they are given 7 of the notes, three fingers 6" in inspected
+    whole = _duet(tmp_path / "whole.mid")  # every note given to three fingers: they keep playing
+    result = run("play", whole, "-o", tmp_path / "w.mid", "--controller", "scripted")
+    assert "thumbs" not in result.output
+    assert json.loads((tmp_path / "w.report.json").read_text())["hands"]["left"]["fingers"] == [2, 3, 4]
 
 
 def test_track_names_the_staves_both_hands_play(tmp_path):
@@ -498,14 +509,19 @@ def test_a_two_hand_files_own_fingering_is_said_to_be_replaced_by_the_planners(t
 
 
 def test_finger_says_when_the_fingered_file_holds_fewer_notes_than_the_piece(tmp_path):
-    left = _track((36, 0, 2), (48, 0, 2), (43, 2, 4))  # a chord wider than the left hand reaches: one note goes
+    left = _track((36, 0, 2), (48, 0, 2), (43, 2, 4))  # a chord wider than three fingers reach: one note goes
     song = _duet(tmp_path / "wide.mid", left=left)
-    result = run("finger", song, "-o", tmp_path / "fingered.mid")
+    result = run("finger", song, "-o", tmp_path / "fingered.mid", "--no-thumb")
     assert result.exit_code == 0, result.output
     assert "(one track per hand; 6 of 7 notes, the others reduced away: the warnings say why)" in " ".join(
         result.output.split()
     )
     assert len(read_midi(tmp_path / "fingered.mid").notes) == 6
+    # by default the hands take their thumbs, which span the octave: every note, one for a thumb
+    thumbs = run("finger", song, "-o", tmp_path / "thumbs.mid")
+    assert "both hands play with their thumbs too" in " ".join(thumbs.output.split()), thumbs.output
+    fingered = read_midi(tmp_path / "thumbs.mid").notes
+    assert len(fingered) == 7 and any(n.finger == 1 for n in fingered)
     whole = run("finger", _duet(tmp_path / "plain.mid"), "-o", tmp_path / "plain-fingered.mid")
     assert "reduced away" not in whole.output
 

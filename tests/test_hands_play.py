@@ -300,3 +300,34 @@ def test_hands_a_third_apart_play_whole_where_their_fingerings_keep_the_wrists_a
     piece = interleaved()
     performance = play_hands(piece, "scripted")  # fingered on its own, each hand: F1 0.39, the wrists pushed aside
     assert performance.report().f1 >= 0.95
+
+
+def test_both_hands_take_their_thumbs_only_where_the_thumbs_keep_more_notes():
+    """A right-hand chord of four notes: three fingers are given three of its notes, hands with
+    their thumbs all four; play_hands then plays with the thumbs (said in one warning line), and
+    a piece three fingers are given whole keeps three fingers, silently."""
+    from pianobot.music.instrument import THUMB
+    from pianobot.perform.hands import thumbs_keep_more
+
+    chord = [Note(0.0, p, 2.0, 80, hand="right") for p in (72, 76, 79, 84)]
+    bass = [Note(0.0, 48, 2.0, 80, hand="left"), Note(2.0, 43, 4.0, 80, hand="left")]
+    piece = Piece(tuple(chord + bass + [Note(2.0, 81, 4.0, 80, hand="right")]), bpm=60)
+    assert thumbs_keep_more(piece) == (6, 7)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        performance = play_hands(piece, "scripted")
+    said = [str(w.message) for w in caught if "thumbs" in str(w.message)]
+    assert said == [
+        "both hands play with their thumbs too: they are given 7 of the notes, three fingers 6 (hand=HandSpec() plays with three)"
+    ]
+    assert performance.report().f1 == 1.0
+    assert all(h.performance.plan.config.world.hand.spec == THUMB for h in performance.hands)
+    three = play_hands(piece, "scripted", hand=HandSpec())  # named: no choice made
+    assert sum(len(h.part) for h in three.hands) == 6
+    whole = Piece(tuple(chord[:3] + bass), bpm=60)
+    assert thumbs_keep_more(whole) is None
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        performance = play_hands(whole, "scripted")
+    assert not [w for w in caught if "thumbs" in str(w.message)]
+    assert all(h.performance.plan.config.world.hand.spec == HandSpec() for h in performance.hands)

@@ -100,6 +100,7 @@ def test_the_corpus_table_counts_what_was_given_and_what_was_refused():
             "notes": notes,
             "sac": figures,
             "scripted": {**figures, "f1": scripted},
+            "fingers": [1, 2, 3, 4] if name == "a" else [2, 3, 4],
         }
 
     rows = [
@@ -108,19 +109,20 @@ def test_the_corpus_table_counts_what_was_given_and_what_was_refused():
         {"piece": "c", "source": "x/c", "measures": "1-2", "refused": "read as one hand's file"},
     ]
     text = corpus.table(rows)
-    assert "| c | `x/c` (1-2) | | | refused: read as one hand's file |" in text
-    assert "| b | `x/b` (1-4) | 100 | 60 | 0.000 |" in text and "| n/a |" in text
-    assert "| mean (2 played) | | | 75% given | 0.400 | | | 0.500 | 0.500 | 80% |" in text
+    assert "| c | `x/c` (1-2) | | | | refused: read as one hand's file |" in text
+    assert "| b | `x/b` (1-4) | 2-4 | 100 | 60 | 0.000 |" in text and "| n/a |" in text
+    assert "| mean (2 played) | | | | 75% given | 0.400 | | | 0.500 | 0.500 | 80% |" in text
     # --thumb: the scripted pianist alone played; what it was given counts
     thumbs = [{**r, "sac": None} for r in rows[:2]]
     text = corpus.table(thumbs)
-    assert "| a | `x/a` (1-4) | 100 | 90 | n/a | | | n/a | 1.000 | n/a |" in text
-    assert "| mean (2 played) | | | 75% given | n/a | | | n/a | 0.500 | n/a |" in text
+    assert "| a | `x/a` (1-4) | 1-4 | 100 | 90 | n/a | | | n/a | 1.000 | n/a |" in text
+    assert "| mean (2 played) | | | | 75% given | n/a | | | n/a | 0.500 | n/a |" in text
 
 
 def test_the_corpus_options_reach_the_players(monkeypatch, tmp_path):
-    """--apart plays each hand in a simulation of its own, --thumb gives each hand its thumb, --only
-    names the excerpts; --json writes what was played (music21 stood in for: the run is not made)."""
+    """--apart plays each hand in a simulation of its own, --thumb gives each hand its thumb and
+    --no-thumb three fingers (default: chosen per file), --only names the excerpts; --json writes
+    what was played (music21 stood in for: the run is not made)."""
     import json
     import sys
     import types
@@ -130,7 +132,7 @@ def test_the_corpus_options_reach_the_players(monkeypatch, tmp_path):
 
     asked = {}
 
-    def play_corpus(folder, only=(), together=True, hand=HandSpec(), general=None):
+    def play_corpus(folder, only=(), together=True, hand=None, general=None):
         asked.update(folder=folder, only=only, together=together, hand=hand, general=general)
         return []
 
@@ -152,8 +154,12 @@ def test_the_corpus_options_reach_the_players(monkeypatch, tmp_path):
     assert record["general"] == str(tmp_path / "policy")
     monkeypatch.setattr(sys, "argv", ["corpus", "--out", str(tmp_path)])
     corpus.main()
-    assert asked["together"] is True and asked["hand"] == HandSpec() and asked["only"] == ()
+    assert asked["together"] is True and asked["hand"] is None and asked["only"] == ()
     assert asked["general"] is None
+    assert json.loads(out.read_text())["thumb"] is True  # (no --json: the record is not written again)
+    monkeypatch.setattr(sys, "argv", ["corpus", "--out", str(tmp_path), "--no-thumb", "--json", str(out)])
+    corpus.main()
+    assert asked["hand"] == HandSpec() and json.loads(out.read_text())["thumb"] is False
 
 
 def test_benchmarks_hands_thumb_gives_every_player_and_the_examples_reading_each_hands_thumb(monkeypatch, tmp_path):

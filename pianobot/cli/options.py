@@ -118,7 +118,7 @@ READING = {  # parameter name: (type, option); the commands' --help shows them i
     "refinger": _reading(bool, LoadOptions.refinger, "--refinger/--no-refinger", "Replace the file's fingering with the planner's (e.g. human fingering for five fingers)."),
     "lowest_note": _reading(Optional[str], None, "--lowest-note", f"Lowest key of the keyboard (name like C4, or MIDI number); default {pitch_name(KeyboardSpec.lowest)}, or a piece's own octaves where its notes lie off the default keys.", INSTRUMENT),
     "keys": _reading(Optional[int], None, "--keys", f"Number of keys on the keyboard; default {KeyboardSpec.count}, or as many as a piece's own octaves need.", INSTRUMENT),
-    "thumb": _reading(bool, False, "--thumb/--no-thumb", "Let the hand use its thumb (finger 1) too.", INSTRUMENT),
+    "thumb": _reading(Optional[bool], None, "--thumb/--no-thumb", "Let the hand use its thumb (finger 1) too, or not; default: both hands of a two-hand file use theirs where they keep notes three fingers leave out (said in one line), one hand does not.", INSTRUMENT),
 }
 # fmt: on
 
@@ -133,6 +133,8 @@ class Reading:
     keyboard_named: bool = False
     """Whether --lowest-note or --keys was given (else :func:`fit_keyboard` may choose the keys,
     and both hands' parts go on their players' keys)."""
+    hand_named: bool = False
+    """Whether --thumb or --no-thumb was given (else :func:`fit_hand` may give both hands their thumbs)."""
 
 
 def make_reading(**given) -> Reading:
@@ -165,6 +167,7 @@ def make_reading(**given) -> Reading:
         keyboard=keyboard,
         hand=THUMB if values["thumb"] else HandSpec(),
         keyboard_named=named,
+        hand_named=values["thumb"] is not None,
     )
 
 
@@ -298,6 +301,21 @@ def read_song(song: Path, options: LoadOptions, keyboard: KeyboardSpec, hand: Ha
             warnings.warn(PianobotWarning(problem))
     check_playable(piece, keyboard, hand)
     return piece
+
+
+def fit_hand(song: Path, reading: Reading, quiet: bool = False) -> Reading:
+    """``reading`` with both hands' thumbs where neither --thumb nor --no-thumb was given and
+    they keep notes of ``song`` that three fingers leave out
+    (:func:`~pianobot.perform.hands.fingers_for_file`), said in one line (not ``quiet``)."""
+    from pianobot.perform.hands import THUMBS_CHOSEN, fingers_for_file
+
+    if reading.hand_named:
+        return reading
+    hand, counts = fingers_for_file(song, reading.options, reading.keyboard, reading.keyboard_named)
+    if counts is not None and not quiet:
+        said = THUMBS_CHOSEN.format(more=counts[1], given=counts[0])
+        warnings.warn(PianobotWarning(f"{song.name}: {said} (--no-thumb plays with three)"))
+    return dataclasses.replace(reading, hand=hand)
 
 
 def both_hands(song: Path, reading: Reading):

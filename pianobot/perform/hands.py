@@ -312,6 +312,7 @@ class HandsPerformance:
                 "performer": h.performer,
                 **(reading.to_dict(h.hand) if reading is not None else {}),
                 "played_as": h.describe(),
+                "fingers": list(h.performance.plan.config.world.hand.spec.fingers),
                 "given_to_the_hand": len(h.part),
                 "left_out_or_reduced": list(h.changes),
                 "plan": h.performance.plan.to_dict(),
@@ -344,6 +345,15 @@ def prepare_part(
     left out), the part moved ``start`` seconds earlier (default: to its first note); ``grow``: a
     part wider than ``keyboard`` is given its own range instead (:func:`~pianobot.music.window.window_for`).
     Each kind of change is one :class:`PianobotWarning`, worded for the written part."""
+    window, reduced, start, left_out = _reduced_part(piece, hand, keyboard, fingers, start, grow)
+    fingered, _ = ensure_fingering(reduced, window.keyboard, fingers, refinger=True)
+    return window, fingered, start, left_out
+
+
+def _reduced_part(
+    piece: Piece, hand: str, keyboard: KeyboardSpec | None, fingers: HandSpec, start: float | None, grow: bool
+) -> tuple[Window, Piece, float, int]:
+    """:func:`prepare_part`'s part before it is fingered."""
     part = piece.part(hand)
     window = window_for(part, hand, keyboard, grow)
     inside = [n for n in part.notes if window.inward(n.pitch) in window.keyboard]
@@ -361,26 +371,64 @@ def prepare_part(
     start = moved.notes[0].onset if start is None else start
     # (the simulated hand is a right hand: its top notes are a left hand's lowest)
     thinned = thin_hand(moved.shift(-start), hand, fingers, "lowest" if hand == "left" else "highest")
-    reduced = reduce_hand(thinned, window.keyboard, fingers, hand)
-    fingered, _ = ensure_fingering(reduced, window.keyboard, fingers, refinger=True)
-    return window, fingered, start, left_out
+    return window, reduce_hand(thinned, window.keyboard, fingers, hand), start, left_out
 
 
-def given_with_thumbs(
-    path: str | Path, options: LoadOptions, reading_keyboard: KeyboardSpec, keyboard: KeyboardSpec | None, grow: bool
-) -> int | None:
-    """How many of the file's notes both hands would be given with their thumbs too, read and
-    reduced as ``--thumb`` reads and reduces them (``reading_keyboard``: :func:`two_hands`'; the rest
-    :func:`prepare_part`'s); None where, with thumbs, one hand's reading plays the file. Nothing is said."""
+def given_notes(piece: Piece, fingers: HandSpec, keyboard: KeyboardSpec | None = None) -> int | None:
+    """How many of ``piece``'s notes (each with its hand) both hands are given with ``fingers``,
+    each part as :func:`prepare_part` gives it: on ``keyboard``, default the general policy's 24
+    keys or a wider part's own octaves. None where a hand's part is refused. Nothing is said."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         try:
-            hands = two_hands(path, options, THUMB, reading_keyboard)
-            if hands is None:
-                return None
-            return sum(len(prepare_part(hands.piece, h, keyboard, THUMB, None, grow)[1]) for h in hands.piece.hands)
+            return sum(
+                len(_reduced_part(piece, h, keyboard or KeyboardSpec(), fingers, None, keyboard is None)[1])
+                for h in piece.hands
+            )
         except PianobotError:
             return None
+
+
+def thumbs_keep_more(
+    three: Piece, thumbs: Piece | None = None, keyboard: KeyboardSpec | None = None
+) -> tuple[int, int] | None:
+    """(notes both hands are given with three fingers, with their thumbs too), where the thumbs
+    keep more of them; else None. ``three``: the piece with every note's hand as read for three
+    fingers; ``thumbs``: as read for hands with their thumbs (default the same); ``keyboard``: as
+    :func:`given_notes`'. This is how both hands choose their fingers where none are named: the
+    thumbs play wherever they keep notes that three fingers leave out (a chord wider than three
+    fingers reach, more notes at once, a passage too fast to play without one)."""
+    given = given_notes(three, HandSpec(), keyboard)
+    if given is None or given == len(three):
+        return None
+    more = given_notes(thumbs if thumbs is not None else three, THUMB, keyboard)
+    return (given, more) if more is not None and more > given else None
+
+
+def fingers_for_file(
+    path: str | Path, options: LoadOptions, keyboard: KeyboardSpec = KeyboardSpec(), keys_named: bool = False
+) -> tuple[HandSpec, tuple[int, int] | None]:
+    """Both hands' fingers for the file at ``path`` where none are named, as ``pianobot play``
+    chooses them: (:data:`~pianobot.music.instrument.THUMB`, (notes given with three fingers, with
+    thumbs)) where the file plays both hands read either way (:func:`two_hands`, for ``keyboard``)
+    and :func:`thumbs_keep_more` says so (on ``keyboard`` where ``keys_named``, else on each
+    player's own keys), else (three fingers, None). A file the reading refuses keeps three
+    fingers: that reading says why. Nothing is said."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        try:
+            three = two_hands(path, options, HandSpec(), keyboard)
+            thumbs = None if three is None else two_hands(path, options, THUMB, keyboard)
+        except PianobotError:
+            return HandSpec(), None
+    if three is None or thumbs is None:
+        return HandSpec(), None
+    counts = thumbs_keep_more(three.piece, thumbs.piece, keyboard if keys_named else None)
+    return (HandSpec(), None) if counts is None else (THUMB, counts)
+
+
+THUMBS_CHOSEN = "both hands play with their thumbs too: they are given {more} of the notes, three fingers {given}"
+"""The line said where :func:`thumbs_keep_more` gives both hands their thumbs (with how to choose three)."""
 
 
 def play_hands(
@@ -397,7 +445,9 @@ def play_hands(
 ) -> HandsPerformance:
     """Perform ``piece``, every note of which has a hand (the module's notes): ``controller``
     'sac' (the general policy, or policies trained for the part) or 'scripted', ``models`` the
-    model store, ``seed`` the hand starts, ``hand`` each hand's fingers; ``keyboard`` the keys
+    model store, ``seed`` the hand starts, ``hand`` each hand's fingers (default: three, or with
+    the thumb too where that keeps more of the notes, :func:`thumbs_keep_more`, said in one
+    warning line); ``keyboard`` the keys
     every part is moved onto (default: for 'sac' the general policy's 24 keys, or a part's own
     range, rounded out to octaves, where it is wider; for 'scripted' each part's own range);
     ``together``: both hands in one simulation (else hand by hand, each in
@@ -409,7 +459,13 @@ def play_hands(
         raise PianobotError("every note needs a hand to play both hands: give the piece's notes a hand first")
     if controller not in ("sac", "scripted"):
         raise PianobotError(f"controller {controller!r}: both hands are played by 'sac' or 'scripted'")
-    fingers = hand or HandSpec()
+    fingers = hand
+    if hand is None:
+        counts = thumbs_keep_more(piece, keyboard=keyboard)
+        fingers = HandSpec() if counts is None else THUMB
+        if counts is not None:
+            said = THUMBS_CHOSEN.format(more=counts[1], given=counts[0])
+            warnings.warn(PianobotWarning(f"{said} (hand=HandSpec() plays with three)"))
     grow = keyboard is None and controller == "sac"  # (the policies' 24 keys, or a wider part's own)
     keyboard = keyboard or (KeyboardSpec() if controller == "sac" else None)
     together = together and len(piece.hands) == 2

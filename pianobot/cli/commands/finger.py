@@ -13,6 +13,7 @@ from pianobot.cli.options import (
     both_hands,
     check_files,
     check_midi_output,
+    fit_hand,
     fit_keyboard,
     reads,
 )
@@ -41,6 +42,7 @@ def finger(
     check_midi_output(output, song, "the fingered piece")
     check_files({"the input": song, "the fingering file": reading.options.fingering}, {"-o": output})
     check_writable(output)
+    reading = fit_hand(song, reading)
     keyboard, hand_spec = reading.keyboard, reading.hand
     hands = both_hands(song, reading)
     if hands is not None:  # a two-hand file: each hand fingered, one track each

@@ -17,6 +17,7 @@ from pianobot.cli.options import (
     both_hands,
     check_files,
     check_models,
+    fit_hand,
     fit_keyboard,
     reads,
 )
@@ -74,6 +75,7 @@ def inspect(
             )
         )
     try:
+        reading = fit_hand(song, reading)
         both = both_hands(song, reading)
     except PianobotError:
         if named:

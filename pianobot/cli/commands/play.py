@@ -24,6 +24,7 @@ from pianobot.cli.options import (
     check_html,
     check_midi_output,
     check_models,
+    fit_hand,
     fit_keyboard,
     read_song,
     reads,
@@ -172,6 +173,7 @@ def play(
         import torch
 
         torch.set_num_threads(1)  # batch-1 inference: more threads only spin against other work on the cores
+    reading = fit_hand(song, reading)
     hands = both_hands(song, reading)
     if left_policy is not None:
         from pianobot.agent import store
@@ -209,7 +211,6 @@ def play(
             seed=seed,
             keyboard=reading.keyboard if reading.keyboard_named else None,  # (none named: each player's own keys)
             hand=reading.hand,
-            thumbs=None if 1 in reading.hand.fingers else (reading.options, reading.keyboard),
             options=dict(
                 general=use_general,
                 general_policy=general_policy
@@ -288,21 +289,19 @@ def play(
 
 
 def play_both(
-    song: Path, output: Path, reading, *, controller, models, seed, keyboard, hand, thumbs, options, files, shown
+    song: Path, output: Path, reading, *, controller, models, seed, keyboard, hand, options, files, shown
 ) -> None:
     """`play` of a two-hand file (``reading``: a :class:`~pianobot.perform.hands.HandsReading`):
     both hands in one simulation (:func:`~pianobot.perform.hands.play_hands`), one
-    track per hand in ``output``, and the report of the whole piece and each hand. ``thumbs``: for
-    hands without their thumbs, the reading's (options, keyboard), to say in one line how many more
-    notes the hands would be given with them, where a hand was given fewer than written."""
+    track per hand in ``output``, and the report of the whole piece and each hand (``hand``: both
+    hands' fingers, as :func:`~pianobot.cli.options.fit_hand` chose them)."""
     import warnings
 
     from pianobot.cli import display
     from pianobot.errors import PianobotWarning
-    from pianobot.music.instrument import KeyboardSpec
     from pianobot.music.midi_io import write_midi
     from pianobot.perform.audio import write_wav
-    from pianobot.perform.hands import AGAINST, TOGETHER, given_with_thumbs, play_hands
+    from pianobot.perform.hands import AGAINST, TOGETHER, play_hands
 
     console, quiet = shown["console"], shown["quiet"]
     if not quiet:
@@ -339,16 +338,6 @@ def play_both(
         for h in performance.hands:
             for line in h.changes:
                 console.print(f"[yellow]left out or reduced:[/yellow] {said(line)}", soft_wrap=True)
-        given = sum(len(h.part) for h in performance.hands)
-        if thumbs is not None and given < len(performance.piece):  # (as play_hands chooses the keys)
-            parts_keyboard = keyboard or (KeyboardSpec() if controller == "sac" else None)
-            more = given_with_thumbs(song, *thumbs, parts_keyboard, keyboard is None and controller == "sac")
-            if more is not None and more > given:
-                console.print(
-                    f"with --thumb the hands would be given {more} of the notes instead of {given}: "
-                    "their thumbs keep notes three fingers leave out",
-                    soft_wrap=True,
-                )
         display.print_all(console, display.report_tables(performance.report(), shown["every"], shown["notes"]))
     console.print(f"performance written to {said(output)} (one track per hand), report to {said(files['report'])}")
     if files["video"] is not None:

@@ -14,6 +14,7 @@ from pianobot.cli.options import (
     both_hands,
     check_files,
     check_html,
+    fit_hand,
     fit_keyboard,
     reads,
 )
@@ -66,6 +67,7 @@ def score(
         if target is not None:
             check_writable(target)
     console = err if to_stdout else out  # standard output carries the JSON
+    reading = fit_hand(reference, reading, quiet=True)  # (the hands play gave the notes to)
     hands = both_hands(reference, reading)
     if hands is not None:
         reference_piece = hands.piece  # every note with its hand, as play scored it

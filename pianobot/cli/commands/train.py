@@ -25,6 +25,7 @@ from pianobot.cli.options import (
     Task,
     both_hands,
     check_files,
+    fit_hand,
     fit_keyboard,
     option,
     read_song,
@@ -217,6 +218,7 @@ def train(
     console = err if json_path is not None and str(json_path) == "-" else out  # standard output carries the JSON
     if models.exists() and not models.is_dir():
         raise PianobotError(f"--models {models} is a file: give a folder")
+    reading = fit_hand(song, reading) if song is not None else reading
     hands = both_hands(song, reading) if song is not None else None
     if song is not None and hands is None:  # (a one-hand piece off the default keys: its own octaves, as play does)
         reading = fit_keyboard(song, reading)
