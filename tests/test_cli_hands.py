@@ -148,6 +148,7 @@ def test_both_hands_take_their_thumbs_where_they_keep_more_notes(tmp_path):
     report = json.loads((tmp_path / "out.report.json").read_text())
     assert report["f1"] == 1.0 and report["hands"]["right"]["given_to_the_hand"] == 5
     assert report["hands"]["right"]["fingers"] == report["hands"]["left"]["fingers"] == [1, 2, 3, 4]
+    assert report["hands"]["right"]["played_as"].endswith(", with its thumb")
     three = run("play", song, "-o", tmp_path / "three.mid", "--controller", "scripted", "--no-thumb")
     assert three.exit_code == 0, three.output
     assert "thumbs" not in three.output
@@ -228,12 +229,16 @@ def test_notes_beyond_the_pianos_keys_are_one_line_named_or_not(tmp_path):
 def test_more_notes_at_once_than_two_hands_have_fingers_are_thinned_in_one_line(tmp_path):
     chord = _track(*((p, 0, 2) for p in (36, 40, 43, 48, 52, 55, 60, 64, 67)), (72, 2, 4))
     song = midi_file(tmp_path / "nine.mid", [("Piano", chord)])
-    result = run("play", song, "-o", tmp_path / "out.mid", "--controller", "scripted", "--quiet")
+    result = run("play", song, "-o", tmp_path / "out.mid", "--controller", "scripted", "--quiet", "--no-thumb")
     assert result.exit_code == 0, result.output
     said = [line for line in result.stderr.splitlines() if "more than two hands of 3 fingers" in line]
     assert len(said) == 1 and "dropped 3 inner note(s)" in said[0], result.stderr
     report = json.loads((tmp_path / "out.report.json").read_text())
     assert report["reference_notes"] == 7  # the piece as both hands can hold it
+    # by default the hands take their thumbs, which hold eight of the nine
+    result = run("play", song, "-o", tmp_path / "out.mid", "--controller", "scripted", "--quiet")
+    said = [line for line in result.stderr.splitlines() if "more than two hands of 4 fingers" in line]
+    assert len(said) == 1 and "dropped 1 inner note(s)" in said[0], result.stderr
 
 
 def test_three_staves_are_given_to_the_hands_by_the_planner_said_in_one_line(tmp_path):
@@ -539,3 +544,37 @@ def test_score_of_one_hands_part_off_the_default_keys_reduces_it_as_play_did(tmp
     assert scored.exit_code == 0, scored.output
     again = json.loads((tmp_path / "s.json").read_text())
     assert again["reference_notes"] == report["reference_notes"] == 4 and again["f1"] == report["f1"]
+
+
+def test_the_thumbs_count_a_chord_note_three_fingers_reading_thinned(tmp_path):
+    """A seven-note chord: read for three fingers (six on two hands) one inner note is thinned
+    away before any hand is given it; the hands with their thumbs keep all seven, so they play
+    with them."""
+    chord = _track(*[(p, 0, 2) for p in (48, 52, 55, 60, 64, 67, 72)], (74, 2, 4), (45, 2, 4))
+    song = midi_file(tmp_path / "seven.mid", [("Piano", chord)])
+    result = run("play", song, "-o", tmp_path / "out.mid", "--controller", "scripted")
+    assert result.exit_code == 0, result.output
+    assert "both hands play with their thumbs too: they are given 9 of the notes, three fingers 8" in " ".join(
+        result.output.split()
+    )
+    assert json.loads((tmp_path / "out.report.json").read_text())["f1"] == 1.0
+
+
+def test_score_reads_the_hands_with_the_fingers_play_chose_whatever_keys_play_named(tmp_path):
+    """Hands given by the planner, which splits the notes differently for three fingers and for
+    hands with thumbs: play on named keys and score (which names none) read them alike."""
+    notes = _track(
+        (66, 0, 2), (67, 0, 2), (79, 0, 2), *[(p, 2, 4) for p in (41, 48, 50, 53, 57)],
+        *[(p, 4, 6) for p in (65, 66, 70, 71, 74, 78)], *[(p, 6, 8) for p in (46, 48, 50, 53)],
+    )  # fmt: skip
+    song = midi_file(tmp_path / "chords.mid", [("Piano", notes)])
+    played = tmp_path / "out.mid"
+    result = run("play", song, "-o", played, "--controller", "scripted", "--lowest-note", "C3", "--keys", "12")
+    assert result.exit_code == 0, result.output
+    report = json.loads((tmp_path / "out.report.json").read_text())
+    scored = run("score", played, song, "--json", tmp_path / "score.json")
+    assert scored.exit_code == 0, scored.output
+    figures = json.loads((tmp_path / "score.json").read_text())
+    assert figures["f1"] == report["f1"]
+    for hand in ("right", "left"):
+        assert figures["hands"][hand]["f1"] == report["hands"][hand]["f1"], hand

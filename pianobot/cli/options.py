@@ -118,7 +118,7 @@ READING = {  # parameter name: (type, option); the commands' --help shows them i
     "refinger": _reading(bool, LoadOptions.refinger, "--refinger/--no-refinger", "Replace the file's fingering with the planner's (e.g. human fingering for five fingers)."),
     "lowest_note": _reading(Optional[str], None, "--lowest-note", f"Lowest key of the keyboard (name like C4, or MIDI number); default {pitch_name(KeyboardSpec.lowest)}, or a piece's own octaves where its notes lie off the default keys.", INSTRUMENT),
     "keys": _reading(Optional[int], None, "--keys", f"Number of keys on the keyboard; default {KeyboardSpec.count}, or as many as a piece's own octaves need.", INSTRUMENT),
-    "thumb": _reading(Optional[bool], None, "--thumb/--no-thumb", "Let the hand use its thumb (finger 1) too, or not; default: both hands of a two-hand file use theirs where they keep notes three fingers leave out (said in one line), one hand does not.", INSTRUMENT),
+    "thumb": _reading(Optional[bool], None, "--thumb/--no-thumb", "Let the hand use its thumb (finger 1) too, or not; default: both hands of a two-hand file use theirs where they keep notes three fingers leave out, one hand does not.", INSTRUMENT),
 }
 # fmt: on
 
@@ -311,7 +311,7 @@ def fit_hand(song: Path, reading: Reading, quiet: bool = False) -> Reading:
 
     if reading.hand_named:
         return reading
-    hand, counts = fingers_for_file(song, reading.options, reading.keyboard, reading.keyboard_named)
+    hand, counts = fingers_for_file(song, reading.options)
     if counts is not None and not quiet:
         said = THUMBS_CHOSEN.format(more=counts[1], given=counts[0])
         warnings.warn(PianobotWarning(f"{song.name}: {said} (--no-thumb plays with three)"))

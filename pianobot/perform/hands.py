@@ -43,7 +43,7 @@ from pianobot.music.hand_scores import HandsReport, compare_hands
 from pianobot.music.instrument import THUMB, HandSpec, KeyboardSpec, check_playable, suggest_transpose
 from pianobot.music.load import LoadOptions, end_legato, load_hands, load_piece, thin_hand
 from pianobot.music.metrics import Report
-from pianobot.music.piece import HANDS, Note, Piece, pitch_name
+from pianobot.music.piece import FINGER_NAMES, HANDS, Note, Piece, pitch_name
 from pianobot.music.window import Window, window_for
 from pianobot.perform import plan
 from pianobot.perform.plan import Performance
@@ -246,14 +246,16 @@ class HandPerformance:
         return " ".join([played.performer, *folders, *guarded])
 
     def describe(self) -> str:
-        """Where the simulated hand played the part: 'mirrored, moved up 1 octave onto C4-B5 (24 keys)'."""
+        """Where and with what the simulated hand played the part: 'mirrored about D, moved up 1
+        octave, on C4-B5 (24 keys)', and ', with its thumb' where it had one."""
         moves = []
         if self.hand == "left":
             moves.append("mirrored about D")
         if self.window.octaves:
             octaves = abs(self.window.octaves)
             moves.append(f"moved {'up' if self.window.octaves > 0 else 'down'} {octaves} octave{'s' * (octaves > 1)}")
-        return ", ".join(moves + [f"on {self.window.keyboard.describe()}"])
+        thumb = [f"with its {FINGER_NAMES[1]}"] if 1 in self.performance.plan.config.world.hand.spec.fingers else []
+        return ", ".join(moves + [f"on {self.window.keyboard.describe()}"] + thumb)
 
 
 @dataclass(frozen=True)
@@ -379,7 +381,7 @@ def given_notes(piece: Piece, fingers: HandSpec, keyboard: KeyboardSpec | None =
     each part as :func:`prepare_part` gives it: on ``keyboard``, default the general policy's 24
     keys or a wider part's own octaves. None where a hand's part is refused. Nothing is said."""
     with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
+        warnings.simplefilter("ignore", PianobotWarning)
         try:
             return sum(
                 len(_reduced_part(piece, h, keyboard or KeyboardSpec(), fingers, None, keyboard is None)[1])
@@ -398,32 +400,32 @@ def thumbs_keep_more(
     :func:`given_notes`'. This is how both hands choose their fingers where none are named: the
     thumbs play wherever they keep notes that three fingers leave out (a chord wider than three
     fingers reach, more notes at once, a passage too fast to play without one)."""
+    thumbs = three if thumbs is None else thumbs
     given = given_notes(three, HandSpec(), keyboard)
-    if given is None or given == len(three):
+    if given is None or given >= len(thumbs):  # (the thumbs' reading may keep notes of a chord three fingers' thins)
         return None
-    more = given_notes(thumbs if thumbs is not None else three, THUMB, keyboard)
+    more = given_notes(thumbs, THUMB, keyboard)
     return (given, more) if more is not None and more > given else None
 
 
-def fingers_for_file(
-    path: str | Path, options: LoadOptions, keyboard: KeyboardSpec = KeyboardSpec(), keys_named: bool = False
-) -> tuple[HandSpec, tuple[int, int] | None]:
+def fingers_for_file(path: str | Path, options: LoadOptions) -> tuple[HandSpec, tuple[int, int] | None]:
     """Both hands' fingers for the file at ``path`` where none are named, as ``pianobot play``
     chooses them: (:data:`~pianobot.music.instrument.THUMB`, (notes given with three fingers, with
-    thumbs)) where the file plays both hands read either way (:func:`two_hands`, for ``keyboard``)
-    and :func:`thumbs_keep_more` says so (on ``keyboard`` where ``keys_named``, else on each
-    player's own keys), else (three fingers, None). A file the reading refuses keeps three
-    fingers: that reading says why. Nothing is said."""
+    thumbs)) where the file plays both hands read either way (:func:`two_hands`) and
+    :func:`thumbs_keep_more` says so, else (three fingers, None). Always on the default keys and
+    each player's own, whatever keys a command names, so that ``pianobot score``, which names
+    none, reads the hands as ``play`` did. A file the reading refuses keeps three fingers: that
+    reading says why. Nothing is said."""
     with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
+        warnings.simplefilter("ignore", PianobotWarning)
         try:
-            three = two_hands(path, options, HandSpec(), keyboard)
-            thumbs = None if three is None else two_hands(path, options, THUMB, keyboard)
+            three = two_hands(path, options, HandSpec())
+            thumbs = None if three is None else two_hands(path, options, THUMB)
         except PianobotError:
             return HandSpec(), None
     if three is None or thumbs is None:
         return HandSpec(), None
-    counts = thumbs_keep_more(three.piece, thumbs.piece, keyboard if keys_named else None)
+    counts = thumbs_keep_more(three.piece, thumbs.piece)
     return (HandSpec(), None) if counts is None else (THUMB, counts)
 
 

@@ -205,8 +205,16 @@ class Performance:
         }
 
     def to_dict(self) -> dict:
-        """The report's JSON: who played (the plan), the seed, what the guards did, and every figure."""
-        return {"seed": self.seed, **self.plan.to_dict(), **self.guards(), **self.report().to_dict()}
+        """The report's JSON: who played (the plan) and with which fingers, the seed, what the guards
+        did, and every figure."""
+        fingers = list(self.plan.config.world.hand.spec.fingers)
+        return {
+            "seed": self.seed,
+            **self.plan.to_dict(),
+            "fingers": fingers,
+            **self.guards(),
+            **self.report().to_dict(),
+        }
 
 
 def assign(

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 from typing import Optional
 
@@ -21,6 +22,7 @@ from pianobot.cli.options import (
 from pianobot.cli.terminal import err, out, said, write_json
 from pianobot.errors import PianobotError
 from pianobot.files import check_writable
+from pianobot.music.instrument import THUMB
 from pianobot.music.metrics import DEFAULT_ONSET_TOLERANCE
 
 
@@ -67,8 +69,12 @@ def score(
         if target is not None:
             check_writable(target)
     console = err if to_stdout else out  # standard output carries the JSON
-    reading = fit_hand(reference, reading, quiet=True)  # (the hands play gave the notes to)
     hands = both_hands(reference, reading)
+    if hands is not None and not reading.hand_named:  # (the fingers play chose: they may read the hands otherwise)
+        thumbs = both_hands(reference, replace(reading, hand=THUMB))
+        if thumbs is not None and thumbs.piece != hands.piece:
+            reading = fit_hand(reference, reading, quiet=True)
+            hands = both_hands(reference, reading)
     if hands is not None:
         reference_piece = hands.piece  # every note with its hand, as play scored it
     else:
