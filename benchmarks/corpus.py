@@ -2,7 +2,7 @@
 scores, written to MIDI files and played as ``pianobot play`` plays them, against each file.
 
     pip install -e ".[corpus]"      # music21, which carries its corpus
-    python -m benchmarks.corpus [--out out/corpus] [--json out.json] [--only NAME ...]
+    python -m benchmarks.corpus [--set test|validation] [--out out/corpus] [--json out.json] [--only NAME ...]
 
 Each excerpt is a piece's first measures (from :data:`EXCERPTS`' first measure), as many as keep
 it within :data:`MAX_NOTES` notes and :data:`MAX_SECONDS` seconds at the score's own tempo
@@ -10,7 +10,10 @@ it within :data:`MAX_NOTES` notes and :data:`MAX_SECONDS` seconds at the score's
 chorales' voices) are the MIDI file's tracks, named as music21 names them: "Piano" and the like,
 for no hand, so the fingering planner gives their notes hands, as ``pianobot play`` does; a
 chorale's "Bass" is read as a left hand's track (its other voices go to the hands by the planner).
-Nothing was chosen or tuned on these pieces: they were played once, as found.
+Nothing was chosen or tuned on these pieces: they were played once, as found. ``--set
+validation`` plays twelve other excerpts (:data:`VALIDATION`: three more of Clara Schumann's
+polonaises, her trio's piano part, two songs' accompaniments, six chorales), which no figure of
+the test set comes from: a setting is chosen on them, and the test set then says how it plays.
 
 Both players play each file as ``pianobot play`` reads it (:func:`pianobot.perform.hands.two_hands`):
 the general policies (the packaged ones: the parts policy on both hands, through the hold guard)
@@ -63,7 +66,25 @@ EXCERPTS = (
     ("chorale-bwv269", "bach/bwv269", None, 0),
 )
 """Two-staff keyboard pieces of every kind the corpus holds (a prelude, a sonata, a rag, a
-mazurka, a polonaise, atonal miniatures, a song's accompaniment) and two four-voice chorales."""
+mazurka, a polonaise, atonal miniatures, a song's accompaniment) and two four-voice chorales:
+the test set."""
+VALIDATION = (
+    ("clara-schumann-polonaise-2", "schumann_clara/polonaise_op1n2", None, 1),
+    ("clara-schumann-polonaise-3", "schumann_clara/polonaise_op1n3", None, 1),
+    ("clara-schumann-polonaise-4", "schumann_clara/polonaise_op1n4", None, 1),
+    ("clara-schumann-trio-3", "schumann_clara/opus17/movement3", (2, 3), 1),
+    ("schubert-lindenbaum", "schubert/Lindenbaum", (1, 2), 1),
+    ("handel-lascia", "handel/rinaldo/Lascia_chio_pianga", (1, 2), 1),
+    ("chorale-bwv8-6", "bach/bwv8.6", None, 0),
+    ("chorale-bwv80-8", "bach/bwv80.8", None, 0),
+    ("chorale-bwv81-7", "bach/bwv81.7", None, 0),
+    ("chorale-bwv83-5", "bach/bwv83.5", None, 0),
+    ("chorale-bwv84-5", "bach/bwv84.5", None, 0),
+    ("chorale-bwv85-6", "bach/bwv85.6", None, 0),
+)
+"""Other excerpts, for choosing settings: none of the test set's pieces (the trio's and the songs'
+piano staves only)."""
+SETS = {"test": EXCERPTS, "validation": VALIDATION}
 MAX_NOTES = 150
 MAX_SECONDS = 40.0
 
@@ -117,6 +138,7 @@ def play_corpus(
     together: bool = True,
     hand: HandSpec | None = None,
     general: Path | None = None,
+    excerpts: tuple = EXCERPTS,
 ) -> list[dict]:
     """Write the excerpts to ``folder`` and play each with both players (``together``: both hands
     in one simulation, as ``pianobot play`` plays them; ``hand``: each hand's fingers, default
@@ -125,7 +147,7 @@ def play_corpus(
     packaged for it the scripted pianist alone plays); a row each."""
     folder.mkdir(parents=True, exist_ok=True)
     rows = []
-    for name, path, parts, first in EXCERPTS:
+    for name, path, parts, first in excerpts:
         if only and name not in only:
             continue
         file = folder / f"{name}.mid"
@@ -202,7 +224,10 @@ def _share(general: float, scripted: float) -> str:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--out", type=Path, default=Path("out/corpus"), help="folder the excerpts are written to")
+    parser.add_argument("--set", choices=tuple(SETS), default="test", help="the test excerpts, or the validation ones")
+    parser.add_argument(
+        "--out", type=Path, help="folder the excerpts are written to (default out/corpus, or out/corpus-validation)"
+    )
     parser.add_argument("--only", nargs="+", default=(), help="only these excerpts (by name)")
     parser.add_argument("--json", type=Path, help="write every figure to this file")
     parser.add_argument("--apart", action="store_true", help="each hand in a simulation of its own")
@@ -223,7 +248,8 @@ def main() -> None:
         parser.error('music21 is not installed: pip install -e ".[corpus]"')
     started = time.perf_counter()
     hand = THUMB if args.thumb else HandSpec() if args.no_thumb else None  # (None: as play chooses)
-    rows = play_corpus(args.out, tuple(args.only), together=not args.apart, hand=hand, general=args.general)
+    out = args.out or Path("out/corpus" if args.set == "test" else "out/corpus-validation")
+    rows = play_corpus(out, tuple(args.only), not args.apart, hand, args.general, SETS[args.set])
     seconds = time.perf_counter() - started
     print()
     print(table(rows))
@@ -233,6 +259,7 @@ def main() -> None:
     if args.json:
         record = {
             "music21": music21.__version__,
+            "set": args.set,
             "apart": args.apart,
             "thumb": True if args.thumb else False if args.no_thumb else "as play chooses",
             "general": None if args.general is None else str(args.general),

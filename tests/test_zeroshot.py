@@ -132,8 +132,8 @@ def test_the_corpus_options_reach_the_players(monkeypatch, tmp_path):
 
     asked = {}
 
-    def play_corpus(folder, only=(), together=True, hand=None, general=None):
-        asked.update(folder=folder, only=only, together=together, hand=hand, general=general)
+    def play_corpus(folder, only=(), together=True, hand=None, general=None, excerpts=corpus.EXCERPTS):
+        asked.update(folder=folder, only=only, together=together, hand=hand, general=general, excerpts=excerpts)
         return []
 
     monkeypatch.setitem(sys.modules, "music21", types.SimpleNamespace(__version__="test"))
@@ -148,6 +148,7 @@ def test_the_corpus_options_reach_the_players(monkeypatch, tmp_path):
         "together": False,
         "hand": HandSpec((1, 2, 3, 4)),
         "general": tmp_path / "policy",
+        "excerpts": corpus.EXCERPTS,
     }
     record = json.loads(out.read_text())
     assert record["apart"] is True and record["thumb"] is True and record["rows"] == []
@@ -160,6 +161,11 @@ def test_the_corpus_options_reach_the_players(monkeypatch, tmp_path):
     monkeypatch.setattr(sys, "argv", ["corpus", "--out", str(tmp_path), "--no-thumb", "--json", str(out)])
     corpus.main()
     assert asked["hand"] == HandSpec() and json.loads(out.read_text())["thumb"] is False
+    monkeypatch.setattr(sys, "argv", ["corpus", "--set", "validation"])
+    corpus.main()
+    assert asked["excerpts"] == corpus.VALIDATION and asked["folder"] == Path("out/corpus-validation")
+    assert not {name for name, *_ in corpus.VALIDATION} & {name for name, *_ in corpus.EXCERPTS}
+    assert not {path for _, path, *_ in corpus.VALIDATION} & {path for _, path, *_ in corpus.EXCERPTS}
 
 
 def test_benchmarks_hands_thumb_gives_every_player_and_the_examples_reading_each_hands_thumb(monkeypatch, tmp_path):
