@@ -15,6 +15,12 @@ validation`` plays twelve other excerpts (:data:`VALIDATION`: three more of Clar
 polonaises, her trio's piano part, two songs' accompaniments, six chorales), which no figure of
 the test set comes from: a setting is chosen on them, and the test set then says how it plays.
 
+    python -m benchmarks.corpus --write-training out/chorales [--count 160]
+
+writes excerpts of other chorales (:func:`write_training`: the first ``--count`` of music21's Bach
+chorales by corpus path, none of the test or validation pieces) for ``pianobot train --task parts
+--pieces out/chorales``, the recipe of the packaged thumb's policy (models/README.md).
+
 Both players play each file as ``pianobot play`` reads it (:func:`pianobot.perform.hands.two_hands`):
 the general policies (the packaged ones: the parts policy on both hands, through the hold guard)
 from hand start 0, and the scripted pianist; figures against the file as written, so notes the
@@ -85,6 +91,8 @@ VALIDATION = (
 """Other excerpts, for choosing settings: none of the test set's pieces (the trio's and the songs'
 piano staves only)."""
 SETS = {"test": EXCERPTS, "validation": VALIDATION}
+TRAINING_COUNT = 160
+"""Chorales :func:`write_training` writes by default: those the packaged thumb's policy was trained on."""
 MAX_NOTES = 150
 MAX_SECONDS = 40.0
 
@@ -130,6 +138,32 @@ def write_excerpt(path: str, parts, first: int, out: Path) -> dict:
     midi.write()
     midi.close()
     return {"source": path, "measures": f"{first}-{last}"}
+
+
+def write_training(out: Path, count: int = TRAINING_COUNT) -> list[Path]:
+    """Write excerpts of the first ``count`` Bach chorales of music21's corpus (its MusicXML files, by path, each
+    from its first measure within the limits, as the test chorales are) to ``out``, none of the
+    test or validation pieces, nor the Well-Tempered Clavier's prelude: training pieces for
+    ``pianobot train --task parts --pieces``. A chorale music21 cannot excerpt is passed over (said)."""
+    from music21 import corpus
+
+    used = {path for _, path, *_ in EXCERPTS + VALIDATION} | {"bach/bwv846"}
+    scores = [str(p).split("corpus/")[-1] for p in corpus.getComposer("bach")]
+    found = {p.rsplit(".", 1)[0] for p in scores if p.endswith(".mxl")}
+    chorales = [p for p in sorted(found) if p not in used]
+    out.mkdir(parents=True, exist_ok=True)
+    written = []
+    for path in chorales:
+        if len(written) == count:
+            break
+        file = out / (path.split("/")[-1].replace(".", "-") + ".mid")
+        try:
+            write_excerpt(path, None, 0, file)
+        except Exception as error:  # (music21's own errors: a score it cannot excerpt)
+            print(f"{path}: passed over ({str(error)[:80]})")
+            continue
+        written.append(file)
+    return written
 
 
 def play_corpus(
@@ -240,12 +274,28 @@ def main() -> None:
         help="the general policy's folder, on both hands (default: the packaged one for the hand; "
         "where none is packaged for it, the scripted pianist alone plays)",
     )
+    parser.add_argument(
+        "--write-training",
+        type=Path,
+        metavar="DIR",
+        help="only write excerpts of other chorales to DIR, to train on (pianobot train --task parts --pieces DIR)",
+    )
+    parser.add_argument(
+        "--count",
+        type=int,
+        default=TRAINING_COUNT,
+        help="with --write-training: how many chorales (default %(default)s)",
+    )
     args = parser.parse_args()
     torch.set_num_threads(1)  # (the simulation is the cost; torch's threads would only contend)
     try:
         import music21
     except ImportError:
         parser.error('music21 is not installed: pip install -e ".[corpus]"')
+    if args.write_training is not None:
+        written = write_training(args.write_training, args.count)
+        print(f"{len(written)} chorale excerpts written to {args.write_training}")
+        return
     started = time.perf_counter()
     hand = THUMB if args.thumb else HandSpec() if args.no_thumb else None  # (None: as play chooses)
     out = args.out or Path("out/corpus" if args.set == "test" else "out/corpus-validation")

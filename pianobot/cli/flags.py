@@ -44,6 +44,7 @@ FLAGS = {
     "train.sac.exploration_steps": "--exploration-steps",
     "train.steps": "--steps",
     "train.learner": "--learner",
+    "train.pieces": "--pieces",
     "train.sac": "the agent's network settings (SACConfig)",
 }
 """Setting (its dotted field path) -> the option that sets it. Training fields are ``train.``

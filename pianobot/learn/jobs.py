@@ -7,8 +7,9 @@ from __future__ import annotations
 import os
 import threading
 import time
+import warnings
 from concurrent.futures import ProcessPoolExecutor
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Callable
 
@@ -17,12 +18,16 @@ import torch
 from pianobot.agent import store
 from pianobot.agent.general import NETWORK_FIELDS, find_general
 from pianobot.agent.policy import policy_configs
-from pianobot.errors import PianobotError
+from pianobot.agent.tasks import GivenParts, Target
+from pianobot.env.piano import EnvConfig
+from pianobot.errors import PianobotError, PianobotWarning, SettingError, quote
 from pianobot.learn.dagger import dagger_policy
 from pianobot.learn.train import Progress, TrainConfig, train_policy
+from pianobot.music.instrument import check_playable
+from pianobot.music.load import LoadOptions
 from pianobot.music.phrases import Phrase
-from pianobot.music.piece import Piece
-from pianobot.music.tasks import VERSIONS
+from pianobot.music.tasks import GIVEN_SHARE, PARTS, VERSIONS
+from pianobot.perform.hands import prepare_part, two_hands
 
 
 @dataclass
@@ -30,13 +35,17 @@ class PhraseJob:
     """One policy to train: a phrase (by content hash) or a task family, and the phrases that use it."""
 
     key: str
-    target: Piece | str
+    target: Target
     folder: Path
     phrases: list[int]
     piece: str = ""
+    given: dict = field(default_factory=dict)
+    """Where a task family's given parts came from (:class:`~pianobot.agent.tasks.GivenParts`'s ``about``)."""
 
     def about(self) -> dict:
-        return {"key": self.key, "piece": self.piece, "phrases": self.phrases}
+        return {"key": self.key, "piece": self.piece, "phrases": self.phrases} | (
+            {"given": self.given} if self.given else {}
+        )
 
 
 def _exit_with_parent(parent: int, every: float = 0.5) -> None:
@@ -113,10 +122,86 @@ def phrase_jobs(phrases: list[Phrase], config: TrainConfig, root: Path, piece: s
     return list(by_hash.values())
 
 
-def task_job(task: str, config: TrainConfig, root: Path) -> PhraseJob:
-    """The one job of a task family."""
+def task_job(task: str, config: TrainConfig, root: Path, given: GivenParts | None = None) -> PhraseJob:
+    """The one job of a task family; ``given``: the ``parts`` family with these parts given, in
+    folders of their own (``task-parts-v3-pieces-<digest of the parts>-<config hash>``)."""
     key = store.task_key(task, VERSIONS.get(task, 1))
-    return PhraseJob(key, task, store.model_dir(root, key, config), [0], f"task {task}")
+    if given is None:
+        return PhraseJob(key, task, store.model_dir(root, key, config), [0], f"task {task}")
+    if task != PARTS:
+        raise SettingError(
+            f"train.pieces gives hands' parts to the {PARTS} family only: drop it for {task}", "train.pieces"
+        )
+    key = f"{key}-pieces-{given.digest}"
+    about = given.about | {"digest": given.digest}
+    return PhraseJob(key, given, store.model_dir(root, key, config), [0], f"task {task}", about)
+
+
+PIECE_SUFFIXES = (".mid", ".midi")
+"""The files of a folder of pieces (:func:`given_parts`) that are read."""
+
+
+def given_parts(folder: Path, env: EnvConfig, share: float = GIVEN_SHARE) -> GivenParts:
+    """The ``parts`` family's given parts from a folder of two-hand files (``pianobot train --task
+    parts --pieces DIR``): each hand's part of every .mid file in ``folder`` (sorted by name) that
+    ``pianobot play`` plays with both hands, read as ``play`` reads it (the hands named by its
+    tracks or given by the fingering planner, for ``env``'s hand) and given to its player as ``play``
+    gives it (:func:`~pianobot.perform.hands.prepare_part`: the left hand's mirrored, both moved by
+    octaves onto ``env``'s keys, what the hand cannot reach reduced, fingered by the planner). Files
+    that play one hand, that the reading refuses, and parts the hand still cannot play as given,
+    are left out, said in one warning line; none left is a one-line error. The readings' own
+    warnings are not said: a file's reductions are the part it gives."""
+    folder = Path(folder)
+    if not folder.is_dir():
+        raise SettingError(
+            f"train.pieces {quote(str(folder))}: not a folder: give a folder of two-hand .mid files", "train.pieces"
+        )
+    files = sorted(p for p in folder.iterdir() if p.is_file() and p.suffix.lower() in PIECE_SUFFIXES)
+    if not files:
+        raise SettingError(
+            f"train.pieces {quote(str(folder))}: no .mid files in it: give a folder of two-hand .mid files",
+            "train.pieces",
+        )
+    keyboard, fingers = env.world.keyboard.spec, env.world.hand.spec
+    parts, one_hand, refused, unplayable = [], 0, 0, 0
+    for file in files:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            try:
+                reading = two_hands(file, LoadOptions(), fingers, keyboard)
+            except PianobotError:
+                refused += 1
+                continue
+            if reading is None:
+                one_hand += 1
+                continue
+            for hand in reading.piece.hands:
+                try:
+                    _, part, _, _ = prepare_part(reading.piece, hand, keyboard, fingers)
+                    check_playable(part, keyboard, fingers)
+                except PianobotError:
+                    unplayable += 1
+                    continue
+                parts.append(part)
+    left_out = [
+        f"{count} {what}"
+        for count, what in (
+            (one_hand, "file(s) that play one hand"),
+            (refused, "file(s) the reading refuses (pianobot inspect FILE says why)"),
+            (unplayable, "part(s) the hand cannot play as given"),
+        )
+        if count
+    ]
+    if not parts:
+        raise SettingError(
+            f"train.pieces {quote(str(folder))}: none of its {len(files)} .mid files gives a part to train on "
+            f"({', '.join(left_out)}): give two-hand files",
+            "train.pieces",
+        )
+    if left_out:
+        warnings.warn(PianobotWarning(f"{folder}: left out {', '.join(left_out)}; {len(parts)} parts are given"))
+    about = {"folder": str(folder), "files": len(files), "parts": len(parts), "share": share}
+    return GivenParts(tuple(parts), share, about)
 
 
 def plan_jobs(jobs: list[PhraseJob], force: bool) -> tuple[list[PhraseJob], list[PhraseJob]]:

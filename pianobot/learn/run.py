@@ -46,13 +46,12 @@ from pianobot.agent import general, store
 from pianobot.agent.buffer import ReplayBuffer
 from pianobot.agent.policy import make_agent
 from pianobot.agent.sac import SAC, resolve_device, vector_size
-from pianobot.agent.tasks import make_env
+from pianobot.agent.tasks import GivenParts, Target, make_env
 from pianobot.config import to_dict
 from pianobot.env.piano import EnvConfig
 from pianobot.errors import PianobotError
 from pianobot.learn.config import TrainConfig
 from pianobot.learn.log import LOG_FILE, PLOT_FILE, TENSORBOARD_DIR, TrainingLog
-from pianobot.music.piece import Piece
 from pianobot.perform.rollout import rollout
 
 EVAL_SEED = 10_000
@@ -79,7 +78,7 @@ class Progress:
     """True once, when the run ends (``step``: the steps it took)."""
 
 
-def make_envs(target: Piece | str, env_config: EnvConfig, count: int) -> gym.vector.VectorEnv:
+def make_envs(target: Target, env_config: EnvConfig, count: int) -> gym.vector.VectorEnv:
     """``count`` environments of a phrase or task family (:func:`~pianobot.agent.tasks.make_env`),
     stepped together: one in this process (the run is exactly what it always was), more each in a
     worker process of its own (spawned: they import the simulator, never torch). None resets by
@@ -112,9 +111,7 @@ def resume_envs(envs: gym.vector.VectorEnv, states: list[dict] | dict, seed: int
     return observations
 
 
-def evaluate(
-    agent: SAC, target: Piece | str, env_config: EnvConfig, episodes: int, first_seed: int = EVAL_SEED
-) -> dict:
+def evaluate(agent: SAC, target: Target, env_config: EnvConfig, episodes: int, first_seed: int = EVAL_SEED) -> dict:
     """Deterministic policy on fixed hand starts (and task instances), seeds ``first_seed``,
     ``first_seed + 1``, ...: mean note F1, velocity error and return."""
     env = make_env(target, env_config)
@@ -164,7 +161,7 @@ def better(figures: dict, than: dict | None) -> bool:
 
 @contextlib.contextmanager
 def open_run(
-    target: Piece | str,
+    target: Target,
     config: TrainConfig,
     folder: Path,
     report: Callable[[Progress], None],
@@ -200,13 +197,21 @@ def _remove_log(folder: Path) -> None:
             folder.rmdir()
 
 
+def target_record(target: Target) -> str | list[dict]:
+    """What a manifest's ``target`` holds: a task family's name (also one given parts:
+    :class:`~pianobot.agent.tasks.GivenParts`, which the job's ``about`` describes), or a phrase's notes."""
+    if isinstance(target, GivenParts):
+        return target.name
+    return target if isinstance(target, str) else [asdict(note) for note in target.notes]
+
+
 @dataclass
 class Run:
     """One training run: what it trains, where, and the bookkeeping every learner needs (see the
     module's docstring for the order of its calls). ``config`` is the run's; once :meth:`begin`
     knows how the run began, its ``from_general`` says so (and with it :attr:`TrainConfig.stop_f1`)."""
 
-    target: Piece | str
+    target: Target
     config: TrainConfig
     folder: Path
     report: Callable[[Progress], None]
@@ -364,7 +369,7 @@ class Run:
         start_kept = self.kept_start or (self.began is not None and final.get("step") == 0)
         manifest = {
             **(self.about or {}),
-            "target": self.target if isinstance(self.target, str) else [asdict(note) for note in self.target.notes],
+            "target": target_record(self.target),
             "steps": step,
             "updates": agent.updates,
             "seconds": round(self.seconds(), 1),  # across interruptions

@@ -29,7 +29,7 @@ from typing import Callable
 
 import numpy as np
 
-from pianobot.agent.tasks import make_env
+from pianobot.agent.tasks import Target, make_env
 from pianobot.learn.config import TrainConfig
 from pianobot.learn.explore import Explorer
 from pianobot.learn.run import (
@@ -48,7 +48,6 @@ from pianobot.learn.run import (
     resume_envs,
     split_kept,
 )
-from pianobot.music.piece import Piece
 
 __all__ = [  # the loop, and the names of pianobot.learn.run that others import from here
     "BEST_PREFIX",
@@ -70,7 +69,7 @@ __all__ = [  # the loop, and the names of pianobot.learn.run that others import 
 
 
 def train_policy(
-    target: Piece | str,
+    target: Target,
     config: TrainConfig,
     folder: Path,
     report: Callable[[Progress], None] = lambda p: None,

@@ -42,6 +42,10 @@ VERSIONS = {PARTS: 3}
 ``parts`` 2 draws one hand's whole part, where 1 drew a phrase of at most six notes of it or a
 melody phrase; 3 draws from five textures, the fifth a right hand in two voices (``right-voices``). A policy folder's key names a version after the first
 (:func:`pianobot.agent.store.task_key`), so that a store keeps each version's policies apart."""
+GIVEN_SHARE = 0.5
+"""The share of a ``parts`` run's instances that are hands' parts of the files it is given
+(``pianobot train --task parts --pieces DIR``, :class:`pianobot.agent.tasks.GivenParts`): the share
+the packaged thumb's policy was trained with (models/README.md)."""
 BPM = 60.0
 FINGERS = (2, 3, 4)
 MAX_SHIFT = 4

@@ -41,7 +41,7 @@ from pianobot.files import check_writable
 from pianobot.learn.config import MAX_ENVS, DaggerConfig, TrainConfig
 from pianobot.learn.explore import EXPLORATIONS
 from pianobot.music.phrases import DEFAULT_MAX_NOTES
-from pianobot.music.tasks import MELODY, PARTS, TASKS
+from pianobot.music.tasks import GIVEN_SHARE, MELODY, PARTS, TASKS
 from pianobot.sim.world import WorldConfig
 
 
@@ -57,6 +57,13 @@ def train(
         help=f"Train on a task family instead, a fresh random instance each episode: the paper's {', '.join(TASKS)}, "
         f"or {MELODY} (random one-hand phrases of up to {DEFAULT_MAX_NOTES} notes in every key, fingered by the "
         f"planner; docs/training.md) or {PARTS} (either hand's whole part of random two-hand pieces).",
+    ),
+    pieces: Optional[Path] = typer.Option(
+        None,
+        "--pieces",
+        help=f"With --task {PARTS}: a folder of two-hand .mid files; {GIVEN_SHARE:.0%} of the instances are then one "
+        "hand's part of one of them (each hand's part of each file, read and given to its player as play gives it), "
+        "the rest the family's own. Files that play one hand are left out.",
     ),
     steps: int = typer.Option(
         TrainConfig.steps,
@@ -181,7 +188,15 @@ def train(
     from pianobot.agent.sac import resolve_device
     from pianobot.cli import display
     from pianobot.learn.accept import JUDGE_SEEDS, judge_for, settle_hands, settle_piece
-    from pianobot.learn.jobs import general_start, phrase_jobs, plan_jobs, run_jobs, run_jobs_on_ray, task_job
+    from pianobot.learn.jobs import (
+        general_start,
+        given_parts,
+        phrase_jobs,
+        plan_jobs,
+        run_jobs,
+        run_jobs_on_ray,
+        task_job,
+    )
     from pianobot.learn.log import LOG_FILE, PLOT_FILE
     from pianobot.learn.train import TASK_EVAL_EPISODES
     from pianobot.music.phrases import split_phrases
@@ -190,6 +205,8 @@ def train(
 
     if (song is None) == (task is None):
         raise PianobotError("give a .mid file to train on, or --task NAME (not both)")
+    if pieces is not None and task != PARTS:
+        raise PianobotError(f"--pieces gives hands' parts to --task {PARTS}: drop it, or train --task {PARTS}")
     if workers < 1 or threads < 1:
         raise PianobotError(f"--workers {workers} --threads {threads}: give 1 or more of each")
     if not 1 <= envs <= MAX_ENVS:
@@ -270,10 +287,13 @@ def train(
     config, start = general_start(config, models, general_policy, networks_given=actor is not None)
     groups = []  # (hand or None, its config, the policy its phrases start from, its jobs)
     if task is not None:
-        job = task_job(task.value, config, models)
+        given = given_parts(pieces, config.env) if pieces is not None else None
+        job = task_job(task.value, config, models, given)
         refuse_training_into(general_policy, [job])
         todo, done = plan_jobs([job], force)
         label = f"task {task}"
+        if given is not None:
+            label += f", {given.share:.0%} of it {len(given.parts)} parts of {given.about['files']} files in {pieces}"
         if start is not None and todo and store.checkpoint_state(job.folder) is None:  # (else it resumes, and says so)
             console.print(f"continuing the policy {said(start)} on {said(label)}: evaluated first", soft_wrap=True)
         groups = [(None, config, start, todo)]
