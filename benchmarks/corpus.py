@@ -292,6 +292,8 @@ def main() -> None:
         import music21
     except ImportError:
         parser.error('music21 is not installed: pip install -e ".[corpus]"')
+    if args.count < 1:
+        parser.error(f"--count {args.count}: give 1 or more chorales")
     if args.write_training is not None:
         written = write_training(args.write_training, args.count)
         print(f"{len(written)} chorale excerpts written to {args.write_training}")

@@ -38,7 +38,9 @@ def test_given_parts_are_drawn_at_their_share_and_the_rest_are_the_familys_own()
     from_given = [d for d in draws if d in given.parts]
     assert 18 <= len(from_given) <= 42  # about half (binomial, 60 draws)
     assert {d for d in from_given} == set(given.parts)  # each given part is drawn
-    assert all(len(d) > 3 for d in draws if d not in given.parts)  # the rest: whole parts of random duets
+    for draw in (d for d in draws if d not in given.parts):  # the rest: the family's own, fingered parts
+        check_playable(draw, EnvConfig().world.keyboard.spec, EnvConfig().world.hand.spec)
+        assert draw.has_fingering and len(draw) > 3
     always = GivenParts(given.parts, share=1.0)
     assert all(draw_part(np.random.default_rng(s), EnvConfig(), always) in given.parts for s in range(5))
     # the same generator draws the same instances
@@ -72,7 +74,8 @@ def test_given_parts_read_each_hand_of_the_two_hand_files_and_say_what_they_leav
         warnings.simplefilter("always")
         given = given_parts(tmp_path, env)
     (said,) = [str(w.message) for w in caught if issubclass(w.category, PianobotWarning)]
-    assert "1 file(s) that play one hand" in said and "1 file(s) the reading refuses" in said and "4 parts" in said
+    assert "1 file(s) that play one hand" in said and "4 parts" in said
+    assert "1 file(s) the reading refuses (broken.mid:" in said  # named, so the user can look at it
     assert len(given.parts) == 4 and given.about == {"folder": str(tmp_path), "files": 4, "parts": 4, "share": 0.5}
     for part in given.parts:  # each as its player is given it: fingered, on the env's keys, from 0
         check_playable(part, env.world.keyboard.spec, THUMB)
@@ -106,6 +109,10 @@ def test_train_the_parts_family_with_pieces_stores_a_general_policy_that_says_wh
     assert given["folder"] == str(pieces) and given["parts"] == 2 and given["share"] == 0.5
     assert folder.name.startswith(f"task-parts-v3-pieces-{given['digest']}-")
     assert general_candidates(models)[0] == folder  # play and train find it as the general policy
+    # the same pieces are the same parts: the same folder, already trained (a resume finds its checkpoint)
+    same = run("train", "--task", "parts", "--pieces", pieces, *quick, "--json", "-")
+    assert same.exit_code == 0 and json.loads(same.stdout)["policies"][0]["folder"] == str(folder)
+    assert json.loads(same.stdout)["policies"][0]["trained_now"] is False
     # other pieces are another family: another folder, not the first one resumed or taken as trained
     _duet(pieces / "b.mid", shift=2)
     again = run("train", "--task", "parts", "--pieces", pieces, *quick, "--json", "-")

@@ -93,7 +93,9 @@ def policy_target(folder: Path) -> Piece | str:
 
 def policy_env(folder: Path) -> PianoEnv:
     """The environment the policy in ``folder`` was trained in, rebuilt from its manifest: its
-    phrase, or fresh instances of its task family each episode."""
+    phrase, or fresh instances of its task family each episode (of a ``parts`` policy trained with
+    given parts, ``train --pieces``, the family's own instances only: the manifest's ``given`` says
+    which folder the rest came from, not the parts themselves)."""
     env_config, _ = policy_configs(folder)
     return make_env(policy_target(folder), env_config)
 

@@ -204,6 +204,6 @@ def training_table(rows) -> Table:
 
 def _kept_start(job) -> str:
     """The folder column of a run that stored nothing: its start played best."""
-    if isinstance(job.target, str):  # a task family, trained on from --general-policy
+    if not isinstance(job.target, Piece):  # a task family (or one given parts), trained on from --general-policy
         return "none: its start policy played best"
     return "none: the general policy plays it"

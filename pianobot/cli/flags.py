@@ -48,7 +48,8 @@ FLAGS = {
     "train.sac": "the agent's network settings (SACConfig)",
 }
 """Setting (its dotted field path) -> the option that sets it. Training fields are ``train.``
-and their path in :class:`~pianobot.learn.config.TrainConfig` (``train.env.world.control``)."""
+and their path in :class:`~pianobot.learn.config.TrainConfig` (``train.env.world.control``), or
+what ``pianobot train`` takes beside it (``train.pieces``: :func:`pianobot.learn.jobs.given_parts`)."""
 
 _FIELD = re.compile(
     r"(?<![\w.])(" + "|".join(re.escape(f) for f in sorted(FLAGS, key=len, reverse=True)) + r")(?![\w.])"

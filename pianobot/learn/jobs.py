@@ -145,12 +145,17 @@ def given_parts(folder: Path, env: EnvConfig, share: float = GIVEN_SHARE) -> Giv
     """The ``parts`` family's given parts from a folder of two-hand files (``pianobot train --task
     parts --pieces DIR``): each hand's part of every .mid file in ``folder`` (sorted by name) that
     ``pianobot play`` plays with both hands, read as ``play`` reads it (the hands named by its
-    tracks or given by the fingering planner, for ``env``'s hand) and given to its player as ``play``
-    gives it (:func:`~pianobot.perform.hands.prepare_part`: the left hand's mirrored, both moved by
-    octaves onto ``env``'s keys, what the hand cannot reach reduced, fingered by the planner). Files
-    that play one hand, that the reading refuses, and parts the hand still cannot play as given,
-    are left out, said in one warning line; none left is a one-line error. The readings' own
-    warnings are not said: a file's reductions are the part it gives."""
+    tracks or given by the fingering planner, for ``env``'s hand), and given to a player as
+    :func:`~pianobot.perform.hands.prepare_part` gives it: the left hand's mirrored, moved by
+    octaves onto ``env``'s keys (notes still off them left out), what the hand cannot reach reduced,
+    fingered by the planner, from the part's own first note. Unlike ``play``, each hand is fingered
+    alone (``play`` plans both hands' fingerings together to keep the wrists apart) and a part wider
+    than the keys is not given its own octaves; like ``play``, a part the planner reports problems
+    with (a passage still faster than the hand) is kept. Files that play one hand, that the reading
+    refuses (the first three named), and parts the hand cannot play as given, are left out, said in
+    one warning line; none left is a one-line error. The readings' own warnings are not said: a
+    file's reductions are the part it gives. The parts are the policy's data, so a later reader or
+    planner that gives other parts of the same files names another folder (:func:`task_job`)."""
     folder = Path(folder)
     if not folder.is_dir():
         raise SettingError(
@@ -163,14 +168,14 @@ def given_parts(folder: Path, env: EnvConfig, share: float = GIVEN_SHARE) -> Giv
             "train.pieces",
         )
     keyboard, fingers = env.world.keyboard.spec, env.world.hand.spec
-    parts, one_hand, refused, unplayable = [], 0, 0, 0
+    parts, one_hand, refused, unplayable = [], 0, [], 0
     for file in files:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             try:
                 reading = two_hands(file, LoadOptions(), fingers, keyboard)
             except PianobotError:
-                refused += 1
+                refused.append(file.name)
                 continue
             if reading is None:
                 one_hand += 1
@@ -187,7 +192,10 @@ def given_parts(folder: Path, env: EnvConfig, share: float = GIVEN_SHARE) -> Giv
         f"{count} {what}"
         for count, what in (
             (one_hand, "file(s) that play one hand"),
-            (refused, "file(s) the reading refuses (pianobot inspect FILE says why)"),
+            (
+                len(refused),
+                f"file(s) the reading refuses ({', '.join(refused[:3])}{', ...' * (len(refused) > 3)}: pianobot inspect FILE says why)",
+            ),
             (unplayable, "part(s) the hand cannot play as given"),
         )
         if count

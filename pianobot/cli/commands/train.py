@@ -62,8 +62,8 @@ def train(
         None,
         "--pieces",
         help=f"With --task {PARTS}: a folder of two-hand .mid files; {GIVEN_SHARE:.0%} of the instances are then one "
-        "hand's part of one of them (each hand's part of each file, read and given to its player as play gives it), "
-        "the rest the family's own. Files that play one hand are left out.",
+        "hand's part of one of them (each file read as play reads it, each hand's part moved onto the run's keys, "
+        "reduced and fingered as play does), the rest the family's own. Files that play one hand are left out.",
     ),
     steps: int = typer.Option(
         TrainConfig.steps,
@@ -287,7 +287,10 @@ def train(
     config, start = general_start(config, models, general_policy, networks_given=actor is not None)
     groups = []  # (hand or None, its config, the policy its phrases start from, its jobs)
     if task is not None:
-        given = given_parts(pieces, config.env) if pieces is not None else None
+        given = None
+        if pieces is not None:
+            console.print(f"reading the two-hand files in {said(pieces)}", soft_wrap=True)
+            given = given_parts(pieces, config.env)
         job = task_job(task.value, config, models, given)
         refuse_training_into(general_policy, [job])
         todo, done = plan_jobs([job], force)
