@@ -289,7 +289,8 @@ def train(
     if task is not None:
         given = None
         if pieces is not None:
-            console.print(f"reading the two-hand files in {said(pieces)}", soft_wrap=True)
+            if pieces.is_dir():  # (else given_parts says what is wrong)
+                console.print(f"reading the two-hand files in {said(pieces)}", soft_wrap=True)
             given = given_parts(pieces, config.env)
         job = task_job(task.value, config, models, given)
         refuse_training_into(general_policy, [job])
