@@ -1,7 +1,7 @@
 """pianobot: teach a simulated dexterous robot hand to play the piano from real MIDI files.
 
 The Python API (docs/api.md): the names below are imported on first use, so ``import pianobot``
-stays quick (it registers the gymnasium ids ``pianobot/Piano-v0``, ``pianobot/OneNote-v0``, ...).
+stays quick (it registers the gymnasium ids ``pianobot/Piano-v1``, ``pianobot/OneNote-v1``, ...).
 
 - :func:`load_piece` -- a ``.mid`` (or PIG) file as a validated :class:`Piece`;
 - :class:`PianoEnv`, :class:`EnvConfig` -- the gymnasium environment;

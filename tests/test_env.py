@@ -122,11 +122,11 @@ def test_torque_control_and_discrete_wrist_run():
 
 
 def test_registered_ids():
-    env = gym.make("pianobot/OneNote-v0", config=EnvConfig(tactile=False))
+    env = gym.make("pianobot/OneNote-v1", config=EnvConfig(tactile=False))
     observation, _ = env.reset(seed=0)
     assert observation["score"].shape == (11, 24, 5)
-    assert gym.make("pianobot/Piano-v0", piece=PHRASE).unwrapped.piece == PHRASE
-    assert {"pianobot/ThreeNote-v0", "pianobot/SixNote-v0", "pianobot/Rhythmic-v0", "pianobot/Chord-v0"} <= set(
+    assert gym.make("pianobot/Piano-v1", piece=PHRASE).unwrapped.piece == PHRASE
+    assert {"pianobot/ThreeNote-v1", "pianobot/SixNote-v1", "pianobot/Rhythmic-v1", "pianobot/Chord-v1"} <= set(
         gym.registry
     )
 

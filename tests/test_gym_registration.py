@@ -1,4 +1,4 @@
-"""The gymnasium ids: every spec says how long an episode runs at most, and pianobot/Piano-v0
+"""The gymnasium ids: every spec says how long an episode runs at most, and pianobot/Piano-v1
 reads a piece from a path (issue 36, item 5)."""
 
 from pathlib import Path
@@ -26,9 +26,9 @@ def test_the_registered_figures_are_the_environments():
 
 
 def test_every_id_has_max_episode_steps_and_an_episode_ends_there():
-    ids = ["pianobot/Piano-v0"] + [env_id(task) for task in TASKS]
+    ids = ["pianobot/Piano-v1"] + [env_id(task) for task in TASKS]
     assert all(isinstance(gymnasium.spec(i).max_episode_steps, int) for i in ids)
-    env = gymnasium.make("pianobot/OneNote-v0", config=QUIET)
+    env = gymnasium.make("pianobot/OneNote-v1", config=QUIET)
     assert env.spec.max_episode_steps == 45
     env.reset(seed=0)
     steps, done = 0, False
@@ -37,28 +37,28 @@ def test_every_id_has_max_episode_steps_and_an_episode_ends_there():
         steps, done = steps + 1, terminated or truncated
     assert steps == env.spec.max_episode_steps == env.unwrapped.horizon
     env.close()
-    six = gymnasium.make("pianobot/SixNote-v0", config=QUIET)
+    six = gymnasium.make("pianobot/SixNote-v1", config=QUIET)
     six.reset(seed=1)
     assert six.unwrapped.horizon == six.spec.max_episode_steps == 20 + 125  # lead-in, six seconds and the tail
     six.close()
 
 
 def test_a_path_is_read_where_a_piece_is(tmp_path):
-    env = gymnasium.make("pianobot/Piano-v0", piece=str(SONG), config=QUIET)
+    env = gymnasium.make("pianobot/Piano-v1", piece=str(SONG), config=QUIET)
     assert env.unwrapped.piece == pianobot.load_piece(SONG)
     assert env.unwrapped.horizon <= env.spec.max_episode_steps
     env.close()
     with pytest.raises(PianobotError, match="no such file"):
-        gymnasium.make("pianobot/Piano-v0", piece=tmp_path / "missing.mid")
+        gymnasium.make("pianobot/Piano-v1", piece=tmp_path / "missing.mid")
 
 
 def test_a_config_with_longer_episodes_warns_with_the_number():
     with pytest.warns(UserWarning, match="up to 65 steps.*max_episode_steps=65"):
-        env = gymnasium.make("pianobot/OneNote-v0", config=pianobot.EnvConfig(tactile=False, lead_in=2.0))
+        env = gymnasium.make("pianobot/OneNote-v1", config=pianobot.EnvConfig(tactile=False, lead_in=2.0))
     env.close()
     with pytest.warns(UserWarning, match="unless you gave it"):  # (the entry point cannot see it was given)
         env = gymnasium.make(
-            "pianobot/OneNote-v0", config=pianobot.EnvConfig(tactile=False, lead_in=2.0), max_episode_steps=65
+            "pianobot/OneNote-v1", config=pianobot.EnvConfig(tactile=False, lead_in=2.0), max_episode_steps=65
         )
     assert env.spec.max_episode_steps == 65
     env.close()

@@ -29,9 +29,9 @@ if TYPE_CHECKING:
     from pianobot.agent.sac import SAC
 
 
-def make_agent(env, config: SACConfig, device: str | torch.device = "cpu") -> SAC:
+def make_agent(env, config: SACConfig, device: str | torch.device = "cpu", training: bool = True) -> SAC:
     """A fresh agent, on ``device``, for the observation and action spaces of ``env`` (a
-    :class:`PianoEnv`, or a gymnasium vector of them)."""
+    :class:`PianoEnv`, or a gymnasium vector of them); ``training`` False: only what acting needs."""
     from pianobot.agent.sac import SAC, finger_layout, score_size, vector_size  # torch: only once an agent is built
 
     space = getattr(env, "single_observation_space", env.observation_space)
@@ -46,6 +46,7 @@ def make_agent(env, config: SACConfig, device: str | torch.device = "cpu") -> SA
         config,
         device,
         finger_layout(space),
+        training,
     )
 
 
@@ -104,7 +105,7 @@ def load_policy(folder: Path, env: PianoEnv) -> SAC:
     """The policy stored in ``folder``, acting in ``env`` (which must have the observation
     layout it was trained with: see :func:`policy_configs`)."""
     _, sac_config = policy_configs(folder)
-    agent = make_agent(env, sac_config)
+    agent = make_agent(env, sac_config, training=False)
     tensors = store.load_tensors(folder / store.POLICY_FILE)
     try:
         agent.load_tensors(tensors, with_training_state=False)

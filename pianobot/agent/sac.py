@@ -314,15 +314,16 @@ class SAC:
         config: SACConfig = SACConfig(),
         device: str | torch.device = "cpu",
         layout: FingerLayout | None = None,
+        training: bool = True,
     ):
         """``layout``: where the fingers' values lie in the vector (:func:`finger_layout`), which
-        the 'fingers' actor needs."""
+        the 'fingers' actor needs. ``training`` False builds only what acting needs (the actor
+        and the encoder it reads): no target critic, no optimisers, so that a policy loaded to
+        play costs neither their memory nor the import of torch's optimiser and compiler modules."""
         self.config = config
         self.device = torch.device(device)
+        self.training = training
         self.critic = Critic(vector_dim, score_dim, tactile_shape, action_dim, config).to(self.device)
-        self.target = Critic(vector_dim, score_dim, tactile_shape, action_dim, config).to(self.device)
-        self.target.load_state_dict(self.critic.state_dict())
-        self.target.requires_grad_(False)
         if config.actor == "fingers":
             if layout is None:
                 raise ValueError(
@@ -333,13 +334,20 @@ class SAC:
             self.actor = Actor(self.critic.encoder.out_dim, action_dim, config).to(self.device)
         self.log_alpha = torch.tensor(math.log(config.initial_alpha), device=self.device, requires_grad=True)
         self.target_entropy = -config.target_entropy_scale * action_dim
+        self.updates = 0
+        if not training:
+            self.critic.requires_grad_(False)
+            self.actor.requires_grad_(False)
+            return
+        self.target = Critic(vector_dim, score_dim, tactile_shape, action_dim, config).to(self.device)
+        self.target.load_state_dict(self.critic.state_dict())
+        self.target.requires_grad_(False)
         lr = config.learning_rate
         self.critic_optimizer = torch.optim.Adam(self.critic.parameters(), lr=lr)
         self.actor_optimizer = torch.optim.Adam(self.actor.parameters(), lr=lr)
         self.alpha_optimizer = torch.optim.Adam([self.log_alpha], lr=lr)
         self._critic_params = list(self.critic.parameters())
         self._target_params = list(self.target.parameters())
-        self.updates = 0
 
     @property
     def alpha(self) -> torch.Tensor:
@@ -468,6 +476,8 @@ class SAC:
         _load_checked(self.critic.encoder, section("encoder."), "encoder.")
         if not with_training_state:
             return
+        if not self.training:
+            raise ValueError("an agent built to act (training=False) holds no training state to load")
         critic = section("critic.")
         critic.update({f"encoder.{k}": v for k, v in section("encoder.").items()})
         _load_checked(self.critic, critic, "critic.")

@@ -56,13 +56,19 @@ reading (:func:`upgrade_manifest`), so every model a user has keeps playing.
   already played its phrase, or was never beaten, now stores none, says ``kept: 'start'`` and is
   recorded in :data:`GENERAL_INDEX`; before, it stored a copy of the start); the file
   ``critic.safetensors`` (missing: the policy cannot pass its critic on to a fine-tuning run,
-  which then begins with fresh Q heads).
+  which then begins with fresh Q heads); ``simulator`` (:data:`pianobot.env.VERSION` of the
+  environment the run that chose the policy trained and evaluated it on; missing, it is read as
+  1 for a policy ``saved`` after v1's physics came in, :data:`V1_SINCE`, else 0, v0's: a
+  manifest without ``saved`` predates v1).
 - 1: the agent's ``config.sac.tactile_resolution`` overrode ``config.env.tactile_pool``; the
   policy file held the tactile convolutions twice (``encoder.conv.*`` beside
   ``encoder.tactile.0.*``); manifests written before the finger targets carried velocity and
   onsets, and before the score window became optional, lack those fields, which then meant
   ``target_velocity=False``, ``target_onsets=False`` and ``score_input=True``.
 """
+V1_SINCE = "2026-11-24T20:31:14+00:00"
+"""When the simulator's v1 physics came in (its commit): a manifest without ``simulator`` saved
+after it was trained on v1 (:func:`upgrade_manifest`)."""
 POLICY_FILE = "policy.safetensors"
 CRITIC_FILE = "critic.safetensors"
 MANIFEST_FILE = "manifest.json"
@@ -166,7 +172,9 @@ def save_manifest(folder: Path, manifest: dict) -> None:
     alone, it records a run that kept its start policy and stored none (:func:`kept_start`)."""
     folder.mkdir(parents=True, exist_ok=True)
     saved = datetime.now(timezone.utc).isoformat(timespec="seconds")
-    manifest = {"format": FORMAT, **manifest, "saved": saved, "versions": package_versions()}
+    from pianobot.env import VERSION  # (the gymnasium ids only: no simulator is imported)
+
+    manifest = {"format": FORMAT, "simulator": VERSION, **manifest, "saved": saved, "versions": package_versions()}
     atomic_write(folder / MANIFEST_FILE, json.dumps(manifest, indent=2, default=str) + "\n")
 
 
@@ -196,7 +204,22 @@ def upgrade_manifest(manifest: dict) -> dict:
         manifest["config"].setdefault("from_general", False)
     manifest.setdefault("start", None)
     manifest.setdefault("kept", "trained")  # (a stored policy was trained, or copied from its start before ``kept``)
+    if "simulator" not in manifest:
+        saved = manifest.get("saved")
+        manifest["simulator"] = int(isinstance(saved, str) and _utc(saved) >= _utc(V1_SINCE))
     return manifest
+
+
+def _utc(stamp: str) -> datetime:
+    try:
+        return datetime.fromisoformat(stamp).astimezone(timezone.utc)
+    except ValueError:
+        return datetime.min.replace(tzinfo=timezone.utc)
+
+
+def simulator(folder: Path) -> int:
+    """The simulator version (:data:`pianobot.env.VERSION`) the policy in ``folder`` was trained on."""
+    return read_manifest(folder)["simulator"]
 
 
 def read_manifest(folder: Path) -> dict:
@@ -293,6 +316,33 @@ def mark_general_plays(root: Path, entries: dict[str, dict | None]) -> None:
             index[key] = entry
     Path(root).mkdir(parents=True, exist_ok=True)
     atomic_write(Path(root) / GENERAL_INDEX, json.dumps(index, indent=2, sort_keys=True) + "\n")
+
+
+JUDGED_INDEX = "judged.json"
+"""The store's index of the phrase policies ``pianobot train`` judged and kept (:func:`judged`)."""
+
+
+def judged(root: Path) -> dict[str, dict]:
+    """The phrase policies whose piece played better with them than with the general policy
+    alone, by folder name: each with the general policy judged beside (``path``, ``sha256``). A
+    missing or unreadable index is an empty one."""
+    try:
+        found = json.loads((Path(root) / JUDGED_INDEX).read_text())
+    except (OSError, ValueError):
+        return {}
+    return {k: v for k, v in found.items() if isinstance(v, dict)} if isinstance(found, dict) else {}
+
+
+def mark_judged(root: Path, entries: dict[str, dict | None]) -> None:
+    """Record (a dict: the general policy judged beside) or forget (None) a verdict that kept these
+    folders' policies; written atomically, merged with what the index holds."""
+    index = judged(root)
+    for name, entry in entries.items():
+        if entry is None:
+            index.pop(name, None)
+        else:
+            index[name] = entry
+    atomic_write(Path(root) / JUDGED_INDEX, json.dumps(index, indent=2, sort_keys=True) + "\n")
 
 
 def covered_keys(root: Path) -> set[str]:

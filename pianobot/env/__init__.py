@@ -1,8 +1,8 @@
 """The gymnasium environment (:mod:`pianobot.env.piano`) and its rewards (:mod:`pianobot.env.rewards`).
 
-The ids ``pianobot/Piano-v0`` (give ``piece=``: a :class:`~pianobot.music.piece.Piece`, or the
+The ids ``pianobot/Piano-v1`` (give ``piece=``: a :class:`~pianobot.music.piece.Piece`, or the
 path of a file to read as :func:`pianobot.load_piece` reads it) and one per task family
-(``pianobot/OneNote-v0``, ``pianobot/ThreeNote-v0``, ...) are registered with gymnasium on
+(``pianobot/OneNote-v1``, ``pianobot/ThreeNote-v1``, ...; :data:`VERSION`) are registered with gymnasium on
 ``import pianobot``; the simulator is imported only when ``gymnasium.make`` builds one. The
 ``melody`` family has no id: its phrases are fingered by the planner, above this layer;
 ``pianobot.agent.tasks.make_env("melody", config)`` makes its environment.
@@ -10,7 +10,7 @@ path of a file to read as :func:`pianobot.load_piece` reads it) and one per task
 Every id's ``max_episode_steps`` is the longest episode the environment runs with the default
 :class:`~pianobot.env.piano.EnvConfig` (it ends every episode itself, ``truncated``, after the
 lead-in, the piece and a short tail): for a task family its longest instance, for
-``pianobot/Piano-v0`` the longest piece pianobot reads. A ``config`` with a longer lead-in or
+``pianobot/Piano-v1`` the longest piece pianobot reads. A ``config`` with a longer lead-in or
 tail, or a faster control rate, runs longer episodes: pass ``max_episode_steps=`` to
 ``gymnasium.make`` then (it warns, with the number).
 """
@@ -27,6 +27,15 @@ from pianobot.music.tasks import BPM, TASKS
 from pianobot.music.tensor import ScoreSpec, steps_for
 
 ENTRY_POINT = "pianobot.env:make_env"
+
+VERSION = 1
+"""The environments' version: the ``-v<N>`` of every gymnasium id, and the simulator a stored
+policy records it was trained on (its manifest's ``simulator``). It goes up whenever the same
+actions could play differently (physics, keyboard, hand, control rate, observations), as
+Gymnasium versions its own environments, so that figures and policies of two versions are never
+taken for one. What each version changed: :mod:`pianobot.env.piano`'s version history. The ids
+of earlier versions are not registered: their physics is gone, and ``gymnasium.make`` of one
+says so and names this version (Gymnasium's ``DeprecatedEnv``)."""
 
 LONGEST_BEATS = {"one-note": 1, "three-note": 3, "six-note": 6, "rhythmic": 3, "chord": 3}
 """Beats in the longest instance of each task family (:func:`pianobot.music.tasks.make_task`)."""
@@ -47,8 +56,12 @@ def _longest_seconds(task: str | None) -> float:
 
 
 def env_id(task: str) -> str:
-    """The gymnasium id of a task family, e.g. 'three-note' -> 'pianobot/ThreeNote-v0'."""
-    return "pianobot/" + "".join(part.capitalize() for part in task.split("-")) + "-v0"
+    """The gymnasium id of a task family, e.g. 'three-note' -> 'pianobot/ThreeNote-v1'."""
+    return "pianobot/" + "".join(part.capitalize() for part in task.split("-")) + f"-v{VERSION}"
+
+
+PIECE_ID = f"pianobot/Piano-v{VERSION}"
+"""The gymnasium id of the environment that plays a given piece."""
 
 
 def make_env(piece=None, task: str | None = None, config=None, **kwargs):
@@ -78,12 +91,10 @@ def make_env(piece=None, task: str | None = None, config=None, **kwargs):
 
 
 def register_envs() -> None:
-    """Register ``pianobot/Piano-v0`` and one id per task family (once)."""
-    if "pianobot/Piano-v0" in gym.registry:
+    """Register ``pianobot/Piano-v1`` and one id per task family (once)."""
+    if PIECE_ID in gym.registry:
         return
-    gym.register(
-        id="pianobot/Piano-v0", entry_point=ENTRY_POINT, max_episode_steps=longest_episode(MAX_SECONDS, **DEFAULT_STEPS)
-    )
+    gym.register(id=PIECE_ID, entry_point=ENTRY_POINT, max_episode_steps=longest_episode(MAX_SECONDS, **DEFAULT_STEPS))
     for task in TASKS:
         gym.register(
             id=env_id(task),

@@ -19,8 +19,8 @@ Spaces are dicts keyed by hand ('right', 'left'); the reward is the sum of the h
 (``info["rewards"]`` has each); ``info["hands"]`` holds each hand's step info, and ``info``
 also the world's key events with the finger and hand of each strike.
 
-Version history: v0 (2026-11-24), the first two-hand environment; no id is registered with
-gymnasium (a two-hand piece's parts need the fingering planner and the windows, above this layer:
+Version: :data:`pianobot.env.VERSION`, as :mod:`pianobot.env.piano`'s (v1 the first with two
+hands, on v1's physics); no id is registered with gymnasium (a two-hand piece's parts need the fingering planner and the windows, above this layer:
 :func:`pianobot.perform.hands.play_hands` builds one).
 """
 

@@ -21,23 +21,22 @@ each in [-1, 1]: joint speeds (``WorldConfig.control='velocity'``, the default),
 targets with -1 and 1 at the joint's limits ('position') or joint torques ('torque'); the wrist's
 is always its speed along the rail (or, with ``discrete_wrist``, a white key to go to).
 
-Version history (ids ``pianobot/Piano-v0``, ``pianobot/OneNote-v0``, ...; a stored model
-records the :class:`EnvConfig` it was trained with, and :data:`pianobot.agent.store.FORMAT`
-says how older records are read):
+Version history (the ids' ``-v<N>``, :data:`pianobot.env.VERSION`; a stored policy records the
+version it was trained on, its manifest's ``simulator``, and the :class:`EnvConfig` it was
+trained with; :data:`pianobot.agent.store.FORMAT` says how older records are read). A version
+changes whenever the same actions could play differently; a change that adds a setting and
+leaves the default environment playing as before keeps it:
 
-- v0: the finger targets carry the next note's velocity (``target_velocity``) and point at
-  note onsets, with the time left to hold a held key (``target_onsets``); both can be turned
-  off to reproduce the observations of policies trained before them.
-- v0, physics of 2026-11-24 (issue 39): every key is a body of its own, asleep while at rest and
-  untouched, instead of one body for the whole keyboard (whose joints' constraints cost the
-  solver a time that grew with the square of the keys). The keys' geometry, mass, hinge, limits
-  and spring are unchanged, and no setting changed, so a stored policy's manifest reads as
-  before; the solver now orders its work differently, which moves the finger joints by 0.004 rad
-  on average over a performance (as running the old keyboard at 45 solver iterations instead of
-  50 does) and now and then a note by one physics step or one velocity unit: the scripted
-  pianist meets its targets on 47 of the 48 random melodies instead of 48 (docs/simulator.md#world).
-- v0, 2026-11-24 (issue 35): ``length=`` and ``view=`` (one hand of a two-hand world,
-  :mod:`pianobot.env.hands`); a one-hand environment observes, acts and rewards as before.
+- v1 (2026-11-24): every key is a body of its own, asleep while at rest and untouched. The
+  keys' geometry, mass, hinge, limits and spring are v0's, but the solver orders its work
+  differently: finger joints move 0.004 rad apart from v0's on average over a performance, and
+  now and then a note one physics step or one velocity unit. Also added, without changing how
+  a one-hand environment plays: ``length=`` and ``view=`` (one hand of a two-hand world,
+  :mod:`pianobot.env.hands`).
+- v0: the first registered version: the whole keyboard one body; finger targets with the next
+  note's velocity (``target_velocity``) that point at note onsets with the time left to hold a
+  held key (``target_onsets``), both of which can be turned off to reproduce the observations
+  of policies trained before them.
 """
 
 from __future__ import annotations

@@ -134,7 +134,13 @@ def _settle(
 
 
 def _mark_judged(models: Path, kept: dict, dropped: dict, own: dict, about: Callable[[object], dict]) -> None:
-    """Record the verdict in the store's index: a kept policy plays its phrases, a dropped one does not."""
+    """Record the verdict in the store's indexes: a kept policy plays its phrases (and was judged
+    beside the general policy ``about`` describes: a later ``play`` with another judges again), a
+    dropped one does not."""
+    store.mark_judged(
+        models,
+        {folder.name: about(k) for k, folder in kept.items()} | {own[k].name: None for k in dropped},
+    )
     store.mark_general_plays(
         models,
         {folder.name: None for folder in kept.values()}

@@ -106,11 +106,41 @@ class Report:
         return out
 
 
+def _mir_eval():
+    """mir_eval's ``util``, ``transcription`` and ``transcription_velocity`` modules, the ones the
+    figures use. mir_eval's package imports every module it has, scipy.stats among them (about
+    2 s); where it has not been imported yet, these three are imported under a stand-in for the
+    package, which is then taken away, so that a later ``import mir_eval`` imports the package
+    whole and finds these modules already there."""
+    import sys
+
+    if "mir_eval.transcription_velocity" not in sys.modules and "mir_eval" not in sys.modules:
+        import importlib.util
+        import types
+
+        spec = importlib.util.find_spec("mir_eval")
+        if spec is None:
+            raise ModuleNotFoundError("No module named 'mir_eval'", name="mir_eval")
+        stand_in = types.ModuleType("mir_eval")
+        stand_in.__path__ = list(spec.submodule_search_locations)
+        sys.modules["mir_eval"] = stand_in
+        try:
+            import mir_eval.transcription_velocity  # noqa: F401  (and util, transcription)
+        finally:
+            if sys.modules.get("mir_eval") is stand_in:
+                del sys.modules["mir_eval"]
+    return (
+        sys.modules["mir_eval.util"],
+        sys.modules["mir_eval.transcription"],
+        sys.modules["mir_eval.transcription_velocity"],
+    )
+
+
 def _arrays(piece: Piece) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     intervals = np.array([[n.onset, n.offset] for n in piece.notes], dtype=float).reshape(-1, 2)
-    import mir_eval  # imported when needed: it takes a second, and `pianobot --version` need not wait
+    util, _, _ = _mir_eval()
 
-    pitches = mir_eval.util.midi_to_hz(np.array([n.pitch for n in piece.notes], dtype=float))
+    pitches = util.midi_to_hz(np.array([n.pitch for n in piece.notes], dtype=float))
     velocities = np.array([n.velocity for n in piece.notes], dtype=float)
     return intervals, pitches, velocities
 
@@ -161,20 +191,18 @@ def compare(
     control_hz: float = ScoreSpec.control_hz,
 ) -> Report:
     """Score ``played`` against ``reference``."""
-    import mir_eval
-
+    _, transcription, transcription_velocity = _mir_eval()
     ref_int, ref_hz, ref_vel = _arrays(reference)
     out_int, out_hz, out_vel = _arrays(played)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # mir_eval warns about empty note lists; the figures say it
-        transcription = mir_eval.transcription
         precision, recall, f1, _ = transcription.precision_recall_f1_overlap(
             ref_int, ref_hz, out_int, out_hz, onset_tolerance=onset_tolerance, offset_ratio=None
         )
         _, _, f1_offsets, _ = transcription.precision_recall_f1_overlap(
             ref_int, ref_hz, out_int, out_hz, onset_tolerance=onset_tolerance
         )
-        _, _, velocity_f1, _ = mir_eval.transcription_velocity.precision_recall_f1_overlap(
+        _, _, velocity_f1, _ = transcription_velocity.precision_recall_f1_overlap(
             ref_int, ref_hz, ref_vel, out_int, out_hz, out_vel, onset_tolerance=onset_tolerance, offset_ratio=None
         )
         pairs = (

@@ -8,8 +8,6 @@ import io
 from pathlib import Path
 
 import numpy as np
-import pretty_midi
-from scipy.io import wavfile
 
 from pianobot.errors import PianobotError
 from pianobot.files import atomic_write
@@ -66,6 +64,8 @@ def synthesize(
     """(audio samples in [-1, 1], how they were made): with the soundfont ``font`` (checked with
     :func:`check_soundfont`), else an installed one, else sine waves; ``delay`` seconds of
     silence before the piece's time 0 (a video's lead-in)."""
+    import pretty_midi  # (imported when sound is made: it and scipy take most of a second)
+
     midi = pretty_midi.PrettyMIDI(io.BytesIO(midi_bytes(piece.shift(delay) if delay else piece)))
     font = font or soundfont()
     if font is not None:
@@ -81,6 +81,8 @@ def write_wav(
     peak = float(np.abs(audio).max()) if audio.size else 0.0
     samples = (audio / peak * 0.9 * 32767).astype(np.int16) if peak > 0 else audio.astype(np.int16)
     buffer = io.BytesIO()
+    from scipy.io import wavfile
+
     wavfile.write(buffer, sample_rate, samples)
     atomic_write(path, buffer.getvalue())
     return method

@@ -20,6 +20,8 @@ one stretch: it plays them as one section, with no hand-over to itself at the ph
 
 from __future__ import annotations
 
+import contextlib
+import warnings
 from dataclasses import dataclass, replace
 from enum import Enum
 from pathlib import Path
@@ -28,8 +30,9 @@ from typing import Callable
 from pianobot.agent import store
 from pianobot.agent.general import PACKAGED, describe, find_general, general_candidates, on_keyboard, plays_keyboard
 from pianobot.agent.policy import policy_configs
+from pianobot.env import VERSION
 from pianobot.env.piano import EnvConfig, PianoEnv
-from pianobot.errors import PianobotError, SettingError
+from pianobot.errors import PianobotError, PianobotWarning, SettingError
 from pianobot.music.instrument import HandSpec, KeyboardSpec
 from pianobot.music.metrics import Report
 from pianobot.music.phrases import DEFAULT_MAX_NOTES, Phrase, split_phrases
@@ -223,12 +226,13 @@ def assign(
     general: Path | None = None,
     fallback: bool = False,
     passed_over: Callable[[], str] | None = lambda: "",
+    leave_out: frozenset[str] = frozenset(),
 ) -> tuple[Stretch, ...]:
     """Who plays each phrase (the module's rule), as stretches in order. A phrase nobody can play
     is a :class:`PianobotError` naming it, where the store is, why the packaged general policy
     does not play it (``passed_over()``, asked only then: :func:`passed_over`; None: the general
-    policy was left out) and how to go on."""
-    index = store.general_plays(models)
+    policy was left out) and how to go on. ``leave_out``: policy folders (names) not to use."""
+    index = store.general_plays(models).keys() | leave_out
     own = {p.index: f for p in phrases if (f := find_policy(models, p)) is not None and f.name not in index}
     for phrase in phrases:
         if phrase.index not in own and general is None and not fallback:
@@ -266,9 +270,9 @@ def stretches_for(phrases: list[Phrase], own: dict[int, Path], general: Path | N
     return tuple(stretches)
 
 
-def _own_environment(models: Path, phrases: list[Phrase]) -> EnvConfig | None:
+def _own_environment(models: Path, phrases: list[Phrase], leave_out: frozenset[str] = frozenset()) -> EnvConfig | None:
     """The environment the piece's own phrase policies were trained in (None: none has one); one for all."""
-    index = store.general_plays(models)
+    index = store.general_plays(models).keys() | leave_out
     folders = {f for f in (find_policy(models, p) for p in phrases) if f is not None and f.name not in index}
     configs = {policy_configs(folder)[0] for folder in folders}
     if len(configs) > 1:
@@ -349,6 +353,7 @@ def plan_performance(
     wrist_guard: bool = PerformancePlan.wrist_guard,
     hold_guard: bool | None = PerformancePlan.hold_guard,
     gui: bool = False,
+    leave_out: frozenset[str] = frozenset(),
 ) -> PerformancePlan:
     """Who plays each stretch of ``piece`` and in which environment (the module's rule).
 
@@ -361,7 +366,7 @@ def plan_performance(
     split (default: the longest whose phrases all have a player in the store). ``wrist_guard``,
     ``hold_guard``: the general policy plays through them (:mod:`pianobot.perform.guard`; a
     ``hold_guard`` of None: :attr:`PerformancePlan.holds`).
-    ``gui``: show the simulation."""
+    ``gui``: show the simulation. ``leave_out``: phrase policy folders (names) not to use."""
     if controller not in CONTROLLERS:
         raise SettingError(f"play.controller {controller!r}: choose one of {', '.join(CONTROLLERS)}", "play.controller")
     if general_policy is not None and not general:
@@ -375,9 +380,10 @@ def plan_performance(
         return PerformancePlan(piece, replace(PLAY_CONFIG, world=world), (stretch,))
 
     phrases = trained_split(models, piece, phrase_notes)
-    env = _own_environment(models, phrases)
+    env = _own_environment(models, phrases, leave_out)
     folder = _general_for(models, env, keyboard, hand, general_policy) if general else None
-    stretches = assign(phrases, models, folder, fallback, (lambda: passed_over(keyboard, hand)) if general else None)
+    said = (lambda: passed_over(keyboard, hand)) if general else None
+    stretches = assign(phrases, models, folder, fallback, said, leave_out)
     if env is None and folder is not None:
         env = on_keyboard(*policy_configs(folder), keyboard)
     if env is None:  # the scripted pianist plays every phrase
@@ -450,6 +456,30 @@ def perform_plan(
     return Performance(plan, played, seed, slowed_steps(made[0]), held_steps(made[0]), wrist_steps(made[0]))
 
 
+def doubted(plan: PerformancePlan, models: Path | str | None, general: Path | None = None) -> dict[Path, str]:
+    """The phrase policies of ``plan`` that ``play`` does not trust as they are, each with why: one
+    trained on another simulator than this one (:data:`pianobot.env.VERSION`), or one that
+    ``pianobot train`` kept beside another general policy than ``general`` (the one that would
+    play in its place now)."""
+    judged = store.judged(Path(models) if models is not None else DEFAULT_MODELS)
+    beside = describe(general)["sha256"] if general is not None else None
+    out: dict[Path, str] = {}
+    for folder in dict.fromkeys(s.policy for s in plan.stretches if s.player is Player.OWN):
+        trained_on = store.simulator(folder)
+        if trained_on != VERSION:
+            out[folder] = f"trained on simulator v{trained_on}, this is v{VERSION}"
+        elif beside is not None and judged.get(folder.name, {}).get("sha256", beside) != beside:
+            out[folder] = f"kept beside another general policy ({judged[folder.name].get('path')})"
+    return out
+
+
+def _better(a: Performance, b: Performance) -> bool:
+    """Whether ``a`` played better than ``b``: note F1, then velocity error (the learners' rule)."""
+    ra, rb = a.report(), b.report()
+    mae = lambda r: r.velocity_mae if r.velocity_mae is not None else float("inf")  # noqa: E731
+    return (ra.f1, -mae(ra)) > (rb.f1, -mae(rb))
+
+
 def play(
     piece: Piece,
     controller: str = "sac",
@@ -460,5 +490,65 @@ def play(
     **options,
 ) -> Performance:
     """Perform ``piece`` as ``pianobot play`` does: :func:`plan_performance` (``controller``,
-    ``models`` and ``options`` are its arguments), then :func:`perform_plan` from hand start ``seed``."""
-    return perform_plan(plan_performance(piece, controller, models, **options), seed, video, on_step)
+    ``models`` and ``options`` are its arguments), then :func:`perform_plan` from hand start ``seed``.
+
+    A phrase policy :func:`doubted` (made on another simulator, or judged beside another general
+    policy) plays as it is only where it plays better: the piece is played both ways, with it
+    and with the general policy in its place, the better kept (note F1, then velocity error;
+    the phrase policy on a tie), and one warning line says which. Without a general policy to
+    judge it beside, it plays, and the line says so."""
+    plan = plan_performance(piece, controller, models, **options)
+
+    def replan(leave_out: frozenset[str]) -> PerformancePlan:
+        return plan_performance(piece, controller, models, **options, leave_out=leave_out)
+
+    return perform_judged(plan, models, replan, seed, video, on_step)
+
+
+def perform_judged(
+    plan: PerformancePlan,
+    models: Path | str | None,
+    replan: Callable[[frozenset[str]], PerformancePlan],
+    seed: int = 0,
+    video: bool = False,
+    on_step: Callable[[int, int], None] | None = None,
+) -> Performance:
+    """:func:`perform_plan`, judging the :func:`doubted` phrase policies as :func:`play` says;
+    ``replan(leave_out)``: the same plan with those policy folders left out."""
+    suspect = frozenset(s.policy.name for s in plan.stretches if s.player is Player.OWN)
+    if not suspect:
+        return perform_plan(plan, seed, video, on_step)
+    try:
+        other = replan(suspect)
+    except PianobotError:
+        other = None
+    doubts = doubted(plan, models, other.general if other is not None else None)
+    if not doubts:
+        return perform_plan(plan, seed, video, on_step)
+    one = len(doubts) == 1
+    names = f"phrase polic{'y' if one else 'ies'} " + ", ".join(f"{f.name} ({why})" for f, why in doubts.items())
+    if doubts.keys() != {s.policy for s in plan.stretches if s.player is Player.OWN}:
+        with contextlib.suppress(
+            PianobotError
+        ):  # (else the general policy cannot play beside the others: it plays all)
+            other = replan(frozenset(f.name for f in doubts))
+    if other is None or other.general is None:
+        warnings.warn(
+            PianobotWarning(f"{names}: played as {'it is' if one else 'they are'}, no general policy to judge beside")
+        )
+        return perform_plan(plan, seed, video, on_step)
+    mine = perform_plan(plan, seed, video, on_step)
+    theirs = perform_plan(other, seed, video, on_step)
+    ours, general = mine.report().f1, theirs.report().f1
+    if _better(theirs, mine):
+        kept, said = (
+            theirs,
+            f"kept the general policy {other.general.name} (note F1 {general:.3f}; {ours:.3f} with {'it' if one else 'them'})",
+        )
+    else:
+        kept, said = (
+            mine,
+            f"kept {'it' if one else 'them'} (note F1 {ours:.3f}; {general:.3f} with the general policy {other.general.name})",
+        )
+    warnings.warn(PianobotWarning(f"{names}: played both ways, {said}"))
+    return kept

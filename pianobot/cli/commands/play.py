@@ -138,7 +138,7 @@ def play(
     from pianobot.music.phrases import split_phrases
     from pianobot.perform.audio import check_soundfont, write_wav
     from pianobot.perform.perform import write_video
-    from pianobot.perform.plan import Player, perform_plan, plan_performance
+    from pianobot.perform.plan import Player, perform_judged, plan_performance
 
     check_midi_output(output, song, "the performance")
     if controller == "sac":
@@ -227,10 +227,7 @@ def play(
         return
     reading = fit_keyboard(song, reading)
     piece = read_song(song, reading.options, reading.keyboard, reading.hand)
-    plan = plan_performance(
-        piece,
-        controller.value,
-        models,
+    chosen = dict(
         keyboard=reading.keyboard,
         hand=reading.hand,
         general=use_general,
@@ -241,6 +238,7 @@ def play(
         hold_guard=hold_guard,
         gui=gui,
     )
+    plan = plan_performance(piece, controller.value, models, **chosen)
     if (
         not quiet
         and controller == "sac"
@@ -252,7 +250,15 @@ def play(
             f"[dim]{len(plan.phrases)} phrases of at most {most} note{'s' * (most > 1)}: the split the policies in {said(models)} were trained for[/dim]"
         )
     with progress(f"playing {said(song.name)}") as on_step:
-        performance = perform_plan(plan, seed=seed, video=video is not None, on_step=on_step)
+        performance = perform_judged(
+            plan,
+            models,
+            lambda leave_out: plan_performance(piece, controller.value, models, **chosen, leave_out=leave_out),
+            seed=seed,
+            video=video is not None,
+            on_step=on_step,
+        )
+    plan = performance.plan
     report = performance.report()
     write_midi(performance.played, output, name=f"pianobot ({plan.performer}): {song.stem}")
     atomic_write(report_path, json.dumps(performance.to_dict(), indent=2) + "\n")
