@@ -84,15 +84,23 @@ def missing_phrases(models: Path, phrases: list[Phrase]) -> list[Phrase]:
 
 
 def phrase_players(models: Path, phrases: list[Phrase]) -> dict[int, str]:
-    """Who the store says plays each phrase, by index, in words: 'own policy', 'general policy
-    (judged better)' where the store's index says the general policy plays it (training kept the
-    general policy, or the phrase's own policy made its piece play worse), else 'general policy
-    (untrained)'. A policy of its own is a folder for the phrase, of any configuration."""
+    """Who the store says plays each phrase, by index, in words: 'own policy', 'own policy (of
+    simulator v0: play judges it)' where it was trained on another simulator than this one,
+    'general policy (judged better)' where the store's index says the general policy plays it
+    (training kept the general policy, or the phrase's own policy made its piece play worse),
+    else 'general policy (untrained)'. A policy of its own is a folder for the phrase, of any configuration."""
+    from pianobot.env import VERSION
+
     own, general = store.trained_keys(models), {key.rsplit("-", 1)[0] for key in store.general_plays(models)}
+
+    def own_policy(phrase: Phrase) -> str:
+        version = store.simulator(find_policy(models, phrase))
+        return "own policy" if version == VERSION else f"own policy (of simulator v{version}: play judges it)"
+
     return {
         p.index: "general policy (judged better)"
         if p.hash in general
-        else "own policy"
+        else own_policy(p)
         if p.hash in own
         else "general policy (untrained)"
         for p in phrases

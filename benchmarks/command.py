@@ -1,0 +1,87 @@
+"""What a user waits for: `pianobot play` end to end, start-up included, beside the simulation alone.
+
+    python -m benchmarks.command [--runs 5]
+
+Two commands, each run ``--runs`` times as a fresh process (`python -m pianobot play ... -q`):
+one hand, the longest one-hand example (`mary.mid`, 19.2 s) with the scripted pianist; two
+hands, a two-hand chorale (`chorale-performed.mid`, 41.6 s) with the default controller (the
+packaged general policies through the hold guard). Beside each, in the same run, the same
+performance in this process after start-up (the plan performed and scored: what the command
+adds is the difference). Real-time factor: seconds of music per second of wall clock; medians.
+Prints a Markdown table for docs/benchmarks.md.
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).parent.parent
+EXAMPLES = ROOT / "examples" / "midi"
+COMMANDS = {
+    "one hand, scripted pianist (`mary.mid`)": ("mary.mid", ["--controller", "scripted"]),
+    "two hands, default controller (`chorale-performed.mid`)": ("chorale-performed.mid", []),
+}
+
+
+def command_seconds(song: str, options: list[str], scratch: Path) -> float:
+    """Wall-clock seconds of `pianobot play <song>` in a fresh process."""
+    args = [sys.executable, "-m", "pianobot", "play", str(EXAMPLES / song), "-o", str(scratch / "o.mid"), "-q"]
+    started = time.perf_counter()
+    subprocess.run([*args, *options], check=True, capture_output=True)
+    return time.perf_counter() - started
+
+
+def library_seconds(song: str, options: list[str]) -> float:
+    """Wall-clock seconds of the same performance in this process, read, performed and scored (no start-up)."""
+    import warnings
+
+    import pianobot
+    from pianobot.perform.hands import read_hands
+
+    controller = "scripted" if "scripted" in options else "sac"
+    started = time.perf_counter()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        if song == "mary.mid":
+            piece = pianobot.load_piece(EXAMPLES / song)
+        else:
+            piece = read_hands(EXAMPLES / song).piece
+        pianobot.play(piece, controller=controller, models=ROOT / "models").report()
+    return time.perf_counter() - started
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--runs", type=int, default=5)
+    args = parser.parse_args(argv)
+    import torch
+
+    torch.set_num_threads(1)
+    import pianobot
+
+    print("| command | music (s) | `pianobot play`, end to end: s, real-time factor | in process after start-up: s, factor |")
+    print("| --- | ---: | ---: | ---: |")
+    with tempfile.TemporaryDirectory() as scratch:
+        for name, (song, options) in COMMANDS.items():
+            duration = pianobot.load_piece(EXAMPLES / song).duration
+            library_seconds(song, options)  # (warm: imports and the policies' first load)
+            ends, insides = [], []
+            for _ in range(args.runs):
+                ends.append(command_seconds(song, options, Path(scratch)))
+                insides.append(library_seconds(song, options))
+            end, inside = statistics.median(ends), statistics.median(insides)
+            print(
+                f"| {name} | {duration:.1f} | {end:.2f} s, {duration / end:.1f}× | {inside:.2f} s, {duration / inside:.1f}× |",
+                flush=True,
+            )
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
