@@ -85,7 +85,8 @@ def config_hash(config) -> str:
     configuration, fine-tuned or trained from scratch (the manifest's ``start`` says which).
     A SAC run (``TrainConfig.learner`` 'sac') leaves out ``learner`` and the DAgger settings it
     does not use, so that its folder keeps the name it had before there was another learner; an
-    agent with the default actor (``SACConfig.actor`` 'mlp') leaves out ``sac.actor`` likewise."""
+    agent with the default actor (``SACConfig.actor`` 'mlp') leaves out ``sac.actor`` likewise, and
+    a run of the Allegro-like hand (``HandSpec.model`` 'allegro') its hand model."""
     runtime = {f.name for f in dataclasses.fields(config) if f.metadata.get("runtime") or f.metadata.get("start")}
     fields = {k: v for k, v in to_dict(config).items() if k not in runtime}
     if fields.get("learner") == "sac":
@@ -93,6 +94,9 @@ def config_hash(config) -> str:
         fields.pop("dagger", None)
     if isinstance(fields.get("sac"), dict) and fields["sac"].get("actor") == "mlp":
         fields["sac"] = {k: v for k, v in fields["sac"].items() if k != "actor"}
+    spec = fields.get("env", {}).get("world", {}).get("hand", {}).get("spec", {})
+    if isinstance(spec, dict) and spec.get("model") == "allegro":  # (the hand model before there were others)
+        spec.pop("model")
     return hashlib.sha256(json.dumps(fields, sort_keys=True, default=str).encode()).hexdigest()[:12]
 
 

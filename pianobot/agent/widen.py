@@ -31,7 +31,7 @@ from pianobot.agent.tasks import make_env
 from pianobot.config import to_dict
 from pianobot.errors import PianobotError
 from pianobot.music.instrument import HandSpec
-from pianobot.sim.hand import FINGER_BASE_X
+from pianobot.sim.hand import hand_model
 
 WIDENED = "widened"
 """A widened policy's manifest says ``"kept": "widened"``: it was not trained as it is."""
@@ -108,9 +108,10 @@ def widen_policy(source: Path, destination: Path, fingers: tuple[int, ...]) -> P
             "the 'fingers' actor without it (train.sac.actor fingers) reads every finger alike"
         )
     before = env.world.hand.spec.fingers
-    if not set(fingers) <= set(FINGER_BASE_X):
+    model = hand_model(env.world.hand.spec.model)
+    if not set(fingers) <= set(model.fingers):
         raise PianobotError(
-            f"fingers {','.join(map(str, fingers))}: the simulated hand has fingers {','.join(map(str, FINGER_BASE_X))}"
+            f"fingers {','.join(map(str, fingers))}: the {model.name} hand has fingers {','.join(map(str, model.fingers))}"
         )
     if not set(before) < set(fingers):
         raise PianobotError(

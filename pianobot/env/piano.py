@@ -56,13 +56,11 @@ from pianobot.music.piece import Piece
 from pianobot.music.tasks import TASKS, make_task
 from pianobot.music.tensor import FINGER, NOTE, VELOCITY, ScoreSpec, score_tensor, steps_for
 from pianobot.sim.frame import HandView
-from pianobot.sim.hand import finger_ik, joint_limits, joint_names
+from pianobot.sim.hand import JOINT_KINDS, finger_ik, joint_limits, joint_names
 from pianobot.sim.keyboard import strike_points
 from pianobot.sim.tactile import TactileConfig, TactileRenderer, pool, to_uint8
 from pianobot.sim.world import PianoWorld, StepResult, WorldConfig
 
-JOINT_KINDS = ("abd", "mcp", "pip", "dip")
-"""Each finger's joints, in action order."""
 Sampler = Callable[[np.random.Generator], Piece]
 """Draws one task instance, a fingered piece, from a generator (the environment's ``np_random``)."""
 IDLE_HEIGHT = 0.010
@@ -138,9 +136,10 @@ def finger_targets(
 
 def actuated_indices(config: "EnvConfig") -> np.ndarray:
     """Where the action's values go in the full command (every finger joint, then the wrist):
-    the actuated joints of each finger in :data:`JOINT_KINDS` order, then the wrist."""
-    joints = len(config.world.hand.spec.fingers) * len(JOINT_KINDS)
-    return np.array([i for i in range(joints) if JOINT_KINDS[i % len(JOINT_KINDS)] in config.actuated] + [joints])
+    the actuated joints of each finger in its hand model's order (:data:`JOINT_KINDS`), then the wrist."""
+    kinds = config.world.hand.model.joints
+    joints = len(config.world.hand.spec.fingers) * len(kinds)
+    return np.array([i for i in range(joints) if kinds[i % len(kinds)] in config.actuated] + [joints])
 
 
 @dataclass(frozen=True)

@@ -91,10 +91,14 @@ def keys_for(piece: Piece, default: KeyboardSpec = KeyboardSpec()) -> KeyboardSp
 
 @dataclass(frozen=True)
 class HandSpec:
-    """Which fingers the robot hand plays with, in pianists' numbering (1 thumb ... 5 little)."""
+    """Which hand model plays, with which of its fingers, in pianists' numbering (1 thumb ... 5 little).
+    The model's body is the simulator's (:func:`pianobot.sim.hand.hand_model`), which checks that
+    it has these fingers."""
 
     fingers: tuple[int, ...] = (2, 3, 4)
     """The Allegro hand's index, middle and ring fingers; add 1 for its thumb."""
+    model: str = "allegro"
+    """The hand model's name (:data:`pianobot.sim.hand.HAND_MODELS`): 'allegro', the paper's Allegro-like hand."""
 
     def __post_init__(self) -> None:
         if not self.fingers or len(set(self.fingers)) != len(self.fingers):

@@ -39,7 +39,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from pianobot.env.piano import JOINT_KINDS, EnvConfig, actuated_indices
+from pianobot.env.piano import EnvConfig, actuated_indices
 from pianobot.music.tensor import FINGER
 from pianobot.perform.rollout import Controller
 from pianobot.pianist.layout import KeyLayout
@@ -86,7 +86,7 @@ class HoldGuard:
         self.teacher = ScriptedPianist(config, tuning)
         joints = actuated_indices(config)[:-1]  # (the last action is the wrist's)
         fingers = len(config.world.hand.spec.fingers)
-        self.joints_of = [np.flatnonzero(joints // len(JOINT_KINDS) == i) for i in range(fingers)]
+        self.joints_of = [np.flatnonzero(joints // len(config.world.hand.model.joints) == i) for i in range(fingers)]
         """Finger (its slot) -> where its actuated joints are in the action."""
         self.held = 0
         """Finger-steps the teacher moved, since the guard was made."""
@@ -152,7 +152,7 @@ class WristGuard:
 
     def act(self, observation: dict) -> np.ndarray:
         action = np.array(self.policy.act(observation), dtype=np.float32)  # a copy: the policy's own is left alone
-        joints = np.asarray(observation["joints"], dtype=float).reshape(self.fingers, 4)
+        joints = np.asarray(observation["joints"], dtype=float).reshape(self.fingers, -1)
         if abs(action[-1]) > self.limit and any(self.motion.low(q) for q in joints):
             action[-1] = np.sign(action[-1]) * self.limit
             self.capped += 1

@@ -43,7 +43,7 @@ from pianobot.perform.controllers import CONTROLLERS, make_controller
 from pianobot.perform.guard import HOLD_GUARD_FAMILIES, HoldGuard, WristGuard
 from pianobot.perform.perform import PLAY_CONFIG
 from pianobot.perform.rollout import Controller, Rollout
-from pianobot.sim.hand import HandConfig
+from pianobot.sim.hand import hand_config
 from pianobot.sim.keyboard import KeyboardConfig
 from pianobot.sim.world import WorldConfig
 
@@ -373,7 +373,7 @@ def plan_performance(
         raise PianobotError(f"--general-policy {general_policy} and --no-general ask for opposite things: give one")
     keyboard, hand = keyboard or KeyboardSpec(), hand or HandSpec()
     models = Path(models) if models is not None else DEFAULT_MODELS
-    world = WorldConfig(keyboard=KeyboardConfig(spec=keyboard), hand=HandConfig(spec=hand), gui=gui)
+    world = WorldConfig(keyboard=KeyboardConfig(spec=keyboard), hand=hand_config(hand), gui=gui)
     if controller in ONE_PLAYER:
         phrases = split_phrases(piece, phrase_notes or DEFAULT_MAX_NOTES)
         stretch = Stretch(tuple(phrases), ONE_PLAYER[controller])

@@ -1,7 +1,7 @@
 """Automatic fingering for the robot hand: dynamic programming over the piece's chords.
 
 The hand slides on a rail along the keyboard; each finger's base sits at a fixed offset from the
-wrist (:data:`pianobot.sim.hand.FINGER_BASE_X`) and reaches sideways by abduction. A *state* is
+wrist (:attr:`pianobot.sim.hand.HandModel.bases`) and reaches sideways by abduction. A *state* is
 one way of playing one chord (a melody note is a chord of one): which finger takes each note and
 where the wrist stands, on a grid of a quarter of a white key. The planner finds the sequence of
 states with the lowest total cost:
@@ -49,7 +49,7 @@ from pianobot.music.piece import Note, Piece, pitch_name
 from pianobot.pianist.layout import KeyLayout
 from pianobot.pianist.strikes import Run, StrikePlanner
 from pianobot.pianist.tuning import PianistTuning
-from pianobot.sim.hand import FINGER_BASE_X, HandConfig
+from pianobot.sim.hand import HandConfig, hand_config
 from pianobot.sim.keyboard import KeyboardConfig, key_boxes, keyboard_width, strike_points
 from pianobot.sim.world import WorldConfig
 
@@ -119,6 +119,8 @@ class Planner:
         self.keyboard, self.hand = keyboard, hand
         self.spec = keyboard.spec
         self.fingers = hand.spec.fingers
+        self.base_x = {f: hand.model.base_x(f) for f in hand.model.fingers}
+        """Each finger's base across the palm (m, from the wrist)."""
         self.key_x = np.array([b.center[0] for b in key_boxes(keyboard)])
         # sideways reach at the white keys' strike points; black keys get no more, since a
         # slanted fingertip easily slips off their narrow tops
@@ -151,7 +153,7 @@ class Planner:
         cost = np.zeros((len(assignments), len(self.grid)))
         for a, fingers in enumerate(assignments):
             for key, finger in zip(keys, fingers):
-                offset = (self.key_x[key] - self.grid - FINGER_BASE_X[finger]) / self.reach[key]
+                offset = (self.key_x[key] - self.grid - self.base_x[finger]) / self.reach[key]
                 cost[a] += np.where(np.abs(offset) <= 1.0, STRETCH_COST * offset**2, _INFEASIBLE)
         return assignments, keys, cost
 
@@ -251,7 +253,7 @@ class Planner:
         """Whether ``finger`` reaches ``key`` from each wrist position of the grid (read-only, cached)."""
         reaches = self._in_reach.get((key, finger))
         if reaches is None:
-            reaches = np.abs(self.key_x[key] - self.grid - FINGER_BASE_X[finger]) / self.reach[key] <= 1.0
+            reaches = np.abs(self.key_x[key] - self.grid - self.base_x[finger]) / self.reach[key] <= 1.0
             reaches.flags.writeable = False
             self._in_reach[key, finger] = reaches
         return reaches
@@ -293,7 +295,7 @@ class Planner:
         ``chord`` puts the wrist outside [``low``, ``high``]: the planner's wrist, or the scripted
         pianist's, whichever is farther out."""
         assignments, keys, _ = self._states(chord)
-        pianist = np.array([np.mean([self.key_x[k] - FINGER_BASE_X[f] for k, f in zip(keys, a)]) for a in assignments])
+        pianist = np.array([np.mean([self.key_x[k] - self.base_x[f] for k, f in zip(keys, a)]) for a in assignments])
         grid = np.maximum(np.maximum(low - self.grid, self.grid - high), 0.0)
         own = np.maximum(np.maximum(low - pianist, pianist - high), 0.0)
         return ROOM_COST * np.maximum(grid[None, :], own[:, None]) / self.pitch
@@ -398,7 +400,7 @@ def _plan(piece: Piece, bpm: float, keyboard: KeyboardSpec, hand: HandSpec) -> F
     """:func:`plan_fingering`, kept for the last pieces asked (``bpm`` is in the key because a
     piece's equality leaves it out): ``pianobot play`` asks whether one hand plays a file, then
     plays it, and music objects are immutable, so the plan is the same both times."""
-    return plan_fingering(piece, KeyboardConfig(spec=keyboard), HandConfig(spec=hand))
+    return plan_fingering(piece, KeyboardConfig(spec=keyboard), hand_config(hand))
 
 
 def plan_fingering(

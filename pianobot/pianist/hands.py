@@ -54,7 +54,7 @@ from pianobot.music.load import CHORD_SPREAD, LEGATO_OVERLAP, LoadOptions, load_
 from pianobot.music.piece import Note, Piece, mirror_pitch
 from pianobot.pianist.fingering import SETTLE_TIME, FingeringPlan, Planner, ensure_fingering
 from pianobot.pianist.reduce import reduce_part
-from pianobot.sim.hand import FINGER_BASE_X, HandConfig, thumb_side_reach
+from pianobot.sim.hand import hand_config, hand_model, thumb_side_reach
 from pianobot.sim.keyboard import KeyboardConfig, key_boxes
 
 TRAVEL_COST = 12.0
@@ -87,20 +87,20 @@ class HandAssignment:
 
 
 @lru_cache(maxsize=4096)
-def _reaches(pitches: tuple[int, ...], fingers: tuple[int, ...]) -> bool:
-    """Whether a right hand with ``fingers`` can hold ``pitches`` (sorted) at one hand position."""
-    if len(pitches) > len(fingers):
+def _reaches(pitches: tuple[int, ...], spec: HandSpec) -> bool:
+    """Whether a right hand ``spec`` names can hold ``pitches`` (sorted) at one hand position."""
+    if len(pitches) > len(spec.fingers):
         return False
     shift = _REACH_KEYS.lowest - pitches[0] // 12 * 12
     if pitches[-1] + shift not in _REACH_KEYS:
         return False
-    planner = _planner(fingers)
+    planner = _planner(spec)
     return planner.place([Note(0.0, p + shift, 1.0) for p in pitches]).possible
 
 
 @lru_cache(maxsize=8)
-def _planner(fingers: tuple[int, ...]) -> Planner:
-    return Planner(KeyboardConfig(spec=_REACH_KEYS), HandConfig(spec=HandSpec(fingers)))
+def _planner(spec: HandSpec) -> Planner:
+    return Planner(KeyboardConfig(spec=_REACH_KEYS), hand_config(spec))
 
 
 def reaches(pitches, hand: str, spec: HandSpec = HandSpec()) -> bool:
@@ -110,7 +110,7 @@ def reaches(pitches, hand: str, spec: HandSpec = HandSpec()) -> bool:
     if not pitches:
         return True
     keys = [mirror_pitch(p) for p in pitches] if hand == "left" else list(pitches)
-    return _reaches(tuple(sorted(keys)), spec.fingers)
+    return _reaches(tuple(sorted(keys)), spec)
 
 
 def group_chords(piece: Piece, spread: float = CHORD_SPREAD) -> list[list[int]]:
@@ -173,12 +173,12 @@ def _local_cost(chord: list[Note], k: int, spec: HandSpec, middle: float | None)
 
 def span(spec: HandSpec) -> int:
     """The widest interval (semitones) the planner lets one hand position hold with ``spec``'s fingers."""
-    return _span(spec.fingers)
+    return _span(spec)
 
 
 @lru_cache(maxsize=8)
-def _span(fingers: tuple[int, ...]) -> int:
-    return max((d for d in range(1, 25) if _reaches((60, 60 + d), fingers)), default=0)
+def _span(spec: HandSpec) -> int:
+    return max((d for d in range(1, 25) if _reaches((60, 60 + d), spec)), default=0)
 
 
 Window = tuple[int, int]
@@ -397,22 +397,21 @@ def finger_apart(
         raise ValueError(f"finger_apart needs both hands' parts, not {', '.join(parts)}")
     if any(not part.notes or not part.has_fingering for _, part in parts.values()):
         raise ValueError("finger_apart needs both hands' parts with notes, every note fingered")
-    gap = 2 * thumb_side_reach(HandConfig(spec=spec))
+    gap = 2 * thumb_side_reach(hand_config(spec))
     fingered = {hand: part for hand, (_, part) in parts.items()}
     plans: dict[str, FingeringPlan | None] = dict.fromkeys(parts)
     planners = {
-        hand: Planner(KeyboardConfig(spec=window.keyboard), HandConfig(spec=spec))
-        for hand, (window, _) in parts.items()
+        hand: Planner(KeyboardConfig(spec=window.keyboard), hand_config(spec)) for hand, (window, _) in parts.items()
     }
     for hand, other in (("left", "right"), ("right", "left"), ("left", "right")):
         if hand in fixed:
             continue
         window, part = parts[hand]
         planner = planners[hand]
-        others = stands(parts[other][0], fingered[other])
+        others = stands(parts[other][0], fingered[other], spec)
         to_frame = _frame(window, part, planner)
         room = []
-        for start, end, _ in stands(window, fingered[hand]):
+        for start, end, _ in stands(window, fingered[hand], spec):
             near = [x for s, e, x in others if s < end and e > start]
             if not near:
                 room.append((-np.inf, np.inf))
@@ -447,14 +446,15 @@ def _frame(window: windows.Window, part: Piece, planner: Planner):
     return lambda x: x - world + view
 
 
-def stands(window: windows.Window, part: Piece) -> list[tuple[float, float, float]]:
-    """Where a hand's fingered ``part`` (in ``window``'s keys) puts its wrist in the world: for each
+def stands(window: windows.Window, part: Piece, spec: HandSpec = HandSpec()) -> list[tuple[float, float, float]]:
+    """Where a hand (``spec``)'s fingered ``part`` (in ``window``'s keys) puts its wrist in the world: for each
     chord (start s, end s, wrist m along the piano), in the module's :func:`finger_apart` terms."""
     chords = part.chords()
     sign = -1.0 if window.hand == "left" else 1.0  # (the left hand's finger bases lie mirrored)
+    model = hand_model(spec.model)
     stands = []
     for i, chord in enumerate(chords):
-        wrist = float(np.mean([_world_x(window.outward(n.pitch)) - sign * FINGER_BASE_X[n.finger] for n in chord]))
+        wrist = float(np.mean([_world_x(window.outward(n.pitch)) - sign * model.base_x(n.finger) for n in chord]))
         ends = max(n.offset for n in chord)
         following = chords[i + 1][0].onset if i + 1 < len(chords) else ends
         end = following if following - ends < IDLE else ends + LINGER

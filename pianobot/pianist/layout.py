@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from pianobot.sim.hand import FINGER_BASE_X
 from pianobot.sim.keyboard import BLACK_STRIKE_FROM_FRONT, WHITE_STRIKE_FROM_FRONT, key_boxes
 from pianobot.sim.world import WorldConfig
 
@@ -42,6 +41,8 @@ class KeyLayout:
         """Where on a black key the fingertip strikes (m from the hinge)."""
         self.black_band_y = geometry.black_length + world.hand.geometry.tip_radius
         """A fingertip closer than this to the hinges (m) is over the black keys' band."""
+        self.model = world.hand.model
+        """The hand model: where its fingers' bases sit on the palm."""
 
     def contact_y(self, key: int) -> float:
         """Where on ``key`` the fingertip strikes (m from the hinge)."""
@@ -49,4 +50,4 @@ class KeyLayout:
 
     def wrist_for(self, finger: int, key: int) -> float:
         """Wrist position that puts ``finger`` straight over ``key`` (m)."""
-        return float(self.key_x[key] - FINGER_BASE_X[finger])
+        return float(self.key_x[key] - self.model.base_x(finger))

@@ -25,7 +25,6 @@ from pianobot.pianist.layout import KeyLayout
 from pianobot.pianist.strikes import Plan, Tip
 from pianobot.pianist.tuning import PianistTuning
 from pianobot.sim.hand import (
-    FINGER_BASE_X,
     PREFERRED_TILT,
     TILT_RANGE,
     finger_ik,
@@ -130,7 +129,7 @@ class Motion:
         contact_y = layout.contact_y(key) if key is not None else layout.white_contact_y
         top = float(layout.key_top[key]) if key is not None else 0.0
         forward = self.hand.palm_y - contact_y
-        offset = layout.key_x[key] - (wrist_next + FINGER_BASE_X[finger]) if key is not None else 0.0
+        offset = layout.key_x[key] - (wrist_next + layout.model.base_x(finger)) if key is not None else 0.0
         abduction = min(max(math.atan2(offset, forward), -geometry.abduction_limit), geometry.abduction_limit)
         reach = forward / math.cos(abduction)  # keeps the tip at contact_y even when the key is out of reach
         if phase in ("ready", "strike") and abs(offset - forward * math.tan(abduction)) > tuning.aim_tolerance:

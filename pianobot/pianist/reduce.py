@@ -46,7 +46,7 @@ from pianobot.music.instrument import PIANO, HandSpec, KeyboardSpec
 from pianobot.music.load import LoadOptions, load_part
 from pianobot.music.piece import Note, Piece, pitch_name
 from pianobot.pianist.fingering import Planner, Reach
-from pianobot.sim.hand import HandConfig
+from pianobot.sim.hand import hand_config
 from pianobot.sim.keyboard import KeyboardConfig
 
 GRACE = 0.15
@@ -113,7 +113,7 @@ def reduce_part(piece: Piece, keyboard: KeyboardSpec, hand: HandSpec, part: str 
     returned as it is, for :func:`~pianobot.music.instrument.check_playable` to explain."""
     if any(n.pitch not in keyboard for n in piece.notes) or any(len(c) > len(hand.fingers) for c in piece.chords()):
         return Reduction(piece)
-    reduction = _Reducer(Planner(KeyboardConfig(spec=keyboard), HandConfig(spec=hand))).run(piece)
+    reduction = _Reducer(Planner(KeyboardConfig(spec=keyboard), hand_config(hand))).run(piece)
     for line in reduction.messages(part):
         warnings.warn(PianobotWarning(line))
     return reduction

@@ -27,6 +27,7 @@ from pianobot.pianist.layout import KeyLayout
 from pianobot.pianist.motion import Motion
 from pianobot.pianist.strikes import StrikePlanner
 from pianobot.pianist.tuning import PianistTuning
+from pianobot.sim.hand import JOINT_KINDS
 
 
 class ScriptedPianist:
@@ -38,6 +39,11 @@ class ScriptedPianist:
         self.config = config
         self.tuning = tuning
         self.fingers = config.world.hand.spec.fingers
+        if config.world.hand.model.joints != JOINT_KINDS:
+            raise ValueError(
+                f"the scripted pianist moves fingers with {', '.join(JOINT_KINDS)} joints; the "
+                f"{config.world.hand.model.name} hand's have {', '.join(config.world.hand.model.joints)}"
+            )
         self.layout = KeyLayout(config.world)
         self.strikes = StrikePlanner(config.world, self.layout, tuning)
         self.motion = Motion(config.world, self.layout, tuning)
@@ -54,7 +60,7 @@ class ScriptedPianist:
     def act(self, observation: dict) -> np.ndarray:
         """One action from the score window, the wrist position and the joint angles."""
         score = observation["score"]
-        joints = np.asarray(observation["joints"], dtype=float).reshape(len(self.fingers), 4)
+        joints = np.asarray(observation["joints"], dtype=float).reshape(len(self.fingers), len(JOINT_KINDS))
         wrist = (float(observation["wrist"][0]) + 1) / 2 * self.layout.width
         tips = {finger: self.motion.tip(q) for finger, q in zip(self.fingers, joints)}
         plans = self.strikes.plan(score, self.previous_row, tips, wrist, self.released)

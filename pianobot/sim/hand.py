@@ -53,9 +53,93 @@ class FingerGeometry:
             raise ValueError(f"flexion_limits {self.flexion_limits}: three (low, high) pairs in radians, low < high")
 
 
-FINGER_BASE_X = {1: -0.0870, 2: -0.0435, 3: 0.0, 4: 0.0435}
-"""Finger base positions across the palm (m); the thumb sits beside the index."""
-FINGER_BASE_Y = {1: 0.012, 2: 0.0, 3: 0.0, 4: 0.0}
+JOINT_KINDS = ("abd", "mcp", "pip", "dip")
+"""A finger's joints, in action order: abduction (about the vertical), then three flexion joints."""
+
+
+@dataclass(frozen=True)
+class HandModel:
+    """Everything about a hand's body that the rest of pianobot asks, for the right hand (the left
+    is its mirror image, :data:`SIDES`): which fingers it has and where each finger's base sits
+    on the palm, the fingers' links and joint limits, the finger sets it plays with, and which
+    fingers may pass which. The world builds its URDF from it (:func:`hand_urdf`), the
+    environment its joints, the fingering planner and the scripted pianist their reach.
+
+    A new hand is a module that makes one and registers it (:func:`register_hand_model`); a
+    :class:`~pianobot.music.instrument.HandSpec` names it."""
+
+    name: str
+    bases: tuple[tuple[int, float, float], ...]
+    """(finger, x, y) of each finger's base (m): x across the palm from the wrist (towards the
+    high keys for the right hand), y towards the pianist; fingers in pianists' numbers, 1 thumb
+    ... 5 little, in order."""
+    geometry: FingerGeometry = field(default_factory=FingerGeometry)
+    """Every finger's links and joint limits."""
+    finger_sets: tuple[tuple[int, ...], ...] = ()
+    """The fingers it plays with, in order of preference (the first is the default)."""
+    passes: frozenset[tuple[int, int]] = frozenset()
+    """(a, b): finger a may pass under or over finger b (none: no finger passes another)."""
+    joints: tuple[str, ...] = JOINT_KINDS
+    """Each finger's joints, in action order (names from :data:`JOINT_KINDS`)."""
+
+    def __post_init__(self) -> None:
+        numbers = [f for f, _, _ in self.bases]
+        if not numbers or numbers != sorted(set(numbers)) or any(not 1 <= f <= 5 for f in numbers):
+            raise ValueError(f"hand model {self.name!r}: fingers {numbers} must be distinct numbers 1-5, in order")
+        for fingers in self.finger_sets:
+            if not fingers or not set(fingers) <= set(numbers):
+                raise ValueError(f"hand model {self.name!r}: finger set {fingers} is not among its fingers {numbers}")
+        if not set(self.joints) <= set(JOINT_KINDS) or len(set(self.joints)) != len(self.joints):
+            raise ValueError(
+                f"hand model {self.name!r}: joints {self.joints} must be distinct names from {JOINT_KINDS}"
+            )
+
+    @property
+    def fingers(self) -> tuple[int, ...]:
+        return tuple(f for f, _, _ in self.bases)
+
+    def base_x(self, finger: int, side: str = "right") -> float:
+        """Where a finger's base sits across the palm (m, along the keyboard, from the wrist)."""
+        x = next(x for f, x, _ in self.bases if f == finger)
+        return x if side == "right" else -x
+
+    def base_y(self, finger: int) -> float:
+        return next(y for f, _, y in self.bases if f == finger)
+
+
+ALLEGRO = HandModel(
+    name="allegro",
+    bases=((1, -0.0870, 0.012), (2, -0.0435, 0.0), (3, 0.0, 0.0), (4, 0.0435, 0.0)),
+    finger_sets=((2, 3, 4), (1, 2, 3, 4)),
+)
+"""The Allegro-like hand of the paper: index, middle and ring fingers 43.5 mm apart, and a thumb
+modelled as a fourth finger beside the index (the Allegro's four joints each); no finger passes
+another."""
+
+HAND_MODELS: dict[str, HandModel] = {}
+"""The hand models pianobot knows, by name (:func:`register_hand_model`)."""
+
+
+def register_hand_model(model: HandModel) -> HandModel:
+    """Make ``model`` known by its name (again: replaced)."""
+    HAND_MODELS[model.name] = model
+    return model
+
+
+register_hand_model(ALLEGRO)
+
+
+def hand_model(name: str) -> HandModel:
+    """The registered hand model called ``name``; another is a one-line error naming those there are."""
+    try:
+        return HAND_MODELS[name]
+    except KeyError:
+        raise ValueError(f"hand model {name!r}: choose one of {', '.join(HAND_MODELS)}") from None
+
+
+FINGER_BASE_X = {f: x for f, x, _ in ALLEGRO.bases}
+"""The Allegro-like hand's finger bases across the palm (m): :attr:`ALLEGRO`'s (kept for code that reads them)."""
+FINGER_BASE_Y = {f: y for f, _, y in ALLEGRO.bases}
 
 
 @dataclass(frozen=True)
@@ -83,6 +167,12 @@ class HandConfig:
     """Mass of each finger link (kg)."""
 
     def __post_init__(self) -> None:
+        missing = set(self.spec.fingers) - set(self.model.fingers)
+        if missing:
+            raise ValueError(
+                f"hand fingers {self.spec.fingers}: the {self.model.name} hand has fingers "
+                f"{', '.join(map(str, self.model.fingers))}"
+            )
         check_ranges(
             self,
             palm_height=(1e-3, 1.0),
@@ -95,17 +185,29 @@ class HandConfig:
             finger_mass=(1e-4, 10.0),
         )
 
+    @property
+    def model(self) -> HandModel:
+        """The hand model :attr:`spec` names."""
+        return hand_model(self.spec.model)
+
+
+def hand_config(spec: HandSpec) -> HandConfig:
+    """The configuration of the hand ``spec`` names, with its model's finger geometry (every other
+    setting the default): the one way code that knows only a spec makes a hand."""
+    return HandConfig(spec=spec, geometry=hand_model(spec.model).geometry)
+
 
 def joint_limits(config: HandConfig) -> np.ndarray:
-    """(2, 4F): the lower and upper limit (rad) of every finger joint, in action order."""
+    """(2, JF): the lower and upper limit (rad) of every finger joint, in action order (J joints a finger)."""
     g = config.geometry
-    per_finger = [(-g.abduction_limit, g.abduction_limit), *g.flexion_limits]
+    limits = dict(zip(JOINT_KINDS, [(-g.abduction_limit, g.abduction_limit), *g.flexion_limits]))
+    per_finger = [limits[j] for j in config.model.joints]
     return np.array(per_finger * len(config.spec.fingers)).T
 
 
 def joint_names(spec: HandSpec) -> list[str]:
-    """Actuated finger joints in action order: for each finger, abduction, MCP, PIP, DIP."""
-    return [f"f{f}_{j}" for f in spec.fingers for j in ("abd", "mcp", "pip", "dip")]
+    """Actuated finger joints in action order: for each finger, its model's joints (abduction, MCP, PIP, DIP)."""
+    return [f"f{f}_{j}" for f in spec.fingers for j in hand_model(spec.model).joints]
 
 
 def _box_inertia(mass: float, size: tuple[float, float, float]) -> str:
@@ -163,15 +265,10 @@ fingers in the mirrored places (the thumb on the high side) and its abduction ax
 the same joint angles put every link at the mirror image of the right hand's."""
 
 
-def finger_base_x(finger: int, side: str = "right") -> float:
-    """Where a finger's base sits across the palm (m, along the keyboard, from the wrist)."""
-    return FINGER_BASE_X[finger] if side == "right" else -FINGER_BASE_X[finger]
-
-
 def thumb_side_reach(config: HandConfig) -> float:
     """How far (m) a hand's finger bases and links reach from its wrist towards its thumb's side
     (down the keyboard for the right hand, up for the left), with no abduction."""
-    return -min(FINGER_BASE_X[f] for f in config.spec.fingers) + config.geometry.link_radius
+    return -min(config.model.base_x(f) for f in config.spec.fingers) + config.geometry.link_radius
 
 
 def hand_urdf(config: HandConfig, rail: tuple[float, float], side: str = "right") -> str:
@@ -181,7 +278,7 @@ def hand_urdf(config: HandConfig, rail: tuple[float, float], side: str = "right"
         raise ValueError(f"a hand's side is one of {', '.join(SIDES)}; got {side!r}")
     g = config.geometry
     mirror = -1 if side == "left" else 1
-    parts = ['<?xml version="1.0"?>', f'<robot name="allegro_like_{side}_hand">']
+    parts = ['<?xml version="1.0"?>', f'<robot name="{config.model.name}_like_{side}_hand">']
     parts.append(
         '<link name="rail"><inertial><mass value="0"/><inertia ixx="0" iyy="0" izz="0" ixy="0" ixz="0" iyz="0"/></inertial></link>'
     )
@@ -204,10 +301,10 @@ def hand_urdf(config: HandConfig, rail: tuple[float, float], side: str = "right"
         parts.append(
             _joint(
                 f"{prefix}_abd",
-                "revolute",
+                "revolute" if "abd" in config.model.joints else "fixed",
                 "palm",
                 f"{prefix}_base",
-                (finger_base_x(f, side), FINGER_BASE_Y[f], 0.0),
+                (config.model.base_x(f, side), config.model.base_y(f), 0.0),
                 f"0 0 {mirror}",
                 (-g.abduction_limit, g.abduction_limit),
             )
@@ -218,7 +315,15 @@ def hand_urdf(config: HandConfig, rail: tuple[float, float], side: str = "right"
             tip = g.tip_radius if link == "distal" else 0.0
             parts.append(_link(f"{prefix}_{link}", config.finger_mass, length, g.link_radius, "finger", tip))
             parts.append(
-                _joint(f"{prefix}_{joint}", "revolute", parent, f"{prefix}_{link}", (0, -offset, 0), "1 0 0", limits)
+                _joint(
+                    f"{prefix}_{joint}",
+                    "revolute" if joint in config.model.joints else "fixed",
+                    parent,
+                    f"{prefix}_{link}",
+                    (0, -offset, 0),
+                    "1 0 0",
+                    limits,
+                )
             )
             parent, offset = f"{prefix}_{link}", length
     parts.append("</robot>")

@@ -200,7 +200,7 @@ def train(
     from pianobot.learn.log import LOG_FILE, PLOT_FILE
     from pianobot.learn.train import TASK_EVAL_EPISODES
     from pianobot.music.phrases import split_phrases
-    from pianobot.sim.hand import HandConfig
+    from pianobot.sim.hand import hand_config
     from pianobot.sim.keyboard import KeyboardConfig
 
     if (song is None) == (task is None):
@@ -241,7 +241,7 @@ def train(
         reading = fit_keyboard(song, reading)
     keyboard, hand = reading.keyboard, reading.hand
     with option("--control", control):
-        world = WorldConfig(keyboard=KeyboardConfig(spec=keyboard), hand=HandConfig(spec=hand), control=control.value)
+        world = WorldConfig(keyboard=KeyboardConfig(spec=keyboard), hand=hand_config(hand), control=control.value)
     with option("--reward", reward):
         rewards = RewardConfig(kind=reward.value, fingering_gate=fingering_gate)
     with option("--joints", joints):
