@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from dataclasses import replace
 
+import numpy as np
 import pytest
 
 from pianobot.agent import store
@@ -93,3 +94,42 @@ def test_the_allegro_hand_keeps_its_policies_folders():
     named = replace(config, env=replace(config.env, world=replace(config.env.world, hand=hand_config(HandSpec()))))
     assert store.config_hash(named) == store.config_hash(config)  # (the Allegro's spec names its model)
     assert store.config_hash(config) != store.config_hash(toy)
+
+
+THUMBED = HandModel(
+    name="thumbed",
+    bases=TOY.bases,
+    finger_sets=((1, 2, 3, 4, 5),),
+    finger_joints=((1, ("abd", "mcp", "pip")),),  # a thumb with three joints, the others four
+)
+
+
+def test_fingers_with_different_joint_counts_act_through_the_finger_shared_actor():
+    import torch
+
+    from pianobot.agent.config import SACConfig
+    from pianobot.agent.policy import make_agent
+    from pianobot.env.piano import finger_counts
+
+    register_hand_model(THUMBED)
+    try:
+        spec = HandSpec((1, 2, 3, 4, 5), model="thumbed")
+        config = EnvConfig(world=WorldConfig(hand=hand_config(spec)), tactile=False)
+        assert finger_counts(config) == ((3, 4, 4, 4, 4), (3, 4, 4, 4, 4))
+        env = PianoEnv(piece=_melody(), config=config)
+        try:
+            observation, _ = env.reset(seed=0)
+            assert env.action_space.shape == (3 + 4 * 4 + 1,) and observation["joints"].shape == (19,)
+            torch.manual_seed(0)
+            agent = make_agent(env, SACConfig(actor="fingers", score_input=False, hidden=32))
+            action = agent.act(observation)
+            assert action.shape == env.action_space.shape and np.all(np.abs(action) <= 1.0)
+            env.step(action)
+            # the thumb's three actions come from the first three of the shared head's outputs
+            assert agent.actor.kept.tolist()[:4] == [0, 1, 2, 4]
+        finally:
+            env.close()
+        with pytest.raises(ValueError, match="not every finger"):
+            ScriptedPianist(config)
+    finally:
+        HAND_MODELS.pop("thumbed", None)

@@ -18,7 +18,7 @@ from pianobot.agent import store
 from pianobot.agent.config import SACConfig
 from pianobot.agent.tasks import make_env
 from pianobot.config import ConfigError, from_dict
-from pianobot.env.piano import EnvConfig, PianoEnv, idle_pose
+from pianobot.env.piano import EnvConfig, PianoEnv, finger_counts, idle_pose
 from pianobot.errors import PianobotError, SettingError, quote
 from pianobot.music.piece import Note, Piece
 from pianobot.music.tasks import FAMILIES
@@ -45,9 +45,16 @@ def make_agent(env, config: SACConfig, device: str | torch.device = "cpu", train
         actions.shape[0],
         config,
         device,
-        finger_layout(space),
+        finger_layout(space, finger_counts(_env_config(env))),
         training,
     )
+
+
+def _env_config(env) -> EnvConfig:
+    """The :class:`EnvConfig` of a :class:`PianoEnv` (wrapped or not) or of a gymnasium vector of them."""
+    if hasattr(env, "get_attr"):
+        return env.get_attr("config")[0]
+    return env.unwrapped.config
 
 
 def policy_configs(folder: Path) -> tuple[EnvConfig, SACConfig]:

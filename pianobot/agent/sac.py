@@ -210,15 +210,25 @@ class FingerLayout:
 
     fingers: int
     joints: int
-    """Joints per finger (observed, actuated or not)."""
+    """Joints per finger (observed, actuated or not); the most any finger has, where they differ."""
     target_width: int
+    counts: tuple[tuple[int, ...], tuple[int, ...]] | None = None
+    """Where fingers differ: each finger's joints, and its actions (None: every finger alike)."""
 
 
-def finger_layout(observation_space) -> FingerLayout | None:
-    """The :class:`FingerLayout` of an environment's observations; None without finger targets."""
+def finger_layout(
+    observation_space, counts: tuple[tuple[int, ...], tuple[int, ...]] | None = None
+) -> FingerLayout | None:
+    """The :class:`FingerLayout` of an environment's observations; None without finger targets.
+    ``counts``: each finger's joints and actions (:func:`pianobot.env.piano.finger_counts`), for a
+    hand whose fingers differ."""
     if "targets" not in observation_space.spaces:
         return None
     fingers, width = observation_space["targets"].shape
+    if counts is not None and len(set(counts[0])) == len(set(counts[1])) == 1:
+        counts = None  # (every finger alike: the one layout)
+    if counts is not None:
+        return FingerLayout(fingers, max(counts[0]), width, counts)
     return FingerLayout(fingers, observation_space["joints"].shape[0] // fingers, width)
 
 
@@ -233,9 +243,22 @@ class FingerActor(GaussianActor):
     def __init__(self, vector_dim: int, score_dim: int, action_dim: int, layout: FingerLayout, config: SACConfig):
         super().__init__(config)
         self.layout, self.score_dim = layout, score_dim
-        self.per_finger = (action_dim - 1) // layout.fingers
-        if self.per_finger * layout.fingers + 1 != action_dim:
-            raise ValueError(f"{action_dim} actions are not {layout.fingers} fingers' alike plus the wrist")
+        if layout.counts is None:
+            self.per_finger = (action_dim - 1) // layout.fingers
+            if self.per_finger * layout.fingers + 1 != action_dim:
+                raise ValueError(f"{action_dim} actions are not {layout.fingers} fingers' alike plus the wrist")
+        else:  # fingers that differ: each one's joints padded to the most (zeros), its actions the first of the most
+            joints, moved = layout.counts
+            self.per_finger = max(moved)
+            if sum(moved) + 1 != action_dim:
+                raise ValueError(f"{action_dim} actions are not the fingers' {sum(moved)} plus the wrist")
+            total = sum(joints)
+            pad = [
+                [sum(joints[:f]) + j if j < n else total for j in range(layout.joints)] for f, n in enumerate(joints)
+            ]
+            self.register_buffer("padded", torch.tensor(pad), persistent=False)
+            kept = [f * self.per_finger + a for f, n in enumerate(moved) for a in range(n)]
+            self.register_buffer("kept", torch.tensor(kept), persistent=False)
         context = vector_dim - score_dim
         own = 2 + 2 * layout.joints + layout.target_width + layout.fingers
         self.finger = _mlp(own + context, 2 * self.per_finger, config.hidden)
@@ -246,22 +269,31 @@ class FingerActor(GaussianActor):
         v = vector[:, self.score_dim :]
         batch = v.shape[0]
         fingers, joints, width = self.layout.fingers, self.layout.joints, self.layout.target_width
+        total = fingers * joints if self.layout.counts is None else sum(self.layout.counts[0])
         angles = 2  # after the wrist's position and speed: angles, speeds, targets, finger by finger
-        speeds = angles + fingers * joints
-        targets = speeds + fingers * joints
+        speeds = angles + total
+        targets = speeds + total
         own = [
             v[:, None, :2].expand(batch, fingers, 2),
-            v[:, angles:speeds].reshape(batch, fingers, joints),
-            v[:, speeds:targets].reshape(batch, fingers, joints),
+            self._by_finger(v[:, angles:speeds]),
+            self._by_finger(v[:, speeds:targets]),
             v[:, targets : targets + fingers * width].reshape(batch, fingers, width),
             self.which.expand(batch, fingers, fingers),
             v[:, None, :].expand(batch, fingers, v.shape[1]),
         ]
         out = self.finger(torch.cat(own, dim=-1))  # (batch, fingers, 2 * per_finger)
-        finger_mean, finger_log_std = out.chunk(2, dim=-1)
+        finger_mean, finger_log_std = (half.reshape(batch, -1) for half in out.chunk(2, dim=-1))
+        if self.layout.counts is not None:  # (each finger's own actions)
+            finger_mean, finger_log_std = finger_mean[:, self.kept], finger_log_std[:, self.kept]
         wrist_mean, wrist_log_std = self.wrist(v).chunk(2, dim=-1)
-        mean = torch.cat([finger_mean.reshape(batch, -1), wrist_mean], dim=1)
-        return mean, torch.cat([finger_log_std.reshape(batch, -1), wrist_log_std], dim=1)
+        return torch.cat([finger_mean, wrist_mean], dim=1), torch.cat([finger_log_std, wrist_log_std], dim=1)
+
+    def _by_finger(self, values: torch.Tensor) -> torch.Tensor:
+        """(batch, fingers, joints): every finger's joints (padded with zeros where fingers differ)."""
+        if self.layout.counts is None:
+            return values.reshape(values.shape[0], self.layout.fingers, self.layout.joints)
+        padded = torch.cat([values, values.new_zeros(values.shape[0], 1)], dim=1)
+        return padded[:, self.padded]
 
 
 def _load_checked(module: nn.Module, state: dict[str, torch.Tensor], prefix: str) -> None:

@@ -137,9 +137,23 @@ def finger_targets(
 def actuated_indices(config: "EnvConfig") -> np.ndarray:
     """Where the action's values go in the full command (every finger joint, then the wrist):
     the actuated joints of each finger in its hand model's order (:data:`JOINT_KINDS`), then the wrist."""
-    kinds = config.world.hand.model.joints
-    joints = len(config.world.hand.spec.fingers) * len(kinds)
-    return np.array([i for i in range(joints) if kinds[i % len(kinds)] in config.actuated] + [joints])
+    kinds = config.world.hand.model.joint_kinds(config.world.hand.spec.fingers)
+    return np.array([i for i, kind in enumerate(kinds) if kind in config.actuated] + [len(kinds)])
+
+
+def finger_counts(config: "EnvConfig") -> tuple[tuple[int, ...], tuple[int, ...]]:
+    """For each finger (in order): how many joints it has (observed), and how many the action moves."""
+    model, fingers = config.world.hand.model, config.world.hand.spec.fingers
+    joints = tuple(len(model.joints_of(f)) for f in fingers)
+    moved = tuple(sum(j in config.actuated for j in model.joints_of(f)) for f in fingers)
+    return joints, moved
+
+
+def start_angles(config: WorldConfig) -> np.ndarray:
+    """Every finger joint's angle at the start of an episode, in action order (:func:`idle_pose`
+    for each finger, its model's joints)."""
+    pose = dict(zip(JOINT_KINDS, idle_pose(config)))
+    return np.array([pose[j] for j in config.hand.model.joint_kinds(config.hand.spec.fingers)])
 
 
 @dataclass(frozen=True)
@@ -275,7 +289,7 @@ class PianoEnv(gym.Env):
         self.frozen = np.zeros(self.n_joints + 1)
         if config.world.control == "position":
             low, high = joint_limits(config.world.hand)
-            self.frozen[:-1] = (np.tile(idle_pose(config.world), self.n_fingers) - low) / (high - low) * 2.0 - 1.0
+            self.frozen[:-1] = (start_angles(config.world) - low) / (high - low) * 2.0 - 1.0
         self.action_space = spaces.Box(-1.0, 1.0, (len(self.actuated),), np.float32)
         if piece is not None:
             self._set_piece(piece)
@@ -323,7 +337,7 @@ class PianoEnv(gym.Env):
 
     def start_pose(self) -> np.ndarray:
         """Every finger joint's angle at the start of an episode."""
-        return np.tile(idle_pose(self.config.world), self.n_fingers)
+        return start_angles(self.config.world)
 
     def begin(self) -> tuple[dict, dict]:
         """The episode's first observation and info, once the world is reset."""

@@ -39,7 +39,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from pianobot.env.piano import EnvConfig, actuated_indices
+from pianobot.env.piano import EnvConfig, actuated_indices, finger_counts
 from pianobot.music.tensor import FINGER
 from pianobot.perform.rollout import Controller
 from pianobot.pianist.layout import KeyLayout
@@ -85,8 +85,9 @@ class HoldGuard:
         self.policy = policy
         self.teacher = ScriptedPianist(config, tuning)
         joints = actuated_indices(config)[:-1]  # (the last action is the wrist's)
-        fingers = len(config.world.hand.spec.fingers)
-        self.joints_of = [np.flatnonzero(joints // len(config.world.hand.model.joints) == i) for i in range(fingers)]
+        counts, _ = finger_counts(config)
+        slot_of = np.repeat(np.arange(len(counts)), counts)  # every joint's finger slot, in command order
+        self.joints_of = [np.flatnonzero(slot_of[joints] == i) for i in range(len(counts))]
         """Finger (its slot) -> where its actuated joints are in the action."""
         self.held = 0
         """Finger-steps the teacher moved, since the guard was made."""

@@ -39,10 +39,11 @@ class ScriptedPianist:
         self.config = config
         self.tuning = tuning
         self.fingers = config.world.hand.spec.fingers
-        if config.world.hand.model.joints != JOINT_KINDS:
+        model = config.world.hand.model
+        if any(model.joints_of(f) != JOINT_KINDS for f in self.fingers):
             raise ValueError(
-                f"the scripted pianist moves fingers with {', '.join(JOINT_KINDS)} joints; the "
-                f"{config.world.hand.model.name} hand's have {', '.join(config.world.hand.model.joints)}"
+                f"the scripted pianist moves fingers with {', '.join(JOINT_KINDS)} joints, which not every finger "
+                f"of the {model.name} hand has"
             )
         self.layout = KeyLayout(config.world)
         self.strikes = StrikePlanner(config.world, self.layout, tuning)

@@ -80,7 +80,9 @@ class HandModel:
     passes: frozenset[tuple[int, int]] = frozenset()
     """(a, b): finger a may pass under or over finger b (none: no finger passes another)."""
     joints: tuple[str, ...] = JOINT_KINDS
-    """Each finger's joints, in action order (names from :data:`JOINT_KINDS`)."""
+    """Each finger's joints, in action order (names from :data:`JOINT_KINDS`); the others are fixed."""
+    finger_joints: tuple[tuple[int, tuple[str, ...]], ...] = ()
+    """(finger, joints): fingers whose joints are not :attr:`joints` (a thumb with fewer, say)."""
 
     def __post_init__(self) -> None:
         numbers = [f for f, _, _ in self.bases]
@@ -89,10 +91,11 @@ class HandModel:
         for fingers in self.finger_sets:
             if not fingers or not set(fingers) <= set(numbers):
                 raise ValueError(f"hand model {self.name!r}: finger set {fingers} is not among its fingers {numbers}")
-        if not set(self.joints) <= set(JOINT_KINDS) or len(set(self.joints)) != len(self.joints):
-            raise ValueError(
-                f"hand model {self.name!r}: joints {self.joints} must be distinct names from {JOINT_KINDS}"
-            )
+        for finger, joints in [(None, self.joints), *self.finger_joints]:
+            if not joints or not set(joints) <= set(JOINT_KINDS) or len(set(joints)) != len(joints):
+                raise ValueError(f"hand model {self.name!r}: joints {joints} must be distinct names from {JOINT_KINDS}")
+            if finger is not None and finger not in numbers:
+                raise ValueError(f"hand model {self.name!r}: joints given for finger {finger}, which it lacks")
 
     @property
     def fingers(self) -> tuple[int, ...]:
@@ -105,6 +108,14 @@ class HandModel:
 
     def base_y(self, finger: int) -> float:
         return next(y for f, _, y in self.bases if f == finger)
+
+    def joints_of(self, finger: int) -> tuple[str, ...]:
+        """A finger's actuated joints, in action order."""
+        return dict(self.finger_joints).get(finger, self.joints)
+
+    def joint_kinds(self, fingers: tuple[int, ...]) -> list[str]:
+        """The kind of every joint of ``fingers``, finger by finger, in action order."""
+        return [j for f in fingers for j in self.joints_of(f)]
 
 
 ALLEGRO = HandModel(
@@ -198,16 +209,16 @@ def hand_config(spec: HandSpec) -> HandConfig:
 
 
 def joint_limits(config: HandConfig) -> np.ndarray:
-    """(2, JF): the lower and upper limit (rad) of every finger joint, in action order (J joints a finger)."""
+    """(2, J): the lower and upper limit (rad) of every finger joint, in action order."""
     g = config.geometry
     limits = dict(zip(JOINT_KINDS, [(-g.abduction_limit, g.abduction_limit), *g.flexion_limits]))
-    per_finger = [limits[j] for j in config.model.joints]
-    return np.array(per_finger * len(config.spec.fingers)).T
+    return np.array([limits[j] for j in config.model.joint_kinds(config.spec.fingers)]).T
 
 
 def joint_names(spec: HandSpec) -> list[str]:
     """Actuated finger joints in action order: for each finger, its model's joints (abduction, MCP, PIP, DIP)."""
-    return [f"f{f}_{j}" for f in spec.fingers for j in hand_model(spec.model).joints]
+    model = hand_model(spec.model)
+    return [f"f{f}_{j}" for f in spec.fingers for j in model.joints_of(f)]
 
 
 def _box_inertia(mass: float, size: tuple[float, float, float]) -> str:
@@ -301,7 +312,7 @@ def hand_urdf(config: HandConfig, rail: tuple[float, float], side: str = "right"
         parts.append(
             _joint(
                 f"{prefix}_abd",
-                "revolute" if "abd" in config.model.joints else "fixed",
+                "revolute" if "abd" in config.model.joints_of(f) else "fixed",
                 "palm",
                 f"{prefix}_base",
                 (config.model.base_x(f, side), config.model.base_y(f), 0.0),
@@ -317,7 +328,7 @@ def hand_urdf(config: HandConfig, rail: tuple[float, float], side: str = "right"
             parts.append(
                 _joint(
                     f"{prefix}_{joint}",
-                    "revolute" if joint in config.model.joints else "fixed",
+                    "revolute" if joint in config.model.joints_of(f) else "fixed",
                     parent,
                     f"{prefix}_{link}",
                     (0, -offset, 0),

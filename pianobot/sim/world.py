@@ -133,7 +133,7 @@ class PianoWorld:
         self.min_separation = 2 * thumb_side_reach(config.hand)
         """Least distance (m) between two hands' wrists, the right one above."""
         self.time = 0.0
-        self._finger_command = np.zeros((len(hands), len(config.hand.model.joints) * len(config.hand.spec.fingers)))
+        self._finger_command = np.zeros((len(hands), len(joint_names(config.hand.spec))))
         self._build()
         if config.gui:
             p.resetDebugVisualizerCamera(0.45, 180, -60, [self.width / 2, 0.11, 0], physicsClientId=self.client)
