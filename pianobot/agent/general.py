@@ -156,9 +156,8 @@ def left_hand_policy(models: Path | None, keyboard: Any = None, hand: Any = Hand
     the general policy, :func:`general_candidates`): the packaged ``parts`` policy for ``hand``'s
     fingers (a spec; default the three-finger hand), when the user's store holds no general policy
     of its own for ``keyboard`` (a spec, None: any) and ``hand`` (such a one plays both hands) and
-    the packaged one plays them (:func:`plays_keyboard`). None: both hands have the general policy. Measured (docs/benchmarks.md, "Two hands"): alone, the left hands of 50 random
-    two-hand pieces at note F1 0.929 against the melody policy's 0.861; through the hold guard, the
-    right hands at 0.933 against the melody policy's 0.923."""
+    the packaged one plays them (:func:`plays_keyboard`). None: both hands have the general policy.
+    Why one policy for both hands: docs/benchmarks.md, "Two hands"."""
 
     def fits(folder: Path) -> bool:
         env, sac = policy_configs(folder)

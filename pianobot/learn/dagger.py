@@ -1,8 +1,8 @@
 """Training by imitation: DAgger (Ross, Gordon and Bagnell, 2011) from the scripted pianist.
 
 Not in the paper, and not the default learner (``TrainConfig.learner``): the paper trains SAC
-from rewards. The scripted pianist (:mod:`pianobot.pianist.scripted`) plays random melodies at
-note F1 0.999 (docs/benchmarks.md), and it can say what it would do in any state, also in those
+from rewards. The scripted pianist (:mod:`pianobot.pianist.scripted`) plays random melodies
+nearly perfectly (docs/benchmarks.md), and it can say what it would do in any state, also in those
 it never leads to itself; a policy that copies it learns a task family in a fraction of SAC's
 steps, which is how the general policy is trained (docs/training.md).
 

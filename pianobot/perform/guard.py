@@ -23,8 +23,8 @@ rush while its finger is still on the key and drags the finger across the neighb
 which sound. The scripted pianist slides the wrist at most
 :attr:`~pianobot.pianist.tuning.PianistTuning.hold_slide` a step while a finger holds a key, and
 not at all while a finger that let go is still low over the keys
-(:meth:`~pianobot.pianist.motion.Motion.low`); only during a strike may it go faster, and it
-rarely does (measured: 3 of about 2500 steps over the examples and 10 random melodies). The guard
+(:meth:`~pianobot.pianist.motion.Motion.low`); only during a strike may it go faster, which it
+rarely does (docs/benchmarks.md, "What the wrist guard and one section change"). The guard
 holds a policy to ``hold_slide`` whenever a fingertip is low, from the joint angles in the
 observation alone, and leaves every other action as the policy chose it. It makes a drag less
 likely, not impossible: a fingertip low over the keys may still slide 8 mm a step.
@@ -50,17 +50,13 @@ from pianobot.pianist.tuning import PianistTuning
 QUIET_STEPS = PianistTuning.prepare_steps + PianistTuning.settle_steps
 """While a finger holds and no finger's next note starts within this many control steps, the hold
 guard's teacher moves the wrist: the least time the teacher gives a finger to get ready for a
-strike (it lifts, moves over the key and settles): 5. Measured on validation sets
-(docs/benchmarks.md, "Two hands"): horizons of 4, 5, 6 and 8 steps played the 30 pieces at 0.970,
-0.970, 0.969 and 0.968 and the 21 polyphonic parts at 0.975, 0.972, 0.974 and 0.967, against 0.966
-and 0.970 with the policy's wrist throughout."""
+strike (it lifts, moves over the key and settles). Chosen on validation sets (docs/benchmarks.md,
+"Two hands")."""
 HOLD_GUARD_FAMILIES = ("parts",)
-"""Task families whose general policies play through the hold guard unless told otherwise. Chosen on
-validation sets (docs/benchmarks.md, "Two hands"): the ``parts`` policy, which learnt from the
-teacher that holds its notes, played 21 polyphonic parts at note F1 0.950 through it against 0.881
-alone, and the left hands of 30 two-hand pieces at 0.973 against 0.945; the ``melody`` policy,
-which learnt from the teacher before it held its notes, played 40 melodies at 0.943 through it
-against 0.960 alone (and its right hands of the 30 pieces at 0.925 against 0.928)."""
+"""Task families whose general policies play through the hold guard unless told otherwise: the
+``parts`` policy, which learnt from the teacher that holds its notes, plays better through it, the
+``melody`` policy, which learnt from the teacher before it held its notes, better alone (chosen on
+validation sets: docs/benchmarks.md, "Two hands")."""
 
 
 class HoldGuard:
@@ -119,7 +115,7 @@ class HoldGuard:
         if holding.size:
             self.teacher.previous_row = self._before(observation["score"][0], holding)
             # (nor what it let go: the policy moves the wrist, and remembered, a key let go for one
-            # step stayed up; measured on the validation pieces, per-step F1 0.873 -> 0.806)
+            # step stayed up, which cost per-step F1 on the validation pieces: docs/history.md)
             self.teacher.released = frozenset()
             taught = self.teacher.act(observation)
             for slot in holding:
