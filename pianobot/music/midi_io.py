@@ -23,7 +23,7 @@ import io
 import re
 import warnings
 from collections import defaultdict
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import mido
@@ -147,6 +147,41 @@ def _load(path: Path) -> mido.MidiFile:
     return midi
 
 
+@dataclass(frozen=True, eq=False)
+class MidiSource:
+    """A .mid file read once (:func:`open_midi`): its path and its parsed contents. Every reader
+    here takes one in place of a path, so that a command reads its file once and derives the rest
+    from what it read."""
+
+    path: Path
+    midi: mido.MidiFile = field(repr=False)
+
+    @property
+    def name(self) -> str:
+        """The file's name."""
+        return self.path.name
+
+
+def open_midi(path: str | Path | MidiSource) -> MidiSource:
+    """The .mid file at ``path``, read and parsed (a bad file refused in one line); a
+    :class:`MidiSource` is returned as it is."""
+    if isinstance(path, MidiSource):
+        return path
+    path = Path(path)
+    return MidiSource(path, _load(path))
+
+
+def source_path(source: str | Path | MidiSource) -> Path:
+    """The path of a file given by its path or as a :class:`MidiSource`."""
+    return source.path if isinstance(source, MidiSource) else Path(source)
+
+
+def _opened(source: str | Path | MidiSource) -> tuple[Path, mido.MidiFile]:
+    """(path, parsed file): a :class:`MidiSource`'s own, else the file read now."""
+    opened = open_midi(source)
+    return opened.path, opened.midi
+
+
 def _absolute(track: mido.MidiTrack) -> list[tuple[int, mido.Message]]:
     """(absolute tick, message) pairs; at equal ticks note-offs come before note-ons."""
     tick, out = 0, []
@@ -246,10 +281,10 @@ def parse_grid(text: str) -> float:
     return top / bottom
 
 
-def selected_tracks(path: str | Path, track: str | int | None) -> list[int]:
+def selected_tracks(path: str | Path | MidiSource, track: str | int | None) -> list[int]:
     """The tracks ``track`` names in the file at ``path`` (as :func:`read_midi` reads them), by index."""
-    path = Path(path)
-    return _select_tracks(_load(path), track, path)
+    path, midi = _opened(path)
+    return _select_tracks(midi, track, path)
 
 
 def _select_tracks(midi: mido.MidiFile, track: str | int | None, path: Path) -> list[int]:
@@ -318,7 +353,7 @@ def _track_notes(
 
 
 def read_midi(
-    path: str | Path,
+    path: str | Path | MidiSource,
     *,
     track: str | int | None = None,
     bpm: float | None = None,
@@ -333,8 +368,7 @@ def read_midi(
     nearest grid line, in the file's beats, for recordings of human players; a note lasts at
     least one grid step. Sustain-pedal events are ignored: a note sounds while its key is down.
     """
-    path = Path(path)
-    midi = _load(path)
+    path, midi = _opened(path)
     if bpm is not None:
         if not 10 <= bpm <= 1000:
             raise SettingError(f"load.tempo {bpm}: choose a tempo between 10 and 1000 bpm", "load.tempo")
@@ -527,10 +561,10 @@ def write_midi(piece: Piece, path: str | Path, *, name: str = "pianobot") -> Pat
     return atomic_write(path, midi_bytes(piece, name=name))
 
 
-def tempi(path: str | Path) -> list[float]:
+def tempi(path: str | Path | MidiSource) -> list[float]:
     """The tempos of a MIDI file in beats per minute, in the order they take effect (120 until its
     first set_tempo, where that is after the start), each change to another tempo once."""
-    midi = _load(Path(path))
+    _, midi = _opened(path)
     changes = _tempo_changes(midi)
     changes = [
         c for i, c in enumerate(changes) if i + 1 == len(changes) or changes[i + 1][0] != c[0]
@@ -543,6 +577,6 @@ def tempi(path: str | Path) -> list[float]:
     return found
 
 
-def describe_tracks(path: str | Path) -> list[TrackInfo]:
+def describe_tracks(path: str | Path | MidiSource) -> list[TrackInfo]:
     """Tracks of a MIDI file, for `pianobot inspect`."""
-    return list_tracks(_load(Path(path)))
+    return list_tracks(_opened(path)[1])

@@ -19,14 +19,11 @@ from pianobot.cli.options import (
     HtmlReport,
     PlayPhraseNotes,
     Reading,
-    both_hands,
     check_files,
     check_html,
     check_midi_output,
     check_models,
-    fit_hand,
-    fit_keyboard,
-    read_song,
+    read_file,
     reads,
 )
 from pianobot.cli.terminal import err, out, said, write_json
@@ -173,8 +170,8 @@ def play(
         import torch
 
         torch.set_num_threads(1)  # batch-1 inference: more threads only spin against other work on the cores
-    reading = fit_hand(song, reading)
-    hands = both_hands(song, reading)
+    read = read_file(song, reading)
+    hands = read.hands
     if left_policy is not None:
         from pianobot.agent import store
 
@@ -210,7 +207,7 @@ def play(
             models=models,
             seed=seed,
             keyboard=reading.keyboard if reading.keyboard_named else None,  # (none named: each player's own keys)
-            hand=reading.hand,
+            hand=read.fingers,
             options=dict(
                 general=use_general,
                 general_policy=general_policy
@@ -225,11 +222,10 @@ def play(
             shown=dict(console=console, notes=notes, every=every, quiet=quiet),
         )
         return
-    reading = fit_keyboard(song, reading)
-    piece = read_song(song, reading.options, reading.keyboard, reading.hand)
+    piece = read.piece
     chosen = dict(
-        keyboard=reading.keyboard,
-        hand=reading.hand,
+        keyboard=read.keyboard,
+        hand=read.fingers,
         general=use_general,
         general_policy=general_policy,
         fallback=fallback is not None,

@@ -23,12 +23,10 @@ from pianobot.cli.options import (
     Reading,
     Reward,
     Task,
-    both_hands,
     check_files,
-    fit_hand,
-    fit_keyboard,
+    finger_file,
     option,
-    read_song,
+    read_file,
     reads,
     refuse_training_into,
     value,
@@ -235,11 +233,9 @@ def train(
     console = err if json_path is not None and str(json_path) == "-" else out  # standard output carries the JSON
     if models.exists() and not models.is_dir():
         raise PianobotError(f"--models {models} is a file: give a folder")
-    reading = fit_hand(song, reading) if song is not None else reading
-    hands = both_hands(song, reading) if song is not None else None
-    if song is not None and hands is None:  # (a one-hand piece off the default keys: its own octaves, as play does)
-        reading = fit_keyboard(song, reading)
-    keyboard, hand = reading.keyboard, reading.hand
+    read = read_file(song, reading, finger=False) if song is not None else None  # (fingered below)
+    hands = None if read is None else read.hands
+    keyboard, hand = (reading.keyboard, reading.hand) if read is None else (read.keyboard, read.fingers)
     with option("--control", control):
         world = WorldConfig(keyboard=KeyboardConfig(spec=keyboard), hand=hand_config(hand), control=control.value)
     with option("--reward", reward):
@@ -303,7 +299,7 @@ def train(
         groups = [(None, config, start, todo)]
     else:
         if hands is None:
-            piece = read_song(song, reading.options, keyboard, hand)
+            piece = finger_file(read, reading).piece
             phrases = {None: split_phrases(piece, phrase_notes)}
             groups = [(None, config, start, phrase_jobs(phrases[None], config, models, piece=song.name))]
             label = f"{song.name}: {len(phrases[None])} phrases"
