@@ -23,6 +23,7 @@ from pianobot.cli.options import (
     check_html,
     check_midi_output,
     check_models,
+    finger_file,
     read_file,
     reads,
 )
@@ -170,7 +171,7 @@ def play(
         import torch
 
         torch.set_num_threads(1)  # batch-1 inference: more threads only spin against other work on the cores
-    read = read_file(song, reading)
+    read = read_file(song, reading, finger=False)  # (one hand's part fingered once --left-policy is checked)
     hands = read.hands
     if left_policy is not None:
         from pianobot.agent import store
@@ -222,6 +223,7 @@ def play(
             shown=dict(console=console, notes=notes, every=every, quiet=quiet),
         )
         return
+    read = finger_file(read, reading)
     piece = read.piece
     chosen = dict(
         keyboard=read.keyboard,
