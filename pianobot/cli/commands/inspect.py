@@ -24,18 +24,21 @@ from pianobot.errors import PianobotError
 from pianobot.files import check_writable
 from pianobot.music.piece import pitch_name
 
+MODELS_OPTION = typer.Option(
+    DEFAULT_STORE, "--models", help="Model store whose trained phrase split to show (as play uses it)."
+)
+JSON_PATH_OPTION = typer.Option(
+    None, "--json", help="Also write what inspect found to this JSON file ('-': standard output)."
+)
+
 
 @reads()
 def inspect(
     song: Path = typer.Argument(..., help="A .mid file (or a PIG fingering .txt file)."),
     phrase_notes: Optional[int] = PlayPhraseNotes,
-    models: Path = typer.Option(
-        DEFAULT_STORE, "--models", help="Model store whose trained phrase split to show (as play uses it)."
-    ),
+    models: Path = MODELS_OPTION,
     all_rows: bool = AllRows,
-    json_path: Optional[Path] = typer.Option(
-        None, "--json", help="Also write what inspect found to this JSON file ('-': standard output)."
-    ),
+    json_path: Optional[Path] = JSON_PATH_OPTION,
     reading: Reading = None,
 ):
     """Explain what a file holds (tracks, hands, pedal, range, polyphony, fingering) and whether the hand can play it."""

@@ -46,88 +46,101 @@ def progress(what: str):
         yield lambda done, total: bar.update(task, completed=done, total=total)
 
 
+SONG_OPTION = typer.Argument(
+    ...,
+    help="The piece to play: a .mid file (or a PIG .txt file); notes without fingering are fingered by the planner.",
+)
+OUTPUT_OPTION = typer.Option(..., "--output", "-o", help="Write what the simulated piano sounded to this .mid file.")
+CONTROLLER_OPTION = typer.Option(
+    CONTROLLERS[0],
+    "--controller",
+    help="Who plays: 'sac' (each phrase's trained policy, else the general policy), 'scripted' (the hand-written pianist) or 'random'.",
+)
+FALLBACK_OPTION = typer.Option(
+    None,
+    "--fallback",
+    help="'scripted': play phrases that have no trained policy with the scripted pianist (when no general policy "
+    "plays them: a phrase's own policy first, then the general policy, then the fallback).",
+)
+USE_GENERAL_OPTION = typer.Option(
+    True,
+    "--general/--no-general",
+    help="Play phrases without a policy of their own with the general policy (--general-policy, else the newest "
+    "`pianobot train --task melody` or `--task parts` policy in --models, else the packaged one), when there is one.",
+)
+LEFT_POLICY_OPTION = typer.Option(
+    None,
+    "--left-policy",
+    help="On a two-hand file, the general policy that plays the left hand (default: --general-policy when given, "
+    "else the newest general policy in --models, else the packaged left hand's policy, a `--task parts` one; "
+    "the right hand has --general-policy, or the newest general policy in --models, or the packaged left hand's "
+    "policy too; one-hand files have the general policy).",
+)
+WRIST_GUARD_OPTION = typer.Option(
+    False,
+    "--wrist-guard/--no-wrist-guard",
+    help="While a fingertip is low over the keys, the general policy's wrist slides no faster than the scripted "
+    "pianist's does while holding a key (PianistTuning.hold_slide, 8 mm a step), so that a late release drags a "
+    "finger across the keys less often (no effect on a policy trained with a discrete wrist).",
+)
+HOLD_GUARD_OPTION = typer.Option(
+    None,  # PerformancePlan.hold_guard (a test holds them equal; the plan module is slow to import)
+    "--hold-guard/--no-hold-guard",
+    help="While a finger holds a written note, the scripted pianist moves that finger (it keeps the key down until "
+    "the note ends, or until its own plan needs the finger for the next note) and the general policy the rest of "
+    "the hand. Default: for a general policy trained on hands' parts (`--task parts`: the packaged left hand's "
+    "policy), not for a melody policy (`--task melody`, which plays melodies better alone); --hold-guard: for "
+    "every general policy; --no-hold-guard: for none. Phrase policies always play alone; no effect on a policy "
+    "without finger targets or with torque control.",
+)
+SEED_OPTION = typer.Option(
+    0,
+    "--seed",
+    help="Seed of the simulation (the hand's start position) and of the random controller.",
+    min=0,
+)
+SOUNDFONT_OPTION = typer.Option(
+    None,
+    "--soundfont",
+    help="A General MIDI .sf2 soundfont for --wav and --video's sound (FluidSynth; default: an installed one, "
+    "else sine waves).",
+)
+JSON_PATH_OPTION = typer.Option(
+    None,
+    "--json",
+    help="Also write the report (who played, every figure, every note) to this JSON file ('-': standard output).",
+)
+NOTES_OPTION = typer.Option(
+    0, "--notes", min=0, help="Print the per-note table's first N rows (the report file has every note)."
+)
+QUIET_OPTION = typer.Option(
+    False, "--quiet", "-q", help="Print only where the files went (and warnings and errors): no figures, no tables."
+)
+
+
 @reads()
 def play(
-    song: Path = typer.Argument(
-        ...,
-        help="The piece to play: a .mid file (or a PIG .txt file); notes without fingering are fingered by the planner.",
-    ),
-    output: Path = typer.Option(
-        ..., "--output", "-o", help="Write what the simulated piano sounded to this .mid file."
-    ),
-    controller: Controller = typer.Option(
-        CONTROLLERS[0],
-        "--controller",
-        help="Who plays: 'sac' (each phrase's trained policy, else the general policy), 'scripted' (the hand-written pianist) or 'random'.",
-    ),
+    song: Path = SONG_OPTION,
+    output: Path = OUTPUT_OPTION,
+    controller: Controller = CONTROLLER_OPTION,
     models: Path = typer.Option(DEFAULT_STORE, "--models", help="Folder of the model store (for --controller sac)."),
-    fallback: Optional[Fallback] = typer.Option(
-        None,
-        "--fallback",
-        help="'scripted': play phrases that have no trained policy with the scripted pianist (when no general policy "
-        "plays them: a phrase's own policy first, then the general policy, then the fallback).",
-    ),
-    use_general: bool = typer.Option(
-        True,
-        "--general/--no-general",
-        help="Play phrases without a policy of their own with the general policy (--general-policy, else the newest "
-        "`pianobot train --task melody` or `--task parts` policy in --models, else the packaged one), when there is one.",
-    ),
+    fallback: Optional[Fallback] = FALLBACK_OPTION,
+    use_general: bool = USE_GENERAL_OPTION,
     general_policy: Optional[Path] = GeneralPolicy,
-    left_policy: Optional[Path] = typer.Option(
-        None,
-        "--left-policy",
-        help="On a two-hand file, the general policy that plays the left hand (default: --general-policy when given, "
-        "else the newest general policy in --models, else the packaged left hand's policy, a `--task parts` one; "
-        "the right hand has --general-policy, or the newest general policy in --models, or the packaged left hand's "
-        "policy too; one-hand files have the general policy).",
-    ),
-    wrist_guard: bool = typer.Option(
-        False,
-        "--wrist-guard/--no-wrist-guard",
-        help="While a fingertip is low over the keys, the general policy's wrist slides no faster than the scripted "
-        "pianist's does while holding a key (PianistTuning.hold_slide, 8 mm a step), so that a late release drags a "
-        "finger across the keys less often (no effect on a policy trained with a discrete wrist).",
-    ),
-    hold_guard: Optional[bool] = typer.Option(
-        None,  # PerformancePlan.hold_guard (a test holds them equal; the plan module is slow to import)
-        "--hold-guard/--no-hold-guard",
-        help="While a finger holds a written note, the scripted pianist moves that finger (it keeps the key down until "
-        "the note ends, or until its own plan needs the finger for the next note) and the general policy the rest of "
-        "the hand. Default: for a general policy trained on hands' parts (`--task parts`: the packaged left hand's "
-        "policy), not for a melody policy (`--task melody`, which plays melodies better alone); --hold-guard: for "
-        "every general policy; --no-hold-guard: for none. Phrase policies always play alone; no effect on a policy "
-        "without finger targets or with torque control.",
-    ),
+    left_policy: Optional[Path] = LEFT_POLICY_OPTION,
+    wrist_guard: bool = WRIST_GUARD_OPTION,
+    hold_guard: Optional[bool] = HOLD_GUARD_OPTION,
     phrase_notes: Optional[int] = PlayPhraseNotes,
-    seed: int = typer.Option(
-        0,
-        "--seed",
-        help="Seed of the simulation (the hand's start position) and of the random controller.",
-        min=0,
-    ),
+    seed: int = SEED_OPTION,
     video: Optional[Path] = typer.Option(None, "--video", help="Also record the performance to this .mp4 file."),
     wav: Optional[Path] = typer.Option(None, "--wav", help="Also synthesise what was played to this .wav file."),
-    soundfont: Optional[Path] = typer.Option(
-        None,
-        "--soundfont",
-        help="A General MIDI .sf2 soundfont for --wav and --video's sound (FluidSynth; default: an installed one, "
-        "else sine waves).",
-    ),
+    soundfont: Optional[Path] = SOUNDFONT_OPTION,
     gui: bool = typer.Option(False, "--gui", help="Show the simulation in a PyBullet window (needs a display)."),
     html: Optional[Path] = HtmlReport,
-    json_path: Optional[Path] = typer.Option(
-        None,
-        "--json",
-        help="Also write the report (who played, every figure, every note) to this JSON file ('-': standard output).",
-    ),
-    notes: int = typer.Option(
-        0, "--notes", min=0, help="Print the per-note table's first N rows (the report file has every note)."
-    ),
+    json_path: Optional[Path] = JSON_PATH_OPTION,
+    notes: int = NOTES_OPTION,
     every: bool = AllFigures,
-    quiet: bool = typer.Option(
-        False, "--quiet", "-q", help="Print only where the files went (and warnings and errors): no figures, no tables."
-    ),
+    quiet: bool = QUIET_OPTION,
     reading: Reading = None,
 ):
     """Perform a piece (both hands of a two-hand file) in the simulator; write the played notes (velocities, fingers, hands) and a report."""
