@@ -27,6 +27,7 @@ from __future__ import annotations
 import bisect
 import math
 from dataclasses import dataclass
+from enum import Enum
 from pathlib import Path
 
 import numpy as np
@@ -125,6 +126,15 @@ def trained_split(models: Path, piece: Piece, phrase_notes: int | None) -> list[
     return split_phrases(piece, DEFAULT_MAX_NOTES)
 
 
+class Player(str, Enum):
+    """Who plays a stretch of a performance (the plan, :mod:`pianobot.perform.plan`, decides)."""
+
+    OWN = "own policy"
+    GENERAL = "general policy"
+    SCRIPTED = "scripted pianist"
+    RANDOM = "random actions"
+
+
 class CompositionalController:
     """Acts with the controller of the section the current step falls in. ``stretches`` say who
     plays what (:func:`pianobot.perform.plan.assign`): a phrase's own policy, the general policy
@@ -134,8 +144,6 @@ class CompositionalController:
     guard outside)."""
 
     def __init__(self, env: PianoEnv, stretches, guard: bool = False, hold: bool = False):
-        from pianobot.perform.plan import Player  # (the plan module builds on this one)
-
         spec = env.spec_score
         lead = env.lead_steps
         grace = math.ceil(DEFAULT_ONSET_TOLERANCE * spec.control_hz - 1e-9)  # steps a strike may come late

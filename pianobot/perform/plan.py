@@ -23,7 +23,6 @@ from __future__ import annotations
 import contextlib
 import warnings
 from dataclasses import dataclass, replace
-from enum import Enum
 from pathlib import Path
 from typing import Callable
 
@@ -38,7 +37,7 @@ from pianobot.music.metrics import Report
 from pianobot.music.phrases import DEFAULT_MAX_NOTES, Phrase, split_phrases
 from pianobot.music.piece import Piece
 from pianobot.perform import perform as simulation  # (called through the module: tests replace simulation.perform)
-from pianobot.perform.compose import CompositionalController, find_policy, trained_split
+from pianobot.perform.compose import CompositionalController, Player, find_policy, trained_split
 from pianobot.perform.controllers import CONTROLLERS, make_controller
 from pianobot.perform.guard import HOLD_GUARD_FAMILIES, HoldGuard, WristGuard
 from pianobot.perform.perform import PLAY_CONFIG
@@ -50,15 +49,6 @@ from pianobot.sim.world import WorldConfig
 DEFAULT_MODELS = store.DEFAULT_STORE
 """The model store when none is named: ``models`` in the current folder (where ``pianobot train``
 writes). The general policy that ships with pianobot is found from anywhere besides."""
-
-
-class Player(str, Enum):
-    """Who plays a stretch of a performance."""
-
-    OWN = "own policy"
-    GENERAL = "general policy"
-    SCRIPTED = "scripted pianist"
-    RANDOM = "random actions"
 
 
 ONE_PLAYER = {"scripted": Player.SCRIPTED, "random": Player.RANDOM}
