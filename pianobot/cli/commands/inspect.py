@@ -43,9 +43,7 @@ def inspect(
 ):
     """Explain what a file holds (tracks, hands, pedal, range, polyphony, fingering) and whether the hand can play it."""
     from pianobot.cli import display
-    from pianobot.music import midi_io
     from pianobot.music.instrument import check_playable
-    from pianobot.music.load import HANDS, hand_tracks
     from pianobot.perform.compose import missing_phrases, phrase_players, trained_split
     from pianobot.pianist.fingering import ensure_fingering
     from pianobot.pianist.reading import open_song
@@ -57,25 +55,8 @@ def inspect(
     if json_path is not None and not to_stdout:
         check_writable(json_path)
     console = err if to_stdout else out  # standard output carries the JSON
-    tracks, named, tempi = [], False, None
     source = open_song(song)  # (the file read once: all below derives from it)
-    if song.suffix.lower() != ".txt":
-        tracks = midi_io.describe_tracks(source)
-        tempi = None if options.tempo is not None else midi_io.tempi(source)  # (--tempo re-times it at one tempo)
-        hands = {i: h for h in HANDS for i in hand_tracks(tracks, h)}
-        named = bool(hands)
-        console.print(display.tracks_table([replace(t, name=said(t.name)) for t in tracks], hands))
-        with_notes = [t for t in tracks if t.notes]
-        pedal = sum(t.pedal for t in tracks)
-        console.print(
-            f"{len(with_notes)} track(s) with notes"
-            + (f"; {_hand_parts(tracks)}" if hands else "")
-            + (
-                f"; sustain pedal pressed {pedal} times (ignored: a note sounds while its key is down)"
-                if pedal
-                else "; no sustain pedal"
-            )
-        )
+    tracks, named, tempi = _show_tracks(console, song, source, options)
     try:
         read = read_file(source, reading, finger=False)
     except PianobotError:
@@ -147,6 +128,34 @@ def inspect(
                 ],
             },
         )
+
+
+def _show_tracks(console, song: Path, source, options) -> tuple[list, bool, list | None]:
+    """A MIDI file's tracks, which hands they name and its pedal, printed: (tracks, whether any
+    track names a hand, the tempos (None with --tempo))."""
+    from pianobot.cli import display
+    from pianobot.music import midi_io
+    from pianobot.music.load import HANDS, hand_tracks
+
+    tracks, named, tempi = [], False, None
+    if song.suffix.lower() != ".txt":
+        tracks = midi_io.describe_tracks(source)
+        tempi = None if options.tempo is not None else midi_io.tempi(source)  # (--tempo re-times it at one tempo)
+        hands = {i: h for h in HANDS for i in hand_tracks(tracks, h)}
+        named = bool(hands)
+        console.print(display.tracks_table([replace(t, name=said(t.name)) for t in tracks], hands))
+        with_notes = [t for t in tracks if t.notes]
+        pedal = sum(t.pedal for t in tracks)
+        console.print(
+            f"{len(with_notes)} track(s) with notes"
+            + (f"; {_hand_parts(tracks)}" if hands else "")
+            + (
+                f"; sustain pedal pressed {pedal} times (ignored: a note sounds while its key is down)"
+                if pedal
+                else "; no sustain pedal"
+            )
+        )
+    return tracks, named, tempi
 
 
 def _summary(piece, tempi: list[float] | None = None) -> tuple[str, dict]:

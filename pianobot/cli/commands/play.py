@@ -144,12 +144,53 @@ def play(
     reading: Reading = None,
 ):
     """Perform a piece (both hands of a two-hand file) in the simulator; write the played notes (velocities, fingers, hands) and a report."""
-    from pianobot.cli import display
-    from pianobot.music.midi_io import write_midi
-    from pianobot.music.phrases import split_phrases
-    from pianobot.perform.audio import check_soundfont, write_wav
-    from pianobot.perform.perform import write_video
-    from pianobot.perform.plan import Player, perform_judged, plan_performance
+    files = dict(report=output.with_suffix(".report.json"), json=json_path, wav=wav, soundfont=soundfont, html=html)
+    files |= dict(video=video)
+    shown = dict(notes=notes, every=every, quiet=quiet)
+    report_path, shown["console"] = _check_files(
+        song, output, reading, controller, models, json_path, html, wav, video, soundfont, gui
+    )
+    read = read_file(song, reading, finger=False)  # (one hand's part fingered once --left-policy is checked)
+    hands = read.hands
+    _check_left_policy(left_policy, song, hands, controller, use_general, models)
+    if hands is not None:  # a two-hand file: both hands, in one simulation
+        if gui:
+            raise PianobotError(
+                f"--gui shows one hand so far, and {song.name} plays with two: "
+                "play one hand for it with --hand right (or --hand left), or watch both with --video"
+            )
+        play_both(
+            song,
+            output,
+            hands,
+            controller=controller.value,
+            models=models,
+            seed=seed,
+            keyboard=reading.keyboard if reading.keyboard_named else None,  # (none named: each player's own keys)
+            hand=read.fingers,
+            options=dict(
+                general=use_general,
+                general_policy=general_policy
+                if left_policy is None
+                else {"right": general_policy, "left": left_policy},
+                fallback=fallback is not None,
+                phrase_notes=phrase_notes,
+                wrist_guard=wrist_guard,
+                hold_guard=hold_guard,
+            ),
+            files=files,
+            shown=shown,
+        )
+        return
+    options = dict(general=use_general, general_policy=general_policy, fallback=fallback is not None)
+    options |= dict(phrase_notes=phrase_notes, wrist_guard=wrist_guard, hold_guard=hold_guard, gui=gui)
+    play_one(song, output, finger_file(read, reading), controller, models, seed, options, files, shown)
+
+
+def _check_files(song, output, reading, controller, models, json_path, html, wav, video, soundfont, gui):
+    """Every file play reads and writes, and what it needs, checked before any work: (the report's
+    path beside -o, the console for what is printed)."""
+    from pianobot.perform.audio import check_soundfont
 
     check_midi_output(output, song, "the performance")
     if controller == "sac":
@@ -184,71 +225,59 @@ def play(
         import torch
 
         torch.set_num_threads(1)  # batch-1 inference: more threads only spin against other work on the cores
-    read = read_file(song, reading, finger=False)  # (one hand's part fingered once --left-policy is checked)
-    hands = read.hands
-    if left_policy is not None:
+    return report_path, console
+
+
+def _check_left_policy(left_policy, song, hands, controller, use_general, models) -> None:
+    """--left-policy only where a general policy plays a two-hand file's left hand, and only a trained policy."""
+    if left_policy is None:
+        return
         from pianobot.agent import store
 
-        why = (
-            "plays one hand"
-            if hands is None
-            else f"is played by --controller {controller.value}"
-            if controller != "sac"
-            else "is played with --no-general"
-            if not use_general
-            else None
-        )
-        if why is not None:
-            raise PianobotError(
-                f"--left-policy {left_policy}: {song.name} {why}, so no general policy plays a left hand; drop --left-policy"
-            )
-        if not store.is_trained(left_policy):
-            raise PianobotError(
-                f"--left-policy {left_policy}: not a trained policy folder (one holding {store.POLICY_FILE} and "
-                f"{store.MANIFEST_FILE}, e.g. a `pianobot train --task parts` folder in {models})"
-            )
-    if hands is not None:  # a two-hand file: both hands, in one simulation
-        if gui:
-            raise PianobotError(
-                f"--gui shows one hand so far, and {song.name} plays with two: "
-                "play one hand for it with --hand right (or --hand left), or watch both with --video"
-            )
-        play_both(
-            song,
-            output,
-            hands,
-            controller=controller.value,
-            models=models,
-            seed=seed,
-            keyboard=reading.keyboard if reading.keyboard_named else None,  # (none named: each player's own keys)
-            hand=read.fingers,
-            options=dict(
-                general=use_general,
-                general_policy=general_policy
-                if left_policy is None
-                else {"right": general_policy, "left": left_policy},
-                fallback=fallback is not None,
-                phrase_notes=phrase_notes,
-                wrist_guard=wrist_guard,
-                hold_guard=hold_guard,
-            ),
-            files=dict(report=report_path, json=json_path, wav=wav, soundfont=soundfont, html=html, video=video),
-            shown=dict(console=console, notes=notes, every=every, quiet=quiet),
-        )
-        return
-    read = finger_file(read, reading)
-    piece = read.piece
-    chosen = dict(
-        keyboard=read.keyboard,
-        hand=read.fingers,
-        general=use_general,
-        general_policy=general_policy,
-        fallback=fallback is not None,
-        phrase_notes=phrase_notes,
-        wrist_guard=wrist_guard,
-        hold_guard=hold_guard,
-        gui=gui,
+    why = (
+        "plays one hand"
+        if hands is None
+        else f"is played by --controller {controller.value}"
+        if controller != "sac"
+        else "is played with --no-general"
+        if not use_general
+        else None
     )
+    if why is not None:
+        raise PianobotError(
+            f"--left-policy {left_policy}: {song.name} {why}, so no general policy plays a left hand; drop --left-policy"
+        )
+    if not store.is_trained(left_policy):
+        raise PianobotError(
+            f"--left-policy {left_policy}: not a trained policy folder (one holding {store.POLICY_FILE} and "
+            f"{store.MANIFEST_FILE}, e.g. a `pianobot train --task parts` folder in {models})"
+        )
+
+
+def play_one(
+    song: Path, output: Path, read, controller, models, seed: int, options: dict, files: dict, shown: dict
+) -> None:
+    """`play` of a one-hand piece (``read``: a :class:`~pianobot.pianist.reading.ReadPiece`, fingered):
+    planned (:func:`~pianobot.perform.plan.plan_performance`), performed as judged
+    (:func:`~pianobot.perform.plan.perform_judged`), written, and reported."""
+    from pianobot.cli import display
+    from pianobot.music.midi_io import write_midi
+    from pianobot.music.phrases import split_phrases
+    from pianobot.perform.audio import write_wav
+    from pianobot.perform.perform import write_video
+    from pianobot.perform.plan import Player, perform_judged, plan_performance
+
+    console, quiet, notes, every = shown["console"], shown["quiet"], shown["notes"], shown["every"]
+    report_path, json_path, video, wav, html = (
+        files["report"],
+        files["json"],
+        files["video"],
+        files["wav"],
+        files["html"],
+    )
+    soundfont, phrase_notes = files["soundfont"], options["phrase_notes"]
+    piece = read.piece
+    chosen = dict(keyboard=read.keyboard, hand=read.fingers, **options)
     plan = plan_performance(piece, controller.value, models, **chosen)
     if (
         not quiet
