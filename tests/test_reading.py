@@ -9,7 +9,7 @@ import mido
 import pytest
 from conftest import run
 
-from pianobot.music import midi_io
+from pianobot.music import midi_file
 from pianobot.music.instrument import THUMB, HandSpec, KeyboardSpec
 from pianobot.pianist.reading import ReadPiece, open_song, read_piece
 
@@ -24,7 +24,7 @@ def reads(monkeypatch):
     MidiFile then parses (writing a file makes a MidiFile without one, and is not counted)."""
     seen: list[str] = []
     real = mido.MidiFile
-    read_input = midi_io.read_input
+    read_input = midi_file.read_input
 
     def reading(path, *args, **kwargs):
         seen.append(Path(path).name)
@@ -36,7 +36,7 @@ def reads(monkeypatch):
         assert seen, "a MIDI file parsed without being read"
         return real(*args, **kwargs)
 
-    monkeypatch.setattr(midi_io, "read_input", reading)
+    monkeypatch.setattr(midi_file, "read_input", reading)
     monkeypatch.setattr(mido, "MidiFile", parsed)
     return seen
 
