@@ -207,3 +207,32 @@ class CompositionalController:
             observation["targets"] = self.env.targets(window, previous)
         self.step += 1
         return section.controller.act(observation)
+
+
+def _guard(controller: Controller, kind: type):
+    """The guard of ``kind`` the general policy plays through in ``controller`` (None: none)."""
+    for section in controller.sections if isinstance(controller, CompositionalController) else []:
+        guard = section.controller
+        while isinstance(guard, (HoldGuard, WristGuard)):
+            if isinstance(guard, kind):
+                return guard
+            guard = guard.policy
+    return None
+
+
+def slowed_steps(controller: Controller) -> int | None:
+    """Steps at which the wrist guard slowed the general policy's wrist in ``controller`` (None: no guard played)."""
+    guard = _guard(controller, WristGuard)
+    return guard.capped if guard is not None else None
+
+
+def held_steps(controller: Controller) -> int | None:
+    """Finger-steps the hold guard moved a holding finger in ``controller`` (None: no guard played)."""
+    guard = _guard(controller, HoldGuard)
+    return guard.held if guard is not None else None
+
+
+def wrist_steps(controller: Controller) -> int:
+    """Control steps in which the hold guard moved the wrist in ``controller`` (0: none, or no guard)."""
+    guard = _guard(controller, HoldGuard)
+    return guard.wrist if guard is not None else 0

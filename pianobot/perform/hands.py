@@ -42,7 +42,7 @@ from pianobot.music.instrument import THUMB, HandSpec, KeyboardSpec
 from pianobot.music.metrics import Report
 from pianobot.music.piece import FINGER_NAMES, HANDS, Piece
 from pianobot.music.window import Window
-from pianobot.perform import plan
+from pianobot.perform import compose, plan
 from pianobot.perform.plan import Performance
 from pianobot.perform.rollout import Rollout
 from pianobot.pianist.hands import finger_apart
@@ -416,9 +416,9 @@ def _play_together(
             plans[h],
             rollout,
             seed,
-            plan.slowed_steps(controllers[h]),
-            plan.held_steps(controllers[h]),
-            plan.wrist_steps(controllers[h]),
+            compose.slowed_steps(controllers[h]),
+            compose.held_steps(controllers[h]),
+            compose.wrist_steps(controllers[h]),
         )
         done.append(HandPerformance(h, window, part, start, left_out, performance, changes, own))
     start = env.score_start - offset
