@@ -129,10 +129,10 @@ class Reading:
     keyboard: KeyboardSpec
     hand: HandSpec
     keyboard_named: bool = False
-    """Whether --lowest-note or --keys was given (else :func:`fit_keyboard` may choose the keys,
+    """Whether --lowest-note or --keys was given (else the reading (:func:`~pianobot.pianist.reading.choose_keys`) may choose the keys,
     and both hands' parts go on their players' keys)."""
     hand_named: bool = False
-    """Whether --thumb or --no-thumb was given (else :func:`fit_hand` may give both hands their thumbs)."""
+    """Whether --thumb or --no-thumb was given (else the reading (:func:`~pianobot.pianist.reading.choose_fingers`) may give both hands their thumbs)."""
 
 
 def make_reading(**given) -> Reading:

@@ -340,7 +340,7 @@ def play_both(
     """`play` of a two-hand file (``reading``: a :class:`~pianobot.perform.hands.HandsReading`):
     both hands in one simulation (:func:`~pianobot.perform.hands.play_hands`), one
     track per hand in ``output``, and the report of the whole piece and each hand (``hand``: both
-    hands' fingers, as :func:`~pianobot.cli.options.fit_hand` chose them)."""
+    hands' fingers, as the reading chose them: :func:`~pianobot.pianist.reading.choose_fingers`)."""
     import warnings
 
     from pianobot.cli import display
