@@ -230,10 +230,10 @@ def _check_files(song, output, reading, controller, models, json_path, html, wav
 
 def _check_left_policy(left_policy, song, hands, controller, use_general, models) -> None:
     """--left-policy only where a general policy plays a two-hand file's left hand, and only a trained policy."""
+    from pianobot.agent import store
+
     if left_policy is None:
         return
-        from pianobot.agent import store
-
     why = (
         "plays one hand"
         if hands is None
