@@ -130,20 +130,20 @@ def test_a_policy_that_reads_no_key_count_plays_any_keyboard_of_at_least_its_key
 
 
 def test_train_gives_a_wide_part_its_own_keys_as_play_does(tmp_path):
-    from pianobot.cli.commands.train import _hand_groups
     from pianobot.learn.config import TrainConfig
+    from pianobot.learn.plan import hand_groups
 
     right = [Note(0.6 * i, p, 0.6 * i + 0.5, 80, hand="right") for i, p in enumerate([55, 62, 67, 72, 81])]
     piece = Piece((*right, Note(0.0, 48, 1.0, 70, hand="left")), bpm=100)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", PianobotWarning)
-        parts, _, offered, groups = _hand_groups(
+        parts, _, offered, groups = hand_groups(
             piece, "wide", tmp_path, TrainConfig(), None, 6, KeyboardSpec(), HandSpec(), False
         )
-    keys = {side: config.env.world.keyboard.spec for side, config, _, _ in groups}
+    keys = {g.hand: g.config.env.world.keyboard.spec for g in groups}
     assert keys == {"right": KeyboardSpec(48, 36), "left": KeyboardSpec()}
     assert {side: parts[side][0].keyboard for side in parts} == keys
-    assert all(start is not None and start.name.startswith("task-parts-") for _, _, start, _ in groups)
+    assert all(g.start is not None and g.start.name.startswith("task-parts-") for g in groups)
 
 
 def test_a_note_without_a_hand_is_refused():

@@ -29,7 +29,7 @@ from pianobot.agent.policy import policy_configs
 from pianobot.config import to_dict
 from pianobot.env.piano import EnvConfig
 from pianobot.errors import PianobotError, SettingError
-from pianobot.music.instrument import HandSpec
+from pianobot.music.instrument import HandSpec, KeyboardSpec
 from pianobot.music.tasks import MELODY, PARTS
 
 if TYPE_CHECKING:
@@ -231,3 +231,25 @@ def start_tensors(folder: Path) -> tuple[dict[str, torch.Tensor], dict[str, torc
     folder = Path(folder)
     critic = folder / store.CRITIC_FILE
     return store.load_tensors(folder / store.POLICY_FILE), store.load_tensors(critic) if critic.exists() else None
+
+
+def passed_over(keyboard: KeyboardSpec, hand: HandSpec) -> str:
+    """Why the packaged general policies do not play a piece read for ``keyboard`` and ``hand``, in
+    words naming the settings (the first that differs); '' where one plays it."""
+    packaged = general_candidates(None)
+    if not packaged or any(
+        plays_keyboard(env, sac, keyboard) and env.world.hand.spec == hand
+        for env, sac in (policy_configs(f) for f in packaged)
+    ):
+        return ""
+    world = policy_configs(packaged[0])[0].world
+    hands = list(dict.fromkeys(policy_configs(f)[0].world.hand.spec for f in packaged))
+    if hand not in hands:
+        return (
+            f"the packaged general policies play with fingers {' or '.join(h.describe() for h in hands)}; this "
+            f"piece is read for fingers {hand.describe()} (hand.fingers)"
+        )
+    return (
+        f"the packaged general policies play keyboards of {world.keyboard.spec.count} keys or more; this piece is "
+        f"read for {keyboard.describe()} (keyboard.count)"
+    )

@@ -3,11 +3,9 @@
 from __future__ import annotations
 
 import contextlib
-import dataclasses
 import functools
 import inspect
 import os
-import warnings
 from dataclasses import dataclass
 from enum import StrEnum
 from pathlib import Path
@@ -18,13 +16,13 @@ import typer
 from pianobot.agent.config import ACTORS, DEVICES
 from pianobot.agent.store import DEFAULT_STORE
 from pianobot.env.rewards import REWARDS
-from pianobot.errors import PianobotError, PianobotWarning, SettingError, quote
+from pianobot.errors import PianobotError, SettingError, quote
 from pianobot.learn.config import LEARNERS
 from pianobot.learn.explore import EXPLORATIONS
 from pianobot.music.instrument import PIANO, THUMB, HandSpec, KeyboardSpec
 from pianobot.music.load import HANDS, LoadOptions
 from pianobot.music.phrases import DEFAULT_MAX_NOTES
-from pianobot.music.piece import Piece, parse_pitch, pitch_name
+from pianobot.music.piece import parse_pitch, pitch_name
 from pianobot.music.tasks import FAMILIES
 from pianobot.perform.controllers import CONTROLLERS
 from pianobot.sim.world import CONTROL_MODES
@@ -131,10 +129,10 @@ class Reading:
     keyboard: KeyboardSpec
     hand: HandSpec
     keyboard_named: bool = False
-    """Whether --lowest-note or --keys was given (else :func:`fit_keyboard` may choose the keys,
+    """Whether --lowest-note or --keys was given (else the reading (:func:`~pianobot.pianist.reading.choose_keys`) may choose the keys,
     and both hands' parts go on their players' keys)."""
     hand_named: bool = False
-    """Whether --thumb or --no-thumb was given (else :func:`fit_hand` may give both hands their thumbs)."""
+    """Whether --thumb or --no-thumb was given (else the reading (:func:`~pianobot.pianist.reading.choose_fingers`) may give both hands their thumbs)."""
 
 
 def make_reading(**given) -> Reading:
@@ -254,76 +252,41 @@ def check_html(path: Path | None) -> None:
         raise PianobotError(f"--html {path}: the report is a web page, name it *.html")
 
 
-def fit_keyboard(song: Path, reading: Reading, quiet: bool = False) -> Reading:
-    """``reading`` with the keys a one-hand piece needs where none were named (--lowest-note,
-    --keys): the default keys where its notes lie on them, else its own octaves
-    (:func:`~pianobot.music.instrument.keys_for`), said in one line (not ``quiet``)."""
-    from pianobot.music.instrument import keys_for
-    from pianobot.music.load import load_part
+WORDING = dict(
+    three="--no-thumb plays with three",
+    keys="--lowest-note and --keys name other keys",
+    refinger="--refinger",
+    written="`pianobot finger` writes it to a file",
+)
+"""What undoes a choice the reading makes, in the command line's words (:class:`~pianobot.pianist.reading.Wording`)."""
 
-    if reading.keyboard_named:
-        return reading
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", PianobotWarning)  # (said when the piece is read for playing)
-        piece = load_part(song, reading.options, reading.hand)
-    keys = keys_for(piece, reading.keyboard)
-    if keys == reading.keyboard or quiet:
-        return dataclasses.replace(reading, keyboard=keys)
-    low, high = min(n.pitch for n in piece.notes), max(n.pitch for n in piece.notes)
-    warnings.warn(
-        PianobotWarning(
-            f"{song.name}: its notes ({pitch_name(low)}-{pitch_name(high)}) lie off the default keys "
-            f"{reading.keyboard.describe()}: played on {keys.describe()}, the piece's own octaves "
-            "(--lowest-note and --keys name other keys)"
-        )
+
+def read_file(song, reading: Reading, *, finger: bool = True, quiet: bool = False, both: bool = True, fit: bool = True):
+    """``song`` (a path, or a file already read: :func:`~pianobot.pianist.reading.open_song`) read as the reading options say, once (:func:`~pianobot.pianist.reading.read_piece`):
+    the keyboard and the fingers chosen where --lowest-note/--keys and --thumb/--no-thumb name none,
+    each choice said in one line (not ``quiet``); ``finger``: one hand's part fingered too;
+    ``both``: both hands where the file plays both; ``fit``: a one-hand part wider than the keys refused."""
+    from pianobot.pianist.reading import Wording, read_piece
+
+    return read_piece(
+        song,
+        reading.options,
+        reading.keyboard if reading.keyboard_named else None,
+        reading.hand if reading.hand_named else None,
+        finger=finger,
+        both=both,
+        fit=fit,
+        quiet=quiet,
+        wording=Wording(**WORDING),
     )
-    return dataclasses.replace(reading, keyboard=keys)
 
 
-def read_song(song: Path, options: LoadOptions, keyboard: KeyboardSpec, hand: HandSpec) -> Piece:
-    """Load a piece for this hand and keyboard; finger it with the planner when it has no fingering."""
-    from pianobot.music.instrument import check_playable
-    from pianobot.pianist.fingering import ensure_fingering
-    from pianobot.pianist.reduce import load_for_hand
+def finger_file(read, reading: Reading):
+    """A one-hand reading of :func:`read_file` (``finger=False``) fingered now
+    (:func:`~pianobot.pianist.reading.finger_read`), its lines in the command line's words."""
+    from pianobot.pianist.reading import Wording, finger_read
 
-    piece = load_for_hand(song, options, keyboard, hand)  # with --hand, reduced to what the hand can play
-    check_playable(piece.without_fingering(), keyboard, hand, options.transpose)  # (its hint: the whole shift)
-    piece, plan = ensure_fingering(piece, keyboard, hand, options.refinger)
-    if plan is not None:
-        why = "--refinger" if options.refinger else "it has notes without fingering"
-        warnings.warn(
-            PianobotWarning(
-                f"{song.name}: fingering planned for fingers {', '.join(map(str, hand.fingers))} ({why}): "
-                f"wrist travel {plan.travel * 100:.1f} cm in {plan.moves} moves; `pianobot finger` writes it to a file"
-            )
-        )
-        for problem in plan.problems:
-            warnings.warn(PianobotWarning(problem))
-    check_playable(piece, keyboard, hand)
-    return piece
-
-
-def fit_hand(song: Path, reading: Reading, quiet: bool = False) -> Reading:
-    """``reading`` with both hands' thumbs where neither --thumb nor --no-thumb was given and
-    they keep notes of ``song`` that three fingers leave out
-    (:func:`~pianobot.perform.hands.fingers_for_file`), said in one line (not ``quiet``)."""
-    from pianobot.perform.hands import THUMBS_CHOSEN, fingers_for_file
-
-    if reading.hand_named:
-        return reading
-    hand, counts = fingers_for_file(song, reading.options)
-    if counts is not None and not quiet:
-        said = THUMBS_CHOSEN.format(more=counts[1], given=counts[0])
-        warnings.warn(PianobotWarning(f"{song.name}: {said} (--no-thumb plays with three)"))
-    return dataclasses.replace(reading, hand=hand)
-
-
-def both_hands(song: Path, reading: Reading):
-    """Both hands of ``song`` where `play` plays both (a :class:`~pianobot.perform.hands.HandsReading`),
-    else None: the reading options read one hand's part, as before two hands."""
-    from pianobot.perform.hands import two_hands
-
-    return two_hands(song, reading.options, reading.hand, reading.keyboard)
+    return finger_read(read, reading.options, Wording(**WORDING))
 
 
 def refuse_training_into(start: Path | None, jobs) -> None:

@@ -27,7 +27,7 @@ from pianobot.music.instrument import check_playable
 from pianobot.music.load import LoadOptions
 from pianobot.music.phrases import Phrase
 from pianobot.music.tasks import GIVEN_SHARE, PARTS, VERSIONS
-from pianobot.perform.hands import prepare_part, two_hands
+from pianobot.pianist.reading import prepare_part, two_hands
 
 
 @dataclass

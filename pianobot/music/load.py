@@ -87,7 +87,7 @@ def thin_chords(piece: Piece, fingers: int) -> tuple[Piece, int]:
     return Piece(tuple(out), bpm=piece.bpm), dropped
 
 
-def _read_midi(path: Path, options: LoadOptions, bpm: float | None = None) -> Piece:
+def _read_midi(path: Path | midi_io.MidiSource, options: LoadOptions, bpm: float | None = None) -> Piece:
     grid = midi_io.parse_grid(options.quantize) if options.quantize else None
     if options.hand is None:
         return midi_io.read_midi(path, track=options.track, bpm=bpm, grid=grid)
@@ -98,7 +98,7 @@ def _read_midi(path: Path, options: LoadOptions, bpm: float | None = None) -> Pi
     return _read_hand(path, options, bpm, grid).with_hands(None)  # one hand's part, read as before hands
 
 
-def _read_hand(path: Path, options: LoadOptions, bpm: float | None, grid: float | None) -> Piece:
+def _read_hand(path: Path | midi_io.MidiSource, options: LoadOptions, bpm: float | None, grid: float | None) -> Piece:
     """``options.hand``'s part: the tracks named for it, else the higher or lower of two tracks, else
     the notes on its side of ``options.split``."""
     tracks = midi_io.describe_tracks(path)
@@ -127,16 +127,17 @@ def _read_hand(path: Path, options: LoadOptions, bpm: float | None, grid: float 
         notes = [n for n in piece.notes if n.pitch < options.split]
     if not notes:
         raise SettingError(
-            f"{path.name} has no notes {'at or above' if options.hand == 'right' else 'below'} "
+            f"{midi_io.source_path(path).name} has no notes {'at or above' if options.hand == 'right' else 'below'} "
             f"{pitch_name(options.split)} for the {options.hand} hand: move the split with load.split",
             "load.split",
         )
     return Piece(tuple(notes), bpm=piece.bpm)
 
 
-def load_piece(path: str | Path, options: LoadOptions = LoadOptions()) -> Piece:
-    """Read a .mid file (or a PIG .txt file) with its fingering, then re-time and transpose it."""
-    path = Path(path)
+def load_piece(path: str | Path | midi_io.MidiSource, options: LoadOptions = LoadOptions()) -> Piece:
+    """Read a .mid file (or a PIG .txt file) with its fingering, then re-time and transpose it
+    (``path`` may be a file already read: :func:`~pianobot.music.midi_io.open_midi`)."""
+    source, path = path, midi_io.source_path(path)
     if path.suffix.lower() == ".txt":
         if options.tempo is not None:
             raise SettingError(
@@ -157,9 +158,9 @@ def load_piece(path: str | Path, options: LoadOptions = LoadOptions()) -> Piece:
             raise SettingError(f"load.hand {quote(options.hand)}: choose right or left", "load.hand")
         piece = pig.read_pig(path, hand=options.hand or "right")  # (its channel: 0 right, 1 left)
     elif options.tempo is not None and options.fingering is None and not pig.sidecar_for(path).exists():
-        piece = _read_midi(path, options, bpm=options.tempo)  # the file's tempo map is never needed
+        piece = _read_midi(source, options, bpm=options.tempo)  # the file's tempo map is never needed
     else:
-        piece = _read_midi(path, options)
+        piece = _read_midi(source, options)
         sidecar = options.fingering or pig.sidecar_for(path)
         if options.fingering is not None or sidecar.exists():
             embedded = any(n.finger is not None for n in piece.notes)
@@ -173,14 +174,14 @@ def load_piece(path: str | Path, options: LoadOptions = LoadOptions()) -> Piece:
             fingers = [n.finger for n in piece.notes]
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore", PianobotWarning)  # already reported by the first read
-                retimed = _read_midi(path, options, bpm=options.tempo)
+                retimed = _read_midi(source, options, bpm=options.tempo)
             piece = retimed.with_fingers(fingers)
     if not piece.notes:
         raise PianobotError(f"{path} has no notes: give a MIDI file with at least one note")
     return piece.transpose(options.transpose)
 
 
-def load_part(path: str | Path, options: LoadOptions, hand: HandSpec) -> Piece:
+def load_part(path: str | Path | midi_io.MidiSource, options: LoadOptions, hand: HandSpec) -> Piece:
     """:func:`load_piece`; with ``options.hand``, also thin chords to what ``hand`` can hold
     (:func:`pianobot.pianist.reduce.load_for_hand` goes on to what it can reach in time); without
     it, a note lasting at most :data:`LEGATO_OVERLAP` into a later onset ends there (a player's
@@ -216,7 +217,7 @@ def thin_hand(piece: Piece, name: str, hand: HandSpec, kept: str = "highest") ->
     return piece
 
 
-def load_hands(path: str | Path, options: LoadOptions = LoadOptions()) -> Piece:
+def load_hands(path: str | Path | midi_io.MidiSource, options: LoadOptions = LoadOptions()) -> Piece:
     """A two-hand piece (a .mid file, or a PIG .txt file with both hands' notes), each note with
     the hand its track's name says, else the channel of its note in the PIG fingering sidecar (or
     the PIG file's), None where nothing says (the fingering planner then gives it one:
@@ -227,7 +228,7 @@ def load_hands(path: str | Path, options: LoadOptions = LoadOptions()) -> Piece:
     hands share one rail) are not taken from the file, and the planner gives every note a hand;
     three or more tracks of notes that are not all named for hands are read as one part whose
     notes the planner gives to the hands."""
-    path = Path(path)
+    source, path = path, midi_io.source_path(path)
     if options.hand is not None:
         raise SettingError(
             "load.hand takes one hand's part; a two-hand reading takes both: drop load.hand", "load.hand"
@@ -244,15 +245,15 @@ def load_hands(path: str | Path, options: LoadOptions = LoadOptions()) -> Piece:
             raise SettingError("load.track needs a MIDI file: a PIG file's channels are its hands", "load.track")
         piece = pig.read_pig(path, hand=None).transpose(options.transpose)
     else:
-        piece = load_piece(path, options)
+        piece = load_piece(source, options)
         sidecar = options.fingering or pig.sidecar_for(path)
         if any(n.hand is None for n in piece.notes) and (options.fingering is not None or sidecar.exists()):
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore", PianobotWarning)  # said by the first read
                 # the notes as the sidecar lists them (the file's times, no shift), in the same order
-                written = pig.apply_fingering(_read_midi(path, replace(options, tempo=None)), sidecar, hands=True)
+                written = pig.apply_fingering(_read_midi(source, replace(options, tempo=None)), sidecar, hands=True)
             piece = piece.with_hands([n.hand or w.hand for n, w in zip(piece.notes, written.notes)])
-        tracks = [t for t in midi_io.describe_tracks(path) if t.notes]
+        tracks = [t for t in midi_io.describe_tracks(source) if t.notes]
         unnamed = [t for t in tracks if midi_io.track_hand(t.name) is None]
         if options.track is None and len(tracks) >= 3 and unnamed and any(n.hand is None for n in piece.notes):
             warnings.warn(

@@ -19,7 +19,6 @@ so that one beat lasts 60/bpm seconds.
 from __future__ import annotations
 
 import bisect
-import io
 import re
 import warnings
 from collections import defaultdict
@@ -29,12 +28,17 @@ from pathlib import Path
 import mido
 
 from pianobot.errors import PianobotError, PianobotWarning, SettingError, quote
-from pianobot.files import atomic_write, read_input
+from pianobot.music.midi_file import (  # noqa: F401 (by their old address too)
+    MAX_FILE_BYTES,
+    MidiSource,
+    open_midi,
+    opened,
+    source_path,
+)
 from pianobot.music.piece import HANDS, MAX_SECONDS, Note, Piece, pitch_name
 
 _FINGER_TOKEN = r"(?:[0-9](?:_[0-9])?|-)"
 _FINGER_TEXT = re.compile(rf"^\s*{_FINGER_TOKEN}(?:[\s,]+{_FINGER_TOKEN})*\s*$")
-MAX_FILE_BYTES = 50_000_000
 HAND_NAMES = {
     "right": re.compile(r"right|\brh\b|\br\.h\.|treble|upper|melody", re.IGNORECASE),
     "left": re.compile(r"left|\blh\b|\bl\.h\.|bass|lower|accomp", re.IGNORECASE),
@@ -88,63 +92,6 @@ def parse_finger_text(text: str) -> list[int | None] | None:
 def finger_text(fingers: list[int | None]) -> str:
     """The inverse of :func:`parse_finger_text`."""
     return " ".join("-" if f is None else str(f) for f in fingers)
-
-
-def _track_chunks(data: bytes) -> tuple[int, bool]:
-    """How many complete track chunks ('MTrk' and its whole length) follow the header, and
-    whether the data ends inside a chunk (a cut file)."""
-    pos, count = 8 + int.from_bytes(data[4:8], "big"), 0
-    while pos + 8 <= len(data):
-        size = int.from_bytes(data[pos + 4 : pos + 8], "big")
-        if pos + 8 + size > len(data):
-            return count, True
-        count += data[pos : pos + 4] == b"MTrk"
-        pos += 8 + size
-    return count, pos < len(data)
-
-
-def _load(path: Path) -> mido.MidiFile:
-    data = read_input(path, limit=MAX_FILE_BYTES, kind=".mid file")
-    if not data.startswith(b"MThd"):
-        raise PianobotError(f"{path} is not a MIDI file (it does not start with 'MThd'): give a standard .mid file")
-    if len(data) < 14:
-        raise PianobotError(
-            f"{path} is not a readable MIDI file (its header is cut short): it may be truncated or corrupt; re-export it"
-        )
-    division = int.from_bytes(data[12:14], "big")
-    if division & 0x8000:
-        raise PianobotError(f"{path} uses SMPTE time division, which pianobot does not read: re-export it with beats")
-    if division == 0:
-        raise PianobotError(f"{path} says a beat has 0 ticks (its header is corrupt): re-export it")
-    declared, (held, cut) = int.from_bytes(data[10:12], "big"), _track_chunks(data)
-    if cut and declared > held:
-        raise PianobotError(
-            f"{path} is not a readable MIDI file (it ends inside track {held}): it may be truncated or corrupt; "
-            "re-export it"
-        )
-    if declared > held:
-        raise PianobotError(
-            f"{path} is truncated or its header does not match its tracks: the header says {declared} track(s), "
-            f"the file holds {held} complete one(s); re-export it"
-        )
-    if declared < held:
-        warnings.warn(
-            PianobotWarning(
-                f"{path.name}: the header says {declared} track(s) but the file holds {held}; read {declared}"
-            )
-        )
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            midi = mido.MidiFile(file=io.BytesIO(data))
-    except Exception as e:  # mido raises many types on corrupt data
-        reason = str(e) or type(e).__name__
-        raise PianobotError(
-            f"{path} is not a readable MIDI file ({reason}): it may be truncated or corrupt; re-export it"
-        ) from None
-    if midi.type == 2:
-        raise PianobotError(f"{path} is a type 2 MIDI file (independent patterns): re-export it as type 0 or 1")
-    return midi
 
 
 def _absolute(track: mido.MidiTrack) -> list[tuple[int, mido.Message]]:
@@ -246,10 +193,10 @@ def parse_grid(text: str) -> float:
     return top / bottom
 
 
-def selected_tracks(path: str | Path, track: str | int | None) -> list[int]:
+def selected_tracks(path: str | Path | MidiSource, track: str | int | None) -> list[int]:
     """The tracks ``track`` names in the file at ``path`` (as :func:`read_midi` reads them), by index."""
-    path = Path(path)
-    return _select_tracks(_load(path), track, path)
+    path, midi = opened(path)
+    return _select_tracks(midi, track, path)
 
 
 def _select_tracks(midi: mido.MidiFile, track: str | int | None, path: Path) -> list[int]:
@@ -318,7 +265,7 @@ def _track_notes(
 
 
 def read_midi(
-    path: str | Path,
+    path: str | Path | MidiSource,
     *,
     track: str | int | None = None,
     bpm: float | None = None,
@@ -333,8 +280,7 @@ def read_midi(
     nearest grid line, in the file's beats, for recordings of human players; a note lasts at
     least one grid step. Sustain-pedal events are ignored: a note sounds while its key is down.
     """
-    path = Path(path)
-    midi = _load(path)
+    path, midi = opened(path)
     if bpm is not None:
         if not 10 <= bpm <= 1000:
             raise SettingError(f"load.tempo {bpm}: choose a tempo between 10 and 1000 bpm", "load.tempo")
@@ -472,65 +418,10 @@ def _resolve_overlaps(notes: list[Note]) -> list[Note]:
     return [n for group in by_pitch.values() for n in group]
 
 
-def _write_resolution(bpm: float) -> tuple[int, int]:
-    """(tempo in microseconds per beat, ticks per beat) so that one tick is exactly 1 ms."""
-    tempo = max(1000, round(60e6 / bpm / 1000) * 1000)
-    return tempo, tempo // 1000
-
-
-def _track(part: Piece, name: str, tempo: int | None) -> mido.MidiTrack:
-    """One track of ``part``'s notes with fingering lyrics, named ``name``, with the tempo if given."""
-    events: list[tuple[int, int, mido.Message | mido.MetaMessage]] = []
-    for chord in part.chords():
-        tick = round(chord[0].onset * 1000)
-        if any(n.finger is not None for n in chord):
-            text = finger_text([n.finger for n in sorted(chord, key=lambda n: n.pitch)])
-            events.append((tick, 1, mido.MetaMessage("lyrics", text=text)))
-        for note in chord:
-            events.append((tick, 2, mido.Message("note_on", note=note.pitch, velocity=note.velocity)))
-    for note in part.notes:
-        events.append((round(note.offset * 1000), 0, mido.Message("note_off", note=note.pitch, velocity=0)))
-    events.sort(key=lambda e: (e[0], e[1]))
-    track = mido.MidiTrack()
-    track.append(mido.MetaMessage("track_name", name=name))
-    if tempo is not None:
-        track.append(mido.MetaMessage("set_tempo", tempo=tempo))
-    last = 0
-    for tick, _, msg in events:
-        track.append(msg.copy(time=tick - last))
-        last = tick
-    track.append(mido.MetaMessage("end_of_track", time=0))
-    return track
-
-
-def midi_bytes(piece: Piece, *, name: str = "pianobot") -> bytes:
-    """The piece as a MIDI file with 1 ms ticks and fingering lyrics: type 0 (one track named
-    ``name``) when no note has a hand, else type 1 with one track per hand ("Right Hand", "Left
-    Hand", then "Unassigned" for notes without a hand), the first carrying the tempo."""
-    tempo, tpb = _write_resolution(piece.bpm)
-    if piece.hands:
-        parts = [(TRACK_NAMES[hand], piece.part(hand)) for hand in piece.hands]
-        parts += [(UNASSIGNED_TRACK, piece.part(None))] if any(n.hand is None for n in piece.notes) else []
-    else:
-        parts = [(name, piece)]
-    # any name: a file name may be '音.mid'
-    midi = mido.MidiFile(type=1 if piece.hands else 0, ticks_per_beat=tpb, charset="utf-8")
-    for i, (track_name, part) in enumerate(parts):
-        midi.tracks.append(_track(part, track_name, tempo if i == 0 else None))
-    buffer = io.BytesIO()
-    midi.save(file=buffer)
-    return buffer.getvalue()
-
-
-def write_midi(piece: Piece, path: str | Path, *, name: str = "pianobot") -> Path:
-    """Write ``piece`` to ``path`` atomically (see :func:`midi_bytes`)."""
-    return atomic_write(path, midi_bytes(piece, name=name))
-
-
-def tempi(path: str | Path) -> list[float]:
+def tempi(path: str | Path | MidiSource) -> list[float]:
     """The tempos of a MIDI file in beats per minute, in the order they take effect (120 until its
     first set_tempo, where that is after the start), each change to another tempo once."""
-    midi = _load(Path(path))
+    _, midi = opened(path)
     changes = _tempo_changes(midi)
     changes = [
         c for i, c in enumerate(changes) if i + 1 == len(changes) or changes[i + 1][0] != c[0]
@@ -543,6 +434,15 @@ def tempi(path: str | Path) -> list[float]:
     return found
 
 
-def describe_tracks(path: str | Path) -> list[TrackInfo]:
+def describe_tracks(path: str | Path | MidiSource) -> list[TrackInfo]:
     """Tracks of a MIDI file, for `pianobot inspect`."""
-    return list_tracks(_load(Path(path)))
+    return list_tracks(opened(path)[1])
+
+
+def __getattr__(name: str):
+    """The writers (:func:`~pianobot.music.midi_out.write_midi`, ``midi_bytes``) by their old address."""
+    if name in ("write_midi", "midi_bytes"):
+        from pianobot.music import midi_out
+
+        return getattr(midi_out, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

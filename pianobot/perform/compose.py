@@ -27,6 +27,7 @@ from __future__ import annotations
 import bisect
 import math
 from dataclasses import dataclass
+from enum import Enum
 from pathlib import Path
 
 import numpy as np
@@ -125,6 +126,15 @@ def trained_split(models: Path, piece: Piece, phrase_notes: int | None) -> list[
     return split_phrases(piece, DEFAULT_MAX_NOTES)
 
 
+class Player(str, Enum):
+    """Who plays a stretch of a performance (the plan, :mod:`pianobot.perform.plan`, decides)."""
+
+    OWN = "own policy"
+    GENERAL = "general policy"
+    SCRIPTED = "scripted pianist"
+    RANDOM = "random actions"
+
+
 class CompositionalController:
     """Acts with the controller of the section the current step falls in. ``stretches`` say who
     plays what (:func:`pianobot.perform.plan.assign`): a phrase's own policy, the general policy
@@ -134,8 +144,6 @@ class CompositionalController:
     guard outside)."""
 
     def __init__(self, env: PianoEnv, stretches, guard: bool = False, hold: bool = False):
-        from pianobot.perform.plan import Player  # (the plan module builds on this one)
-
         spec = env.spec_score
         lead = env.lead_steps
         grace = math.ceil(DEFAULT_ONSET_TOLERANCE * spec.control_hz - 1e-9)  # steps a strike may come late
@@ -199,3 +207,32 @@ class CompositionalController:
             observation["targets"] = self.env.targets(window, previous)
         self.step += 1
         return section.controller.act(observation)
+
+
+def _guard(controller: Controller, kind: type):
+    """The guard of ``kind`` the general policy plays through in ``controller`` (None: none)."""
+    for section in controller.sections if isinstance(controller, CompositionalController) else []:
+        guard = section.controller
+        while isinstance(guard, (HoldGuard, WristGuard)):
+            if isinstance(guard, kind):
+                return guard
+            guard = guard.policy
+    return None
+
+
+def slowed_steps(controller: Controller) -> int | None:
+    """Steps at which the wrist guard slowed the general policy's wrist in ``controller`` (None: no guard played)."""
+    guard = _guard(controller, WristGuard)
+    return guard.capped if guard is not None else None
+
+
+def held_steps(controller: Controller) -> int | None:
+    """Finger-steps the hold guard moved a holding finger in ``controller`` (None: no guard played)."""
+    guard = _guard(controller, HoldGuard)
+    return guard.held if guard is not None else None
+
+
+def wrist_steps(controller: Controller) -> int:
+    """Control steps in which the hold guard moved the wrist in ``controller`` (0: none, or no guard)."""
+    guard = _guard(controller, HoldGuard)
+    return guard.wrist if guard is not None else 0

@@ -37,8 +37,11 @@ training evaluated it; a general policy that drags keys while the hand shifts pl
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 
+from pianobot.agent import store
 from pianobot.env.piano import EnvConfig, actuated_indices, finger_counts
 from pianobot.music.tensor import FINGER
 from pianobot.perform.rollout import Controller
@@ -154,3 +157,9 @@ class WristGuard:
             action[-1] = np.sign(action[-1]) * self.limit
             self.capped += 1
         return action
+
+
+def guarded_family(general: Path | None) -> bool:
+    """Whether the general policy in ``general`` was trained on a task family whose policies play
+    through the hold guard unless told otherwise (:data:`~pianobot.perform.guard.HOLD_GUARD_FAMILIES`)."""
+    return general is not None and store.read_manifest(Path(general)).get("target") in HOLD_GUARD_FAMILIES

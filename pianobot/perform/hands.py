@@ -23,9 +23,8 @@ the left; their links collide), a key struck by one sounding for both. Where tha
 physics) each hand plays in a simulation of its own, said in one warning line, and what the
 two keyboards sounded is merged.
 
-Reading: :func:`two_hands` decides, as ``pianobot play`` does, whether a file plays both
-hands (tracks named for the hands, or notes one hand cannot play that the fingering planner gives
-to both) or one, as before two hands; :func:`play` (``pianobot.play``) plays a piece with both
+Reading a file (whether it plays both hands, each hand's part, with which fingers) is
+:mod:`pianobot.pianist.reading`'s; :func:`play` (``pianobot.play``) plays a piece with both
 hands with :func:`play_hands` and any other piece as one hand.
 """
 
@@ -38,18 +37,28 @@ from typing import Callable
 
 from pianobot.agent.general import left_hand_policy
 from pianobot.errors import PianobotError, PianobotWarning, SettingError
-from pianobot.music import midi_io
 from pianobot.music.hand_scores import HandsReport, compare_hands
-from pianobot.music.instrument import THUMB, HandSpec, KeyboardSpec, check_playable, suggest_transpose
-from pianobot.music.load import LoadOptions, end_legato, load_hands, load_piece, thin_hand
+from pianobot.music.instrument import THUMB, HandSpec, KeyboardSpec
 from pianobot.music.metrics import Report
-from pianobot.music.piece import FINGER_NAMES, HANDS, Note, Piece, pitch_name
-from pianobot.music.window import Window, window_for
-from pianobot.perform import plan
+from pianobot.music.piece import FINGER_NAMES, HANDS, Piece
+from pianobot.music.window import Window
+from pianobot.perform import compose, plan
 from pianobot.perform.plan import Performance
 from pianobot.perform.rollout import Rollout
-from pianobot.pianist.fingering import ensure_fingering
-from pianobot.pianist.hands import finger_apart, load_two_hands, reduce_hand
+from pianobot.pianist.hands import finger_apart
+from pianobot.pianist.reading import (  # noqa: F401 (the reading, pianist/reading.py's: these names kept here too)
+    THUMBS_CHOSEN,
+    HandsReading,
+    _warn_again,
+    fingers_for_file,
+    given_notes,
+    names_hands,
+    one_hand_refusal,
+    prepare_part,
+    read_hands,
+    thumbs_keep_more,
+    two_hands,
+)
 
 APART = "each hand in a simulation of its own"
 """How both hands play with ``together=False``: said wherever such a performance is reported."""
@@ -59,151 +68,6 @@ AGAINST = "figures against the piece as read from the file (notes left out or re
 """What the figures of both hands are against: the file's notes, but for a chord of more notes than both
 hands have fingers, thinned as the file is read (said in its own line)."""
 """What a two-hand performance's figures are measured against."""
-
-
-@dataclass(frozen=True)
-class HandsReading:
-    """A two-hand file as read for both hands: every note with its hand, and how many of each
-    hand's notes the file named (its tracks' names, or a PIG file's channels) rather than the
-    fingering planner (:func:`~pianobot.pianist.hands.assign_hands`)."""
-
-    piece: Piece
-    named: dict[str, int]
-    source: str = "its track"
-    """What named a note's hand in the file: 'its track', 'the PIG channel'."""
-
-    def to_dict(self, hand: str) -> dict:
-        """``hand``'s part: how many notes, its range, how many the file named and the planner assigned."""
-        part = self.piece.part(hand)
-        named = min(self.named.get(hand, 0), len(part))  # (a note the reading thinned away may have been named)
-        return {
-            "notes": len(part),
-            "range": [pitch_name(min(n.pitch for n in part.notes)), pitch_name(max(n.pitch for n in part.notes))],
-            "named_by_file": named,
-            "assigned_by_planner": len(part) - named,
-        }
-
-    def describe(self, hand: str) -> str:
-        """One line on ``hand``'s part: 'right hand: 64 notes, C4-D5, named by its track'."""
-        part = self.to_dict(hand)
-        named, assigned = part["named_by_file"], part["assigned_by_planner"]
-        if assigned == 0:
-            who = f"named by {self.source}"
-        elif named == 0:
-            who = "assigned by the fingering planner"
-        else:
-            who = f"{named} named by {self.source}, {assigned} assigned by the fingering planner"
-        notes = f"{part['notes']} note{'s' * (part['notes'] != 1)}"
-        return f"{hand} hand: {notes}, {'-'.join(part['range'])}, {who}"
-
-
-def read_hands(path: str | Path, options: LoadOptions = LoadOptions(), spec: HandSpec = HandSpec()) -> HandsReading:
-    """Both hands of the file at ``path``: :func:`~pianobot.pianist.hands.load_two_hands` (its
-    warnings and its one-line refusals), with what the file named."""
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", PianobotWarning)  # said by load_two_hands
-        given = load_hands(path, options)
-    piece = load_two_hands(path, options, spec)
-    named = {hand: sum(n.hand == hand for n in given.notes) for hand in HANDS}
-    return HandsReading(piece, named, "the PIG channel" if Path(path).suffix.lower() == ".txt" else "its track")
-
-
-def names_hands(path: str | Path, track: str | None = None) -> bool:
-    """Whether the file says which hand plays its notes: a track named for a hand (of those
-    ``track`` names, :func:`~pianobot.music.midi_io.read_midi`'s; None: all), or a PIG file."""
-    path = Path(path)
-    if path.suffix.lower() == ".txt":
-        return True
-    read = None if track is None else set(midi_io.selected_tracks(path, track))
-    return any(
-        t.notes and midi_io.track_hand(t.name) and (read is None or t.index in read)
-        for t in midi_io.describe_tracks(path)
-    )
-
-
-def two_hands(
-    path: str | Path, options: LoadOptions, spec: HandSpec = HandSpec(), keyboard: KeyboardSpec = KeyboardSpec()
-) -> HandsReading | None:
-    """Both hands of the file at ``path`` where ``pianobot play`` plays both, else None: read it
-    as one hand, as before two hands.
-
-    Both hands: without ``options.hand``, and with ``options.track`` naming two or more tracks of
-    notes or none (then only those tracks are read), a file whose tracks are named for
-    hands (the notes of others given hands by the fingering planner), or a PIG file, with notes
-    for both hands; or a file that cannot be one hand's, whose notes the fingering planner gives
-    to both hands: its notes span more keys than one hand's ``keyboard`` has, or, unfingered,
-    one hand's reading refuses it (notes off ``keyboard``, more at once than the hand's fingers,
-    a chord or a move it cannot reach). Where the planner gives every note to one hand, or both
-    hands' reading refuses a file that one hand's refuses too, one hand's reading says why. The
-    reading's warnings are said only where both hands play (or where it refuses the file: notes
-    beyond the piano)."""
-    path = Path(path)
-    if options.hand is not None:
-        return None
-    if options.track is not None:
-        if path.suffix.lower() == ".txt":
-            return None  # (one hand's reading refuses --track on a PIG file)
-        read = set(midi_io.selected_tracks(path, options.track))
-        if len([t for t in midi_io.describe_tracks(path) if t.notes and t.index in read]) < 2:
-            return None  # (one track: one hand's part, as before two hands)
-    if path.suffix.lower() == ".txt" and (options.tempo or options.fingering or options.quantize):
-        return None  # (one hand's reading refuses them in its own words)
-    one_hand_refuses = ""
-    if not names_hands(path, options.track):
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")  # said when the piece is read
-            piece = end_legato(load_piece(path, options))  # (as one hand's reading reads it)
-        pitches = [n.pitch for n in piece.notes]
-        if max(pitches) - min(pitches) < keyboard.count:
-            if any(n.finger is not None for n in piece.notes):
-                return None  # (a fingered file is one hand's: its fingers say so)
-            one_hand_refuses = one_hand_refusal(piece, spec, keyboard, options.refinger)
-            if not one_hand_refuses:
-                return None
-    try:
-        with warnings.catch_warnings(record=True) as caught:
-            warnings.simplefilter("always")
-            hands = read_hands(path, options, spec)
-    except PianobotError:
-        if one_hand_refuses:
-            return None  # one hand's reading says why, in its own words
-        _warn_again(caught)
-        raise
-    if len(hands.piece.hands) < 2:
-        return None
-    _warn_again(caught)
-    if one_hand_refuses:
-        warnings.warn(
-            PianobotWarning(
-                f"{path.name}: one hand cannot play it ({one_hand_refuses}): its notes are given to both hands"
-            )
-        )
-    return hands
-
-
-def one_hand_refusal(piece: Piece, spec: HandSpec, keyboard: KeyboardSpec, refinger: bool = False) -> str:
-    """Why one hand with ``spec``'s fingers cannot play ``piece`` (unfingered, spanning fewer keys
-    than ``keyboard`` has), in words; '' where it can. It is asked on ``keyboard`` moved by the
-    transposition one hand's reading would suggest (:func:`~pianobot.music.instrument.suggest_transpose`):
-    notes a transposition brings onto the keys are no reason for two hands. A single line of notes is
-    always one hand's (the fingering planner only slows what is fast); chords and held notes are
-    asked of the planner."""
-    shift = suggest_transpose(piece, keyboard) or 0  # (0 where the notes fit: the plan is then reused)
-    under = KeyboardSpec(max(0, min(keyboard.lowest - shift, 128 - keyboard.count)), keyboard.count)
-    try:
-        check_playable(piece, under, spec)  # (more notes at once than fingers)
-        if piece.max_polyphony()[0] > 1:
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore")  # (one hand's reading says them, where one hand plays)
-                ensure_fingering(piece, under, spec, refinger)
-    except PianobotError as refused:
-        return str(refused).split(": ")[0]
-    return ""
-
-
-def _warn_again(caught: list) -> None:
-    for warning in caught:
-        warnings.warn(warning.message)
 
 
 @dataclass(frozen=True)
@@ -333,104 +197,6 @@ class HandsPerformance:
             "hands": hands,
             **whole,
         }
-
-
-def prepare_part(
-    piece: Piece,
-    hand: str,
-    keyboard: KeyboardSpec | None,
-    fingers: HandSpec,
-    start: float | None = None,
-    grow: bool = False,
-) -> tuple[Window, Piece, float, int]:
-    """``hand``'s part of ``piece`` as the simulated hand is given it: (window, part, start, notes
-    left out), the part moved ``start`` seconds earlier (default: to its first note); ``grow``: a
-    part wider than ``keyboard`` is given its own range instead (:func:`~pianobot.music.window.window_for`).
-    Each kind of change is one :class:`PianobotWarning`, worded for the written part."""
-    window, reduced, start, left_out = _reduced_part(piece, hand, keyboard, fingers, start, grow)
-    fingered, _ = ensure_fingering(reduced, window.keyboard, fingers, refinger=True)
-    return window, fingered, start, left_out
-
-
-def _reduced_part(
-    piece: Piece, hand: str, keyboard: KeyboardSpec | None, fingers: HandSpec, start: float | None, grow: bool
-) -> tuple[Window, Piece, float, int]:
-    """:func:`prepare_part`'s part before it is fingered."""
-    part = piece.part(hand)
-    window = window_for(part, hand, keyboard, grow)
-    inside = [n for n in part.notes if window.inward(n.pitch) in window.keyboard]
-    left_out = len(part) - len(inside)
-    if left_out:
-        warnings.warn(
-            PianobotWarning(
-                f"the {hand} hand's part spans more than the {window.keyboard.count} keys its player knows: "
-                f"left out {left_out} note(s) outside them"
-            )
-        )
-    if not inside:
-        raise PianobotError(f"none of the {hand} hand's notes fits the keyboard its player knows")
-    moved = Piece(tuple(Note(n.onset, window.inward(n.pitch), n.offset, n.velocity) for n in inside), bpm=piece.bpm)
-    start = moved.notes[0].onset if start is None else start
-    # (the simulated hand is a right hand: its top notes are a left hand's lowest)
-    thinned = thin_hand(moved.shift(-start), hand, fingers, "lowest" if hand == "left" else "highest")
-    return window, reduce_hand(thinned, window.keyboard, fingers, hand), start, left_out
-
-
-def given_notes(piece: Piece, fingers: HandSpec, keyboard: KeyboardSpec | None = None) -> int | None:
-    """How many of ``piece``'s notes (each with its hand) both hands are given with ``fingers``,
-    each part as :func:`prepare_part` gives it: on ``keyboard``, default the general policy's 24
-    keys or a wider part's own octaves. None where a hand's part is refused. Nothing is said."""
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", PianobotWarning)
-        try:
-            return sum(
-                len(_reduced_part(piece, h, keyboard or KeyboardSpec(), fingers, None, keyboard is None)[1])
-                for h in piece.hands
-            )
-        except PianobotError:
-            return None
-
-
-def thumbs_keep_more(
-    three: Piece, thumbs: Piece | None = None, keyboard: KeyboardSpec | None = None
-) -> tuple[int, int] | None:
-    """(notes both hands are given with three fingers, with their thumbs too), where the thumbs
-    keep more of them; else None. ``three``: the piece with every note's hand as read for three
-    fingers; ``thumbs``: as read for hands with their thumbs (default the same); ``keyboard``: as
-    :func:`given_notes`'. This is how both hands choose their fingers where none are named: the
-    thumbs play wherever they keep notes that three fingers leave out (a chord wider than three
-    fingers reach, more notes at once, a passage too fast to play without one)."""
-    thumbs = three if thumbs is None else thumbs
-    given = given_notes(three, HandSpec(), keyboard)
-    if given is None or given >= len(thumbs):  # (the thumbs' reading may keep notes of a chord three fingers' thins)
-        return None
-    more = given_notes(thumbs, THUMB, keyboard)
-    return (given, more) if more is not None and more > given else None
-
-
-def fingers_for_file(path: str | Path, options: LoadOptions) -> tuple[HandSpec, tuple[int, int] | None]:
-    """Both hands' fingers for the file at ``path`` where none are named, as ``pianobot play``
-    chooses them: (:data:`~pianobot.music.instrument.THUMB`, (notes given with three fingers, with
-    thumbs)) where the file plays both hands read either way (:func:`two_hands`) and
-    :func:`thumbs_keep_more` says so, else (three fingers, None). Always on the default keys and
-    each player's own, whatever keys a command names, so that ``pianobot score``, which names
-    none, reads the hands as ``play`` did. A file the reading refuses keeps three fingers: that
-    reading says why. Nothing is said."""
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", PianobotWarning)
-        try:
-            three = two_hands(path, options, HandSpec())
-            thumbs = None if three is None else two_hands(path, options, THUMB)
-        except PianobotError:
-            return HandSpec(), None
-    if three is None or thumbs is None:
-        return HandSpec(), None
-    counts = thumbs_keep_more(three.piece, thumbs.piece)
-    return (HandSpec(), None) if counts is None else (THUMB, counts)
-
-
-THUMBS_CHOSEN = "both hands play with their thumbs too: they are given {more} of the notes, three fingers {given}"
-"""The line said where :func:`thumbs_keep_more` gives both hands their thumbs (with how to choose three)."""
 
 
 def play_hands(
@@ -650,9 +416,9 @@ def _play_together(
             plans[h],
             rollout,
             seed,
-            plan.slowed_steps(controllers[h]),
-            plan.held_steps(controllers[h]),
-            plan.wrist_steps(controllers[h]),
+            compose.slowed_steps(controllers[h]),
+            compose.held_steps(controllers[h]),
+            compose.wrist_steps(controllers[h]),
         )
         done.append(HandPerformance(h, window, part, start, left_out, performance, changes, own))
     start = env.score_start - offset

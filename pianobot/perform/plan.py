@@ -23,12 +23,19 @@ from __future__ import annotations
 import contextlib
 import warnings
 from dataclasses import dataclass, replace
-from enum import Enum
 from pathlib import Path
 from typing import Callable
 
 from pianobot.agent import store
-from pianobot.agent.general import PACKAGED, describe, find_general, general_candidates, on_keyboard, plays_keyboard
+from pianobot.agent.general import (
+    PACKAGED,
+    describe,
+    find_general,
+    general_candidates,
+    on_keyboard,
+    passed_over,
+    plays_keyboard,
+)
 from pianobot.agent.policy import policy_configs
 from pianobot.env import VERSION
 from pianobot.env.piano import EnvConfig, PianoEnv
@@ -37,10 +44,11 @@ from pianobot.music.instrument import HandSpec, KeyboardSpec
 from pianobot.music.metrics import Report
 from pianobot.music.phrases import DEFAULT_MAX_NOTES, Phrase, split_phrases
 from pianobot.music.piece import Piece
+from pianobot.perform import compose
 from pianobot.perform import perform as simulation  # (called through the module: tests replace simulation.perform)
-from pianobot.perform.compose import CompositionalController, find_policy, trained_split
+from pianobot.perform.compose import CompositionalController, Player, find_policy, trained_split
 from pianobot.perform.controllers import CONTROLLERS, make_controller
-from pianobot.perform.guard import HOLD_GUARD_FAMILIES, HoldGuard, WristGuard
+from pianobot.perform.guard import guarded_family
 from pianobot.perform.perform import PLAY_CONFIG
 from pianobot.perform.rollout import Controller, Rollout
 from pianobot.sim.hand import hand_config
@@ -50,15 +58,6 @@ from pianobot.sim.world import WorldConfig
 DEFAULT_MODELS = store.DEFAULT_STORE
 """The model store when none is named: ``models`` in the current folder (where ``pianobot train``
 writes). The general policy that ships with pianobot is found from anywhere besides."""
-
-
-class Player(str, Enum):
-    """Who plays a stretch of a performance."""
-
-    OWN = "own policy"
-    GENERAL = "general policy"
-    SCRIPTED = "scripted pianist"
-    RANDOM = "random actions"
 
 
 ONE_PLAYER = {"scripted": Player.SCRIPTED, "random": Player.RANDOM}
@@ -94,12 +93,6 @@ class Stretch:
             "player": self.player.value,
             "policy": str(self.policy) if self.policy is not None else None,
         }
-
-
-def guarded_family(general: Path | None) -> bool:
-    """Whether the general policy in ``general`` was trained on a task family whose policies play
-    through the hold guard unless told otherwise (:data:`~pianobot.perform.guard.HOLD_GUARD_FAMILIES`)."""
-    return general is not None and store.read_manifest(Path(general)).get("target") in HOLD_GUARD_FAMILIES
 
 
 @dataclass(frozen=True)
@@ -317,28 +310,6 @@ def _general_for(
     )
 
 
-def passed_over(keyboard: KeyboardSpec, hand: HandSpec) -> str:
-    """Why the packaged general policies do not play a piece read for ``keyboard`` and ``hand``, in
-    words naming the settings (the first that differs); '' where one plays it."""
-    packaged = general_candidates(None)
-    if not packaged or any(
-        plays_keyboard(env, sac, keyboard) and env.world.hand.spec == hand
-        for env, sac in (policy_configs(f) for f in packaged)
-    ):
-        return ""
-    world = policy_configs(packaged[0])[0].world
-    hands = list(dict.fromkeys(policy_configs(f)[0].world.hand.spec for f in packaged))
-    if hand not in hands:
-        return (
-            f"the packaged general policies play with fingers {' or '.join(h.describe() for h in hands)}; this "
-            f"piece is read for fingers {hand.describe()} (hand.fingers)"
-        )
-    return (
-        f"the packaged general policies play keyboards of {world.keyboard.spec.count} keys or more; this piece is "
-        f"read for {keyboard.describe()} (keyboard.count)"
-    )
-
-
 def plan_performance(
     piece: Piece,
     controller: str = "sac",
@@ -412,35 +383,6 @@ def controller_for(plan: PerformancePlan, env: PianoEnv, seed: int = 0) -> Contr
     return CompositionalController(env, plan.stretches, plan.wrist_guard, plan.holds)
 
 
-def _guard(controller: Controller, kind: type):
-    """The guard of ``kind`` the general policy plays through in ``controller`` (None: none)."""
-    for section in controller.sections if isinstance(controller, CompositionalController) else []:
-        guard = section.controller
-        while isinstance(guard, (HoldGuard, WristGuard)):
-            if isinstance(guard, kind):
-                return guard
-            guard = guard.policy
-    return None
-
-
-def slowed_steps(controller: Controller) -> int | None:
-    """Steps at which the wrist guard slowed the general policy's wrist in ``controller`` (None: no guard played)."""
-    guard = _guard(controller, WristGuard)
-    return guard.capped if guard is not None else None
-
-
-def held_steps(controller: Controller) -> int | None:
-    """Finger-steps the hold guard moved a holding finger in ``controller`` (None: no guard played)."""
-    guard = _guard(controller, HoldGuard)
-    return guard.held if guard is not None else None
-
-
-def wrist_steps(controller: Controller) -> int:
-    """Control steps in which the hold guard moved the wrist in ``controller`` (0: none, or no guard)."""
-    guard = _guard(controller, HoldGuard)
-    return guard.wrist if guard is not None else 0
-
-
 def perform_plan(
     plan: PerformancePlan, seed: int = 0, video: bool = False, on_step: Callable[[int, int], None] | None = None
 ) -> Performance:
@@ -453,7 +395,8 @@ def perform_plan(
         return made[0]
 
     played = simulation.perform(plan.piece, controller, plan.config, seed, video, on_step)
-    return Performance(plan, played, seed, slowed_steps(made[0]), held_steps(made[0]), wrist_steps(made[0]))
+    guards = compose.slowed_steps(made[0]), compose.held_steps(made[0]), compose.wrist_steps(made[0])
+    return Performance(plan, played, seed, *guards)
 
 
 def doubted(plan: PerformancePlan, models: Path | str | None, general: Path | None = None) -> dict[Path, str]:

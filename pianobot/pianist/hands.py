@@ -48,6 +48,7 @@ from pathlib import Path
 import numpy as np
 
 from pianobot.errors import PianobotError, PianobotWarning
+from pianobot.music import midi_io
 from pianobot.music import window as windows
 from pianobot.music.instrument import HandSpec, KeyboardSpec, keyboard_for
 from pianobot.music.load import CHORD_SPREAD, LEGATO_OVERLAP, LoadOptions, load_hands, thin_hand
@@ -289,7 +290,9 @@ def thin_for_hands(piece: Piece, spec: HandSpec = HandSpec()) -> tuple[Piece, in
     return Piece(tuple(n for i, n in enumerate(piece.notes) if i not in drop), bpm=piece.bpm), len(drop)
 
 
-def load_two_hands(path: str | Path, options: LoadOptions = LoadOptions(), spec: HandSpec = HandSpec()) -> Piece:
+def load_two_hands(
+    path: str | Path | midi_io.MidiSource, options: LoadOptions = LoadOptions(), spec: HandSpec = HandSpec()
+) -> Piece:
     """A two-hand piece with every note's hand: :func:`~pianobot.music.load.load_hands` (hands
     from track names, bad input refused in one line), chords of more notes than both hands' fingers
     thinned (one warning), and the notes without a hand given one by :func:`assign_hands`."""
@@ -297,7 +300,7 @@ def load_two_hands(path: str | Path, options: LoadOptions = LoadOptions(), spec:
     if dropped:
         warnings.warn(
             PianobotWarning(
-                f"{Path(path).name} has chords of more than {2 * len(spec.fingers)} notes, more than two hands of "
+                f"{midi_io.source_path(path).name} has chords of more than {2 * len(spec.fingers)} notes, more than two hands of "
                 f"{len(spec.fingers)} fingers hold: kept their lowest and highest {len(spec.fingers)}, "
                 f"dropped {dropped} inner note(s)"
             )

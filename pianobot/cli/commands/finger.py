@@ -10,11 +10,9 @@ from pianobot.cli.flags import phrase
 from pianobot.cli.options import (
     AllRows,
     Reading,
-    both_hands,
     check_files,
     check_midi_output,
-    fit_hand,
-    fit_keyboard,
+    read_file,
     reads,
 )
 from pianobot.cli.terminal import out, said
@@ -37,14 +35,12 @@ def finger(
     from pianobot.music.phrases import split_phrases
     from pianobot.pianist.fingering import ensure_fingering
     from pianobot.pianist.hands import finger_hands
-    from pianobot.pianist.reduce import load_for_hand
 
     check_midi_output(output, song, "the fingered piece")
     check_files({"the input": song, "the fingering file": reading.options.fingering}, {"-o": output})
     check_writable(output)
-    reading = fit_hand(song, reading)
-    keyboard, hand_spec = reading.keyboard, reading.hand
-    hands = both_hands(song, reading)
+    read = read_file(song, reading, finger=False)
+    keyboard, hand_spec, hands = read.keyboard, read.fingers, read.hands
     if hands is not None:  # a two-hand file: each hand fingered, one track each
         fingered = finger_hands(hands.piece, hand_spec, refinger=True)
         write_midi(fingered.piece, output)
@@ -67,8 +63,7 @@ def finger(
         )
         out.print(f"fingering for both hands written to {said(output)} (one track per hand{less})", soft_wrap=True)
         return
-    keyboard = fit_keyboard(song, reading).keyboard
-    piece = load_for_hand(song, reading.options, keyboard, hand_spec)
+    piece = read.part
     check_playable(piece.without_fingering(), keyboard, hand_spec, reading.options.transpose)  # (the whole shift)
     had = sum(n.finger is not None for n in piece.notes)
     piece, plan = ensure_fingering(piece, keyboard, hand_spec, refinger=True)

@@ -14,11 +14,9 @@ from pianobot.cli.options import (
     AllRows,
     PlayPhraseNotes,
     Reading,
-    both_hands,
     check_files,
     check_models,
-    fit_hand,
-    fit_keyboard,
+    read_file,
     reads,
 )
 from pianobot.cli.terminal import err, out, said, write_json
@@ -26,28 +24,29 @@ from pianobot.errors import PianobotError
 from pianobot.files import check_writable
 from pianobot.music.piece import pitch_name
 
+MODELS_OPTION = typer.Option(
+    DEFAULT_STORE, "--models", help="Model store whose trained phrase split to show (as play uses it)."
+)
+JSON_PATH_OPTION = typer.Option(
+    None, "--json", help="Also write what inspect found to this JSON file ('-': standard output)."
+)
+
 
 @reads()
 def inspect(
     song: Path = typer.Argument(..., help="A .mid file (or a PIG fingering .txt file)."),
     phrase_notes: Optional[int] = PlayPhraseNotes,
-    models: Path = typer.Option(
-        DEFAULT_STORE, "--models", help="Model store whose trained phrase split to show (as play uses it)."
-    ),
+    models: Path = MODELS_OPTION,
     all_rows: bool = AllRows,
-    json_path: Optional[Path] = typer.Option(
-        None, "--json", help="Also write what inspect found to this JSON file ('-': standard output)."
-    ),
+    json_path: Optional[Path] = JSON_PATH_OPTION,
     reading: Reading = None,
 ):
     """Explain what a file holds (tracks, hands, pedal, range, polyphony, fingering) and whether the hand can play it."""
     from pianobot.cli import display
-    from pianobot.music import midi_io
     from pianobot.music.instrument import check_playable
-    from pianobot.music.load import HANDS, hand_tracks
     from pianobot.perform.compose import missing_phrases, phrase_players, trained_split
     from pianobot.pianist.fingering import ensure_fingering
-    from pianobot.pianist.reduce import load_for_hand
+    from pianobot.pianist.reading import open_song
 
     options, keyboard, hand_spec = reading.options, reading.keyboard, reading.hand
     to_stdout = json_path is not None and str(json_path) == "-"
@@ -56,38 +55,23 @@ def inspect(
     if json_path is not None and not to_stdout:
         check_writable(json_path)
     console = err if to_stdout else out  # standard output carries the JSON
-    tracks, named, tempi = [], False, None
-    if song.suffix.lower() != ".txt":
-        tracks = midi_io.describe_tracks(song)
-        tempi = None if options.tempo is not None else midi_io.tempi(song)  # (--tempo re-times it at one tempo)
-        hands = {i: h for h in HANDS for i in hand_tracks(tracks, h)}
-        named = bool(hands)
-        console.print(display.tracks_table([replace(t, name=said(t.name)) for t in tracks], hands))
-        with_notes = [t for t in tracks if t.notes]
-        pedal = sum(t.pedal for t in tracks)
-        console.print(
-            f"{len(with_notes)} track(s) with notes"
-            + (f"; {_hand_parts(tracks)}" if hands else "")
-            + (
-                f"; sustain pedal pressed {pedal} times (ignored: a note sounds while its key is down)"
-                if pedal
-                else "; no sustain pedal"
-            )
-        )
+    source = open_song(song)  # (the file read once: all below derives from it)
+    tracks, named, tempi = _show_tracks(console, song, source, options)
     try:
-        reading = fit_hand(song, reading)
-        both = both_hands(song, reading)
+        read = read_file(source, reading, finger=False)
     except PianobotError:
         if named:
             raise  # the two-hand reading's refusal (notes beyond the piano)
-        both = None  # one hand's reading, below, says what it found, then what is wrong
+        read = None  # one hand's reading, below, says what it found, then what is wrong
+    both = None if read is None else read.hands
     if both is not None:
         _both_hands(console, both, tracks, json_path, tempi)
         return
     if len([t for t in tracks if t.notes]) > 1 and options.track is None and options.hand is None:
         console.print("[yellow]several tracks are merged; play one part with --track N or --hand right|left[/yellow]")
-    keyboard = fit_keyboard(song, reading).keyboard
-    piece = load_for_hand(song, options, keyboard, hand_spec)
+    if read is None:
+        read = read_file(source, reading, finger=False, both=False)
+    keyboard, hand_spec, piece = read.keyboard, read.fingers, read.part
     line, data = _summary(piece, tempi)
     console.print(line)
     if options.hand is not None:
@@ -97,7 +81,7 @@ def inspect(
 
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # (said as the part was read)
-            written = len(load_piece(song, options))
+            written = len(load_piece(source, options))
         if written > len(piece):
             console.print(
                 f"[yellow]the {options.hand} hand's part has {written} notes: the hand is given {len(piece)} "
@@ -144,6 +128,34 @@ def inspect(
                 ],
             },
         )
+
+
+def _show_tracks(console, song: Path, source, options) -> tuple[list, bool, list | None]:
+    """A MIDI file's tracks, which hands they name and its pedal, printed: (tracks, whether any
+    track names a hand, the tempos (None with --tempo))."""
+    from pianobot.cli import display
+    from pianobot.music import midi_io
+    from pianobot.music.load import HANDS, hand_tracks
+
+    tracks, named, tempi = [], False, None
+    if song.suffix.lower() != ".txt":
+        tracks = midi_io.describe_tracks(source)
+        tempi = None if options.tempo is not None else midi_io.tempi(source)  # (--tempo re-times it at one tempo)
+        hands = {i: h for h in HANDS for i in hand_tracks(tracks, h)}
+        named = bool(hands)
+        console.print(display.tracks_table([replace(t, name=said(t.name)) for t in tracks], hands))
+        with_notes = [t for t in tracks if t.notes]
+        pedal = sum(t.pedal for t in tracks)
+        console.print(
+            f"{len(with_notes)} track(s) with notes"
+            + (f"; {_hand_parts(tracks)}" if hands else "")
+            + (
+                f"; sustain pedal pressed {pedal} times (ignored: a note sounds while its key is down)"
+                if pedal
+                else "; no sustain pedal"
+            )
+        )
+    return tracks, named, tempi
 
 
 def _summary(piece, tempi: list[float] | None = None) -> tuple[str, dict]:

@@ -19,14 +19,12 @@ from pianobot.cli.options import (
     HtmlReport,
     PlayPhraseNotes,
     Reading,
-    both_hands,
     check_files,
     check_html,
     check_midi_output,
     check_models,
-    fit_hand,
-    fit_keyboard,
-    read_song,
+    finger_file,
+    read_file,
     reads,
 )
 from pianobot.cli.terminal import err, out, said, write_json
@@ -48,97 +46,151 @@ def progress(what: str):
         yield lambda done, total: bar.update(task, completed=done, total=total)
 
 
+SONG_OPTION = typer.Argument(
+    ...,
+    help="The piece to play: a .mid file (or a PIG .txt file); notes without fingering are fingered by the planner.",
+)
+OUTPUT_OPTION = typer.Option(..., "--output", "-o", help="Write what the simulated piano sounded to this .mid file.")
+CONTROLLER_OPTION = typer.Option(
+    CONTROLLERS[0],
+    "--controller",
+    help="Who plays: 'sac' (each phrase's trained policy, else the general policy), 'scripted' (the hand-written pianist) or 'random'.",
+)
+FALLBACK_OPTION = typer.Option(
+    None,
+    "--fallback",
+    help="'scripted': play phrases that have no trained policy with the scripted pianist (when no general policy "
+    "plays them: a phrase's own policy first, then the general policy, then the fallback).",
+)
+USE_GENERAL_OPTION = typer.Option(
+    True,
+    "--general/--no-general",
+    help="Play phrases without a policy of their own with the general policy (--general-policy, else the newest "
+    "`pianobot train --task melody` or `--task parts` policy in --models, else the packaged one), when there is one.",
+)
+LEFT_POLICY_OPTION = typer.Option(
+    None,
+    "--left-policy",
+    help="On a two-hand file, the general policy that plays the left hand (default: --general-policy when given, "
+    "else the newest general policy in --models, else the packaged left hand's policy, a `--task parts` one; "
+    "the right hand has --general-policy, or the newest general policy in --models, or the packaged left hand's "
+    "policy too; one-hand files have the general policy).",
+)
+WRIST_GUARD_OPTION = typer.Option(
+    False,
+    "--wrist-guard/--no-wrist-guard",
+    help="While a fingertip is low over the keys, the general policy's wrist slides no faster than the scripted "
+    "pianist's does while holding a key (PianistTuning.hold_slide, 8 mm a step), so that a late release drags a "
+    "finger across the keys less often (no effect on a policy trained with a discrete wrist).",
+)
+HOLD_GUARD_OPTION = typer.Option(
+    None,  # PerformancePlan.hold_guard (a test holds them equal; the plan module is slow to import)
+    "--hold-guard/--no-hold-guard",
+    help="While a finger holds a written note, the scripted pianist moves that finger (it keeps the key down until "
+    "the note ends, or until its own plan needs the finger for the next note) and the general policy the rest of "
+    "the hand. Default: for a general policy trained on hands' parts (`--task parts`: the packaged left hand's "
+    "policy), not for a melody policy (`--task melody`, which plays melodies better alone); --hold-guard: for "
+    "every general policy; --no-hold-guard: for none. Phrase policies always play alone; no effect on a policy "
+    "without finger targets or with torque control.",
+)
+SEED_OPTION = typer.Option(
+    0,
+    "--seed",
+    help="Seed of the simulation (the hand's start position) and of the random controller.",
+    min=0,
+)
+SOUNDFONT_OPTION = typer.Option(
+    None,
+    "--soundfont",
+    help="A General MIDI .sf2 soundfont for --wav and --video's sound (FluidSynth; default: an installed one, "
+    "else sine waves).",
+)
+JSON_PATH_OPTION = typer.Option(
+    None,
+    "--json",
+    help="Also write the report (who played, every figure, every note) to this JSON file ('-': standard output).",
+)
+NOTES_OPTION = typer.Option(
+    0, "--notes", min=0, help="Print the per-note table's first N rows (the report file has every note)."
+)
+QUIET_OPTION = typer.Option(
+    False, "--quiet", "-q", help="Print only where the files went (and warnings and errors): no figures, no tables."
+)
+
+
 @reads()
 def play(
-    song: Path = typer.Argument(
-        ...,
-        help="The piece to play: a .mid file (or a PIG .txt file); notes without fingering are fingered by the planner.",
-    ),
-    output: Path = typer.Option(
-        ..., "--output", "-o", help="Write what the simulated piano sounded to this .mid file."
-    ),
-    controller: Controller = typer.Option(
-        CONTROLLERS[0],
-        "--controller",
-        help="Who plays: 'sac' (each phrase's trained policy, else the general policy), 'scripted' (the hand-written pianist) or 'random'.",
-    ),
+    song: Path = SONG_OPTION,
+    output: Path = OUTPUT_OPTION,
+    controller: Controller = CONTROLLER_OPTION,
     models: Path = typer.Option(DEFAULT_STORE, "--models", help="Folder of the model store (for --controller sac)."),
-    fallback: Optional[Fallback] = typer.Option(
-        None,
-        "--fallback",
-        help="'scripted': play phrases that have no trained policy with the scripted pianist (when no general policy "
-        "plays them: a phrase's own policy first, then the general policy, then the fallback).",
-    ),
-    use_general: bool = typer.Option(
-        True,
-        "--general/--no-general",
-        help="Play phrases without a policy of their own with the general policy (--general-policy, else the newest "
-        "`pianobot train --task melody` or `--task parts` policy in --models, else the packaged one), when there is one.",
-    ),
+    fallback: Optional[Fallback] = FALLBACK_OPTION,
+    use_general: bool = USE_GENERAL_OPTION,
     general_policy: Optional[Path] = GeneralPolicy,
-    left_policy: Optional[Path] = typer.Option(
-        None,
-        "--left-policy",
-        help="On a two-hand file, the general policy that plays the left hand (default: --general-policy when given, "
-        "else the newest general policy in --models, else the packaged left hand's policy, a `--task parts` one; "
-        "the right hand has --general-policy, or the newest general policy in --models, or the packaged left hand's "
-        "policy too; one-hand files have the general policy).",
-    ),
-    wrist_guard: bool = typer.Option(
-        False,
-        "--wrist-guard/--no-wrist-guard",
-        help="While a fingertip is low over the keys, the general policy's wrist slides no faster than the scripted "
-        "pianist's does while holding a key (PianistTuning.hold_slide, 8 mm a step), so that a late release drags a "
-        "finger across the keys less often (no effect on a policy trained with a discrete wrist).",
-    ),
-    hold_guard: Optional[bool] = typer.Option(
-        None,  # PerformancePlan.hold_guard (a test holds them equal; the plan module is slow to import)
-        "--hold-guard/--no-hold-guard",
-        help="While a finger holds a written note, the scripted pianist moves that finger (it keeps the key down until "
-        "the note ends, or until its own plan needs the finger for the next note) and the general policy the rest of "
-        "the hand. Default: for a general policy trained on hands' parts (`--task parts`: the packaged left hand's "
-        "policy), not for a melody policy (`--task melody`, which plays melodies better alone); --hold-guard: for "
-        "every general policy; --no-hold-guard: for none. Phrase policies always play alone; no effect on a policy "
-        "without finger targets or with torque control.",
-    ),
+    left_policy: Optional[Path] = LEFT_POLICY_OPTION,
+    wrist_guard: bool = WRIST_GUARD_OPTION,
+    hold_guard: Optional[bool] = HOLD_GUARD_OPTION,
     phrase_notes: Optional[int] = PlayPhraseNotes,
-    seed: int = typer.Option(
-        0,
-        "--seed",
-        help="Seed of the simulation (the hand's start position) and of the random controller.",
-        min=0,
-    ),
+    seed: int = SEED_OPTION,
     video: Optional[Path] = typer.Option(None, "--video", help="Also record the performance to this .mp4 file."),
     wav: Optional[Path] = typer.Option(None, "--wav", help="Also synthesise what was played to this .wav file."),
-    soundfont: Optional[Path] = typer.Option(
-        None,
-        "--soundfont",
-        help="A General MIDI .sf2 soundfont for --wav and --video's sound (FluidSynth; default: an installed one, "
-        "else sine waves).",
-    ),
+    soundfont: Optional[Path] = SOUNDFONT_OPTION,
     gui: bool = typer.Option(False, "--gui", help="Show the simulation in a PyBullet window (needs a display)."),
     html: Optional[Path] = HtmlReport,
-    json_path: Optional[Path] = typer.Option(
-        None,
-        "--json",
-        help="Also write the report (who played, every figure, every note) to this JSON file ('-': standard output).",
-    ),
-    notes: int = typer.Option(
-        0, "--notes", min=0, help="Print the per-note table's first N rows (the report file has every note)."
-    ),
+    json_path: Optional[Path] = JSON_PATH_OPTION,
+    notes: int = NOTES_OPTION,
     every: bool = AllFigures,
-    quiet: bool = typer.Option(
-        False, "--quiet", "-q", help="Print only where the files went (and warnings and errors): no figures, no tables."
-    ),
+    quiet: bool = QUIET_OPTION,
     reading: Reading = None,
 ):
     """Perform a piece (both hands of a two-hand file) in the simulator; write the played notes (velocities, fingers, hands) and a report."""
-    from pianobot.cli import display
-    from pianobot.music.midi_io import write_midi
-    from pianobot.music.phrases import split_phrases
-    from pianobot.perform.audio import check_soundfont, write_wav
-    from pianobot.perform.perform import write_video
-    from pianobot.perform.plan import Player, perform_judged, plan_performance
+    files = dict(report=output.with_suffix(".report.json"), json=json_path, wav=wav, soundfont=soundfont, html=html)
+    files |= dict(video=video)
+    shown = dict(notes=notes, every=every, quiet=quiet)
+    report_path, shown["console"] = _check_files(
+        song, output, reading, controller, models, json_path, html, wav, video, soundfont, gui
+    )
+    read = read_file(song, reading, finger=False)  # (one hand's part fingered once --left-policy is checked)
+    hands = read.hands
+    _check_left_policy(left_policy, song, hands, controller, use_general, models)
+    if hands is not None:  # a two-hand file: both hands, in one simulation
+        if gui:
+            raise PianobotError(
+                f"--gui shows one hand so far, and {song.name} plays with two: "
+                "play one hand for it with --hand right (or --hand left), or watch both with --video"
+            )
+        play_both(
+            song,
+            output,
+            hands,
+            controller=controller.value,
+            models=models,
+            seed=seed,
+            keyboard=reading.keyboard if reading.keyboard_named else None,  # (none named: each player's own keys)
+            hand=read.fingers,
+            options=dict(
+                general=use_general,
+                general_policy=general_policy
+                if left_policy is None
+                else {"right": general_policy, "left": left_policy},
+                fallback=fallback is not None,
+                phrase_notes=phrase_notes,
+                wrist_guard=wrist_guard,
+                hold_guard=hold_guard,
+            ),
+            files=files,
+            shown=shown,
+        )
+        return
+    options = dict(general=use_general, general_policy=general_policy, fallback=fallback is not None)
+    options |= dict(phrase_notes=phrase_notes, wrist_guard=wrist_guard, hold_guard=hold_guard, gui=gui)
+    play_one(song, output, finger_file(read, reading), controller, models, seed, options, files, shown)
+
+
+def _check_files(song, output, reading, controller, models, json_path, html, wav, video, soundfont, gui):
+    """Every file play reads and writes, and what it needs, checked before any work: (the report's
+    path beside -o, the console for what is printed)."""
+    from pianobot.perform.audio import check_soundfont
 
     check_midi_output(output, song, "the performance")
     if controller == "sac":
@@ -173,71 +225,59 @@ def play(
         import torch
 
         torch.set_num_threads(1)  # batch-1 inference: more threads only spin against other work on the cores
-    reading = fit_hand(song, reading)
-    hands = both_hands(song, reading)
-    if left_policy is not None:
-        from pianobot.agent import store
+    return report_path, console
 
-        why = (
-            "plays one hand"
-            if hands is None
-            else f"is played by --controller {controller.value}"
-            if controller != "sac"
-            else "is played with --no-general"
-            if not use_general
-            else None
-        )
-        if why is not None:
-            raise PianobotError(
-                f"--left-policy {left_policy}: {song.name} {why}, so no general policy plays a left hand; drop --left-policy"
-            )
-        if not store.is_trained(left_policy):
-            raise PianobotError(
-                f"--left-policy {left_policy}: not a trained policy folder (one holding {store.POLICY_FILE} and "
-                f"{store.MANIFEST_FILE}, e.g. a `pianobot train --task parts` folder in {models})"
-            )
-    if hands is not None:  # a two-hand file: both hands, in one simulation
-        if gui:
-            raise PianobotError(
-                f"--gui shows one hand so far, and {song.name} plays with two: "
-                "play one hand for it with --hand right (or --hand left), or watch both with --video"
-            )
-        play_both(
-            song,
-            output,
-            hands,
-            controller=controller.value,
-            models=models,
-            seed=seed,
-            keyboard=reading.keyboard if reading.keyboard_named else None,  # (none named: each player's own keys)
-            hand=reading.hand,
-            options=dict(
-                general=use_general,
-                general_policy=general_policy
-                if left_policy is None
-                else {"right": general_policy, "left": left_policy},
-                fallback=fallback is not None,
-                phrase_notes=phrase_notes,
-                wrist_guard=wrist_guard,
-                hold_guard=hold_guard,
-            ),
-            files=dict(report=report_path, json=json_path, wav=wav, soundfont=soundfont, html=html, video=video),
-            shown=dict(console=console, notes=notes, every=every, quiet=quiet),
-        )
+
+def _check_left_policy(left_policy, song, hands, controller, use_general, models) -> None:
+    """--left-policy only where a general policy plays a two-hand file's left hand, and only a trained policy."""
+    from pianobot.agent import store
+
+    if left_policy is None:
         return
-    reading = fit_keyboard(song, reading)
-    piece = read_song(song, reading.options, reading.keyboard, reading.hand)
-    chosen = dict(
-        keyboard=reading.keyboard,
-        hand=reading.hand,
-        general=use_general,
-        general_policy=general_policy,
-        fallback=fallback is not None,
-        phrase_notes=phrase_notes,
-        wrist_guard=wrist_guard,
-        hold_guard=hold_guard,
-        gui=gui,
+    why = (
+        "plays one hand"
+        if hands is None
+        else f"is played by --controller {controller.value}"
+        if controller != "sac"
+        else "is played with --no-general"
+        if not use_general
+        else None
     )
+    if why is not None:
+        raise PianobotError(
+            f"--left-policy {left_policy}: {song.name} {why}, so no general policy plays a left hand; drop --left-policy"
+        )
+    if not store.is_trained(left_policy):
+        raise PianobotError(
+            f"--left-policy {left_policy}: not a trained policy folder (one holding {store.POLICY_FILE} and "
+            f"{store.MANIFEST_FILE}, e.g. a `pianobot train --task parts` folder in {models})"
+        )
+
+
+def play_one(
+    song: Path, output: Path, read, controller, models, seed: int, options: dict, files: dict, shown: dict
+) -> None:
+    """`play` of a one-hand piece (``read``: a :class:`~pianobot.pianist.reading.ReadPiece`, fingered):
+    planned (:func:`~pianobot.perform.plan.plan_performance`), performed as judged
+    (:func:`~pianobot.perform.plan.perform_judged`), written, and reported."""
+    from pianobot.cli import display
+    from pianobot.music.midi_io import write_midi
+    from pianobot.music.phrases import split_phrases
+    from pianobot.perform.audio import write_wav
+    from pianobot.perform.perform import write_video
+    from pianobot.perform.plan import Player, perform_judged, plan_performance
+
+    console, quiet, notes, every = shown["console"], shown["quiet"], shown["notes"], shown["every"]
+    report_path, json_path, video, wav, html = (
+        files["report"],
+        files["json"],
+        files["video"],
+        files["wav"],
+        files["html"],
+    )
+    soundfont, phrase_notes = files["soundfont"], options["phrase_notes"]
+    piece = read.piece
+    chosen = dict(keyboard=read.keyboard, hand=read.fingers, **options)
     plan = plan_performance(piece, controller.value, models, **chosen)
     if (
         not quiet
@@ -300,7 +340,7 @@ def play_both(
     """`play` of a two-hand file (``reading``: a :class:`~pianobot.perform.hands.HandsReading`):
     both hands in one simulation (:func:`~pianobot.perform.hands.play_hands`), one
     track per hand in ``output``, and the report of the whole piece and each hand (``hand``: both
-    hands' fingers, as :func:`~pianobot.cli.options.fit_hand` chose them)."""
+    hands' fingers, as the reading chose them: :func:`~pianobot.pianist.reading.choose_fingers`)."""
     import warnings
 
     from pianobot.cli import display

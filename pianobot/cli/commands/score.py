@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-from dataclasses import replace
 from pathlib import Path
 from typing import Optional
 
@@ -12,17 +11,14 @@ from pianobot.cli.options import (
     AllFigures,
     HtmlReport,
     Reading,
-    both_hands,
     check_files,
     check_html,
-    fit_hand,
-    fit_keyboard,
+    read_file,
     reads,
 )
 from pianobot.cli.terminal import err, out, said, write_json
 from pianobot.errors import PianobotError
 from pianobot.files import check_writable
-from pianobot.music.instrument import THUMB
 from pianobot.music.metrics import DEFAULT_ONSET_TOLERANCE
 
 
@@ -53,7 +49,6 @@ def score(
     from pianobot.music import midi_io
     from pianobot.music.hand_scores import compare_hands
     from pianobot.music.metrics import plot_report
-    from pianobot.pianist.reduce import load_for_hand
 
     if not 0 < onset_tolerance <= 1:
         raise PianobotError(f"--onset-tolerance {onset_tolerance}: give seconds between 0 and 1, e.g. 0.05")
@@ -69,19 +64,9 @@ def score(
         if target is not None:
             check_writable(target)
     console = err if to_stdout else out  # standard output carries the JSON
-    hands = both_hands(reference, reading)
-    if hands is not None and not reading.hand_named:  # (the fingers play chose: they may read the hands otherwise)
-        thumbs = both_hands(reference, replace(reading, hand=THUMB))
-        if thumbs is not None and thumbs.piece != hands.piece:
-            reading = fit_hand(reference, reading, quiet=True)
-            hands = both_hands(reference, reading)
-    if hands is not None:
-        reference_piece = hands.piece  # every note with its hand, as play scored it
-    else:
-        keys = fit_keyboard(reference, reading, quiet=True).keyboard  # (the keys play chose: its reduction's)
-        reference_piece = load_for_hand(
-            reference, reading.options, keys, reading.hand, fit=False
-        )  # with --hand, reduced as play reduces it
+    # the fingers and keys play chose (they may read the hands otherwise), nothing said again
+    read = read_file(reference, reading, finger=False, quiet=True, fit=False)
+    reference_piece = read.hands.piece if read.both else read.part  # as play scored it (with --hand, reduced)
     played_piece = midi_io.read_midi(played)
     scores = compare_hands(reference_piece, played_piece, onset_tolerance=onset_tolerance)
     report = scores.whole

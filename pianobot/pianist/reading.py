@@ -1,0 +1,483 @@
+"""One way to read a file: from the file on disk to what the players get.
+
+Every command that reads a piece (``play``, ``score``, ``inspect``, ``finger``, ``train``) and
+:func:`pianobot.play`'s callers read it here, in steps, each a function:
+
+1. :func:`open_song`: the file read and parsed, once (a PIG .txt file is read as text where
+   needed); every later step derives what it needs from what was read;
+2. :func:`choose_fingers`: the fingers both hands play with where none are named (their thumbs
+   too where those keep notes that three fingers leave out: :func:`thumbs_keep_more`);
+3. :func:`read_both_hands`: whether the file plays both hands (:func:`two_hands`), and then every
+   note with its hand (:class:`HandsReading`);
+4. otherwise one hand's part: :func:`choose_keys` (the keys it needs where none are named) and
+   :func:`read_part` (with a hand named, reduced to what the hand can play,
+   :func:`~pianobot.pianist.reduce.load_for_hand`);
+5. :func:`finger_part`: one hand's part checked against the keyboard and fingered by the planner
+   where it has no fingering.
+
+:func:`read_piece` takes them in order and returns a :class:`ReadPiece`: the tracks read,
+whether it is one hand or two, each hand's part, what was reduced away and why (the lines
+said), the fingering plan, the fingers and the keyboard. What each step says is a
+:class:`~pianobot.errors.PianobotWarning`, or, for a file it refuses, a one-line
+:class:`~pianobot.errors.PianobotError`; the caller words what undoes a choice
+(:class:`Wording`). Each hand's part as its player is given it (:func:`prepare_part`: mirrored,
+moved onto its keys, reduced, fingered) is here too.
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+
+from pianobot.errors import PianobotError, PianobotWarning
+from pianobot.music import midi_io
+from pianobot.music.instrument import THUMB, HandSpec, KeyboardSpec, check_playable, keys_for, suggest_transpose
+from pianobot.music.load import LoadOptions, end_legato, load_hands, load_part, load_piece, thin_hand
+from pianobot.music.midi_io import MidiSource, TrackInfo, source_path
+from pianobot.music.piece import HANDS, Note, Piece, pitch_name
+from pianobot.music.window import Window, window_for
+from pianobot.pianist.fingering import FingeringPlan, ensure_fingering
+from pianobot.pianist.hands import load_two_hands, reduce_hand
+from pianobot.pianist.reduce import load_for_hand
+
+Source = Path | MidiSource
+"""A file to read: a PIG .txt file's path, or a .mid file read once (:func:`open_song`)."""
+
+
+@dataclass(frozen=True)
+class Wording:
+    """How the caller says what undoes a choice the reading made for it (the command line names
+    its options; the library's defaults name the settings)."""
+
+    three: str = "hand=HandSpec() plays with three"
+    """After the line that gives both hands their thumbs."""
+    keys: str = "a keyboard named for it plays on other keys"
+    """After the line that moves a one-hand piece onto its own octaves."""
+    refinger: str = "load.refinger"
+    """Why a piece with fingering was fingered again."""
+    written: str = "write the fingered piece to keep it"
+    """After the line that says a fingering was planned."""
+
+
+@dataclass(frozen=True)
+class ReadPiece:
+    """A file as read for its players (:func:`read_piece`)."""
+
+    path: Path
+    source: Source = field(repr=False)
+    """The file as read (:func:`open_song`): any further reading derives from it."""
+    tracks: tuple[TrackInfo, ...]
+    """The MIDI file's tracks (none for a PIG file)."""
+    keyboard: KeyboardSpec
+    """The keys: those named, else the default (both hands: each player's own), else a one-hand
+    piece's own octaves where its notes lie off the default keys."""
+    fingers: HandSpec
+    """The fingers each hand plays with."""
+    thumbs: tuple[int, int] | None = None
+    """Where the thumbs were chosen: (notes both hands are given with three fingers, with thumbs)."""
+    hands: HandsReading | None = None
+    """Both hands: every note with its hand, and what the file named (else one hand's part)."""
+    part: Piece | None = None
+    """One hand's part as read (with a hand named, reduced to what it can play), before fingering."""
+    piece: Piece | None = None
+    """What is played: both hands' notes, each with its hand; or one hand's part, fingered
+    (None where the reading stopped before fingering)."""
+    fingering: FingeringPlan | None = None
+    """One hand's fingering as the planner made it (None: the file's own, or not fingered here)."""
+    reduced: tuple[str, ...] = ()
+    """What was reduced away or changed, and why: one line per kind, as said."""
+
+    @property
+    def both(self) -> bool:
+        """Whether both hands play."""
+        return self.hands is not None
+
+    @property
+    def name(self) -> str:
+        """The file's name."""
+        return self.path.name
+
+
+def open_song(path: str | Path | MidiSource) -> Source:
+    """The file at ``path`` read once: a .mid file parsed (refused in one line where it is no
+    readable MIDI file); a PIG .txt file's path (its text read by each step that needs it)."""
+    if isinstance(path, MidiSource) or Path(path).suffix.lower() == ".txt":
+        return path if isinstance(path, MidiSource) else Path(path)
+    return midi_io.open_midi(path)
+
+
+def tracks_of(source: Source) -> tuple[TrackInfo, ...]:
+    """The tracks of a MIDI file read (none for a PIG file)."""
+    return tuple(midi_io.describe_tracks(source)) if isinstance(source, MidiSource) else ()
+
+
+def choose_fingers(
+    source: Source, options: LoadOptions, quiet: bool = False, wording: Wording = Wording()
+) -> tuple[HandSpec, tuple[int, int] | None]:
+    """Both hands' fingers where none are named: :func:`fingers_for_file`, and where it gives
+    both hands their thumbs, one line saying so (not ``quiet``)."""
+    hand, counts = fingers_for_file(source, options)
+    if counts is not None and not quiet:
+        said = THUMBS_CHOSEN.format(more=counts[1], given=counts[0])
+        warnings.warn(PianobotWarning(f"{source_path(source).name}: {said} ({wording.three})"))
+    return hand, counts
+
+
+def read_both_hands(
+    source: Source, options: LoadOptions, fingers: HandSpec, keyboard: KeyboardSpec = KeyboardSpec()
+) -> HandsReading | None:
+    """Both hands of the file where it plays both (:func:`two_hands`), else None."""
+    return two_hands(source, options, fingers, keyboard)
+
+
+def choose_keys(
+    source: Source, options: LoadOptions, fingers: HandSpec, quiet: bool = False, wording: Wording = Wording()
+) -> KeyboardSpec:
+    """The keys a one-hand piece needs where none are named: the default keys where its notes lie
+    on them, else its own octaves (:func:`~pianobot.music.instrument.keys_for`), said in one line
+    (not ``quiet``)."""
+    default = KeyboardSpec()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", PianobotWarning)  # (said when the part is read)
+        piece = load_part(source, options, fingers)
+    keys = keys_for(piece, default)
+    if keys != default and not quiet:
+        low, high = min(n.pitch for n in piece.notes), max(n.pitch for n in piece.notes)
+        warnings.warn(
+            PianobotWarning(
+                f"{source_path(source).name}: its notes ({pitch_name(low)}-{pitch_name(high)}) lie off the default keys "
+                f"{default.describe()}: played on {keys.describe()}, the piece's own octaves ({wording.keys})"
+            )
+        )
+    return keys
+
+
+def read_part(
+    source: Source, options: LoadOptions, keyboard: KeyboardSpec, fingers: HandSpec, fit: bool = True
+) -> tuple[Piece, tuple[str, ...]]:
+    """One hand's part (:func:`~pianobot.pianist.reduce.load_for_hand`: with ``options.hand``,
+    reduced to what the hand can play), and the lines its reading said."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", PianobotWarning)
+        part = load_for_hand(source, options, keyboard, fingers, fit=fit)
+    _warn_again(caught)
+    return part, tuple(str(w.message) for w in caught if issubclass(w.category, PianobotWarning))
+
+
+def finger_part(
+    part: Piece,
+    options: LoadOptions,
+    keyboard: KeyboardSpec,
+    fingers: HandSpec,
+    name: str,
+    wording: Wording = Wording(),
+) -> tuple[Piece, FingeringPlan | None]:
+    """One hand's part checked against ``keyboard`` and ``fingers`` (a refusal's hint counts the
+    whole transposition in), then fingered by the planner where it has no fingering (or
+    ``options.refinger``), said in one line with the plan's problems (``name``: the file's)."""
+    check_playable(part.without_fingering(), keyboard, fingers, options.transpose)
+    piece, plan = ensure_fingering(part, keyboard, fingers, options.refinger)
+    if plan is not None:
+        why = wording.refinger if options.refinger else "it has notes without fingering"
+        warnings.warn(
+            PianobotWarning(
+                f"{name}: fingering planned for fingers {', '.join(map(str, fingers.fingers))} ({why}): "
+                f"wrist travel {plan.travel * 100:.1f} cm in {plan.moves} moves; {wording.written}"
+            )
+        )
+        for problem in plan.problems:
+            warnings.warn(PianobotWarning(problem))
+    check_playable(piece, keyboard, fingers)
+    return piece, plan
+
+
+def read_piece(
+    path: str | Path | MidiSource,
+    options: LoadOptions = LoadOptions(),
+    keyboard: KeyboardSpec | None = None,
+    fingers: HandSpec | None = None,
+    *,
+    finger: bool = True,
+    both: bool = True,
+    fit: bool = True,
+    quiet: bool = False,
+    wording: Wording = Wording(),
+) -> ReadPiece:
+    """The file at ``path`` read for its players, step by step (the module's notes), the file
+    read once. ``keyboard``, ``fingers``: None where none are named (then chosen, each choice
+    said in one line unless ``quiet``). ``finger``: one hand's part also checked and fingered
+    (:func:`finger_part`; else :attr:`ReadPiece.piece` is None for one hand). ``both``: ask
+    whether it plays both hands (else one hand's part, as before two hands). ``fit``: as
+    :func:`~pianobot.pianist.reduce.load_for_hand`'s (a part wider than the keys refused)."""
+    source = open_song(path)
+    name = source_path(source)
+    tracks = tracks_of(source)
+    thumbs = None
+    if fingers is None:
+        fingers, thumbs = choose_fingers(source, options, quiet, wording)
+    hands = read_both_hands(source, options, fingers, keyboard or KeyboardSpec()) if both else None
+    if hands is not None:
+        return ReadPiece(name, source, tracks, keyboard or KeyboardSpec(), fingers, thumbs, hands, piece=hands.piece)
+    keys = keyboard or choose_keys(source, options, fingers, quiet, wording)
+    part, reduced = read_part(source, options, keys, fingers, fit)
+    read = ReadPiece(name, source, tracks, keys, fingers, thumbs, None, part, reduced=reduced)
+    return finger_read(read, options, wording) if finger else read
+
+
+def finger_read(read: ReadPiece, options: LoadOptions, wording: Wording = Wording()) -> ReadPiece:
+    """A one-hand reading made with ``finger=False`` (:func:`read_piece`), fingered now
+    (:func:`finger_part`); a reading of both hands, or one already fingered, as it is."""
+    if read.part is None or read.piece is not None:
+        return read
+    piece, plan = finger_part(read.part, options, read.keyboard, read.fingers, read.name, wording)
+    return replace(read, piece=piece, fingering=plan)
+
+
+@dataclass(frozen=True)
+class HandsReading:
+    """A two-hand file as read for both hands: every note with its hand, and how many of each
+    hand's notes the file named (its tracks' names, or a PIG file's channels) rather than the
+    fingering planner (:func:`~pianobot.pianist.hands.assign_hands`)."""
+
+    piece: Piece
+    named: dict[str, int]
+    source: str = "its track"
+    """What named a note's hand in the file: 'its track', 'the PIG channel'."""
+
+    def to_dict(self, hand: str) -> dict:
+        """``hand``'s part: how many notes, its range, how many the file named and the planner assigned."""
+        part = self.piece.part(hand)
+        named = min(self.named.get(hand, 0), len(part))  # (a note the reading thinned away may have been named)
+        return {
+            "notes": len(part),
+            "range": [pitch_name(min(n.pitch for n in part.notes)), pitch_name(max(n.pitch for n in part.notes))],
+            "named_by_file": named,
+            "assigned_by_planner": len(part) - named,
+        }
+
+    def describe(self, hand: str) -> str:
+        """One line on ``hand``'s part: 'right hand: 64 notes, C4-D5, named by its track'."""
+        part = self.to_dict(hand)
+        named, assigned = part["named_by_file"], part["assigned_by_planner"]
+        if assigned == 0:
+            who = f"named by {self.source}"
+        elif named == 0:
+            who = "assigned by the fingering planner"
+        else:
+            who = f"{named} named by {self.source}, {assigned} assigned by the fingering planner"
+        notes = f"{part['notes']} note{'s' * (part['notes'] != 1)}"
+        return f"{hand} hand: {notes}, {'-'.join(part['range'])}, {who}"
+
+
+def read_hands(
+    path: str | Path | MidiSource, options: LoadOptions = LoadOptions(), spec: HandSpec = HandSpec()
+) -> HandsReading:
+    """Both hands of the file at ``path``: :func:`~pianobot.pianist.hands.load_two_hands` (its
+    warnings and its one-line refusals), with what the file named."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", PianobotWarning)  # said by load_two_hands
+        given = load_hands(source := open_song(path), options)
+    piece = load_two_hands(source, options, spec)
+    named = {hand: sum(n.hand == hand for n in given.notes) for hand in HANDS}
+    return HandsReading(piece, named, "the PIG channel" if source_path(path).suffix.lower() == ".txt" else "its track")
+
+
+def names_hands(path: str | Path | MidiSource, track: str | None = None) -> bool:
+    """Whether the file says which hand plays its notes: a track named for a hand (of those
+    ``track`` names, :func:`~pianobot.music.midi_io.read_midi`'s; None: all), or a PIG file."""
+    if source_path(path).suffix.lower() == ".txt":
+        return True
+    source = midi_io.open_midi(path)
+    read = None if track is None else set(midi_io.selected_tracks(source, track))
+    return any(
+        t.notes and midi_io.track_hand(t.name) and (read is None or t.index in read)
+        for t in midi_io.describe_tracks(source)
+    )
+
+
+def two_hands(
+    path: str | Path | MidiSource,
+    options: LoadOptions,
+    spec: HandSpec = HandSpec(),
+    keyboard: KeyboardSpec = KeyboardSpec(),
+) -> HandsReading | None:
+    """Both hands of the file at ``path`` where ``pianobot play`` plays both, else None: read it
+    as one hand, as before two hands.
+
+    Both hands: without ``options.hand``, and with ``options.track`` naming two or more tracks of
+    notes or none (then only those tracks are read), a file whose tracks are named for
+    hands (the notes of others given hands by the fingering planner), or a PIG file, with notes
+    for both hands; or a file that cannot be one hand's, whose notes the fingering planner gives
+    to both hands: its notes span more keys than one hand's ``keyboard`` has, or, unfingered,
+    one hand's reading refuses it (notes off ``keyboard``, more at once than the hand's fingers,
+    a chord or a move it cannot reach). Where the planner gives every note to one hand, or both
+    hands' reading refuses a file that one hand's refuses too, one hand's reading says why. The
+    reading's warnings are said only where both hands play (or where it refuses the file: notes
+    beyond the piano)."""
+    if options.hand is not None:
+        return None
+    path, source = source_path(path), open_song(path)
+    if options.track is not None:
+        if path.suffix.lower() == ".txt":
+            return None  # (one hand's reading refuses --track on a PIG file)
+        read = set(midi_io.selected_tracks(source, options.track))
+        if len([t for t in midi_io.describe_tracks(source) if t.notes and t.index in read]) < 2:
+            return None  # (one track: one hand's part, as before two hands)
+    if path.suffix.lower() == ".txt" and (options.tempo or options.fingering or options.quantize):
+        return None  # (one hand's reading refuses them in its own words)
+    one_hand_refuses = ""
+    if not names_hands(source, options.track):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # said when the piece is read
+            piece = end_legato(load_piece(source, options))  # (as one hand's reading reads it)
+        pitches = [n.pitch for n in piece.notes]
+        if max(pitches) - min(pitches) < keyboard.count:
+            if any(n.finger is not None for n in piece.notes):
+                return None  # (a fingered file is one hand's: its fingers say so)
+            one_hand_refuses = one_hand_refusal(piece, spec, keyboard, options.refinger)
+            if not one_hand_refuses:
+                return None
+    try:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            hands = read_hands(source, options, spec)
+    except PianobotError:
+        if one_hand_refuses:
+            return None  # one hand's reading says why, in its own words
+        _warn_again(caught)
+        raise
+    if len(hands.piece.hands) < 2:
+        return None
+    _warn_again(caught)
+    if one_hand_refuses:
+        warnings.warn(
+            PianobotWarning(
+                f"{path.name}: one hand cannot play it ({one_hand_refuses}): its notes are given to both hands"
+            )
+        )
+    return hands
+
+
+def one_hand_refusal(piece: Piece, spec: HandSpec, keyboard: KeyboardSpec, refinger: bool = False) -> str:
+    """Why one hand with ``spec``'s fingers cannot play ``piece`` (unfingered, spanning fewer keys
+    than ``keyboard`` has), in words; '' where it can. It is asked on ``keyboard`` moved by the
+    transposition one hand's reading would suggest (:func:`~pianobot.music.instrument.suggest_transpose`):
+    notes a transposition brings onto the keys are no reason for two hands. A single line of notes is
+    always one hand's (the fingering planner only slows what is fast); chords and held notes are
+    asked of the planner."""
+    shift = suggest_transpose(piece, keyboard) or 0  # (0 where the notes fit: the plan is then reused)
+    under = KeyboardSpec(max(0, min(keyboard.lowest - shift, 128 - keyboard.count)), keyboard.count)
+    try:
+        check_playable(piece, under, spec)  # (more notes at once than fingers)
+        if piece.max_polyphony()[0] > 1:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")  # (one hand's reading says them, where one hand plays)
+                ensure_fingering(piece, under, spec, refinger)
+    except PianobotError as refused:
+        return str(refused).split(": ")[0]
+    return ""
+
+
+def _warn_again(caught: list) -> None:
+    for warning in caught:
+        warnings.warn(warning.message)
+
+
+def prepare_part(
+    piece: Piece,
+    hand: str,
+    keyboard: KeyboardSpec | None,
+    fingers: HandSpec,
+    start: float | None = None,
+    grow: bool = False,
+) -> tuple[Window, Piece, float, int]:
+    """``hand``'s part of ``piece`` as the simulated hand is given it: (window, part, start, notes
+    left out), the part moved ``start`` seconds earlier (default: to its first note); ``grow``: a
+    part wider than ``keyboard`` is given its own range instead (:func:`~pianobot.music.window.window_for`).
+    Each kind of change is one :class:`PianobotWarning`, worded for the written part."""
+    window, reduced, start, left_out = _reduced_part(piece, hand, keyboard, fingers, start, grow)
+    fingered, _ = ensure_fingering(reduced, window.keyboard, fingers, refinger=True)
+    return window, fingered, start, left_out
+
+
+def _reduced_part(
+    piece: Piece, hand: str, keyboard: KeyboardSpec | None, fingers: HandSpec, start: float | None, grow: bool
+) -> tuple[Window, Piece, float, int]:
+    """:func:`prepare_part`'s part before it is fingered."""
+    part = piece.part(hand)
+    window = window_for(part, hand, keyboard, grow)
+    inside = [n for n in part.notes if window.inward(n.pitch) in window.keyboard]
+    left_out = len(part) - len(inside)
+    if left_out:
+        warnings.warn(
+            PianobotWarning(
+                f"the {hand} hand's part spans more than the {window.keyboard.count} keys its player knows: "
+                f"left out {left_out} note(s) outside them"
+            )
+        )
+    if not inside:
+        raise PianobotError(f"none of the {hand} hand's notes fits the keyboard its player knows")
+    moved = Piece(tuple(Note(n.onset, window.inward(n.pitch), n.offset, n.velocity) for n in inside), bpm=piece.bpm)
+    start = moved.notes[0].onset if start is None else start
+    # (the simulated hand is a right hand: its top notes are a left hand's lowest)
+    thinned = thin_hand(moved.shift(-start), hand, fingers, "lowest" if hand == "left" else "highest")
+    return window, reduce_hand(thinned, window.keyboard, fingers, hand), start, left_out
+
+
+def given_notes(piece: Piece, fingers: HandSpec, keyboard: KeyboardSpec | None = None) -> int | None:
+    """How many of ``piece``'s notes (each with its hand) both hands are given with ``fingers``,
+    each part as :func:`prepare_part` gives it: on ``keyboard``, default the general policy's 24
+    keys or a wider part's own octaves. None where a hand's part is refused. Nothing is said."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", PianobotWarning)
+        try:
+            return sum(
+                len(_reduced_part(piece, h, keyboard or KeyboardSpec(), fingers, None, keyboard is None)[1])
+                for h in piece.hands
+            )
+        except PianobotError:
+            return None
+
+
+def thumbs_keep_more(
+    three: Piece, thumbs: Piece | None = None, keyboard: KeyboardSpec | None = None
+) -> tuple[int, int] | None:
+    """(notes both hands are given with three fingers, with their thumbs too), where the thumbs
+    keep more of them; else None. ``three``: the piece with every note's hand as read for three
+    fingers; ``thumbs``: as read for hands with their thumbs (default the same); ``keyboard``: as
+    :func:`given_notes`'. This is how both hands choose their fingers where none are named: the
+    thumbs play wherever they keep notes that three fingers leave out (a chord wider than three
+    fingers reach, more notes at once, a passage too fast to play without one)."""
+    thumbs = three if thumbs is None else thumbs
+    given = given_notes(three, HandSpec(), keyboard)
+    if given is None or given >= len(thumbs):  # (the thumbs' reading may keep notes of a chord three fingers' thins)
+        return None
+    more = given_notes(thumbs, THUMB, keyboard)
+    return (given, more) if more is not None and more > given else None
+
+
+def fingers_for_file(path: str | Path | MidiSource, options: LoadOptions) -> tuple[HandSpec, tuple[int, int] | None]:
+    """Both hands' fingers for the file at ``path`` where none are named, as ``pianobot play``
+    chooses them: (:data:`~pianobot.music.instrument.THUMB`, (notes given with three fingers, with
+    thumbs)) where the file plays both hands read either way (:func:`two_hands`) and
+    :func:`thumbs_keep_more` says so, else (three fingers, None). Always on the default keys and
+    each player's own, whatever keys a command names, so that ``pianobot score``, which names
+    none, reads the hands as ``play`` did. A file the reading refuses keeps three fingers: that
+    reading says why. Nothing is said."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", PianobotWarning)
+        try:
+            source = open_song(path)
+            three = two_hands(source, options, HandSpec())
+            thumbs = None if three is None else two_hands(source, options, THUMB)
+        except PianobotError:
+            return HandSpec(), None
+    if three is None or thumbs is None:
+        return HandSpec(), None
+    counts = thumbs_keep_more(three.piece, thumbs.piece)
+    return (HandSpec(), None) if counts is None else (THUMB, counts)
+
+
+THUMBS_CHOSEN = "both hands play with their thumbs too: they are given {more} of the notes, three fingers {given}"
+"""The line said where :func:`thumbs_keep_more` gives both hands their thumbs (with how to choose three)."""
