@@ -102,7 +102,7 @@ def test_the_packaged_parts_policy_widens_to_a_hand_with_its_thumb(tmp_path):
         widen_policy(source, folder, (1, 2, 3, 4))
     with pytest.raises(PianobotError, match="do not add"):
         widen_policy(source, tmp_path / "same", (2, 3, 4))
-    with pytest.raises(PianobotError, match="the simulated hand has fingers 1,2,3,4"):
+    with pytest.raises(PianobotError, match="the allegro hand has fingers 1,2,3,4"):
         widen_policy(source, tmp_path / "five", (2, 3, 4, 5))
     assert not (tmp_path / "same").exists() and not (tmp_path / "five").exists()
 
