@@ -65,7 +65,9 @@ def main(argv: list[str] | None = None) -> int:
     torch.set_num_threads(1)
     import pianobot
 
-    print("| command | music (s) | `pianobot play`, end to end: s, real-time factor | in process after start-up: s, factor |")
+    print(
+        "| command | music (s) | `pianobot play`, end to end: s, real-time factor | in process after start-up: s, factor |"
+    )
     print("| --- | ---: | ---: | ---: |")
     with tempfile.TemporaryDirectory() as scratch:
         for name, (song, options) in COMMANDS.items():
