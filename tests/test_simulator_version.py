@@ -71,7 +71,9 @@ def test_a_policy_of_another_simulator_is_played_both_ways_and_the_better_kept(t
     plan = plan_performance(piece, models=models)
     (folder,) = doubted(plan, models)
     assert f"simulator v{VERSION - 1}" in doubted(plan, models)[folder]
-    with pytest.warns(PianobotWarning, match=r"played both ways, kept (it|the general policy task-melody-[0-9a-f]+) \(note F1"):
+    with pytest.warns(
+        PianobotWarning, match=r"played both ways, kept (it|the general policy task-melody-[0-9a-f]+) \(note F1"
+    ):
         performance = play(piece, models=models)
     own = plan_performance(piece, models=models)
     general = plan_performance(piece, models=models, leave_out=frozenset({ONE_NOTE}))
