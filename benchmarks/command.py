@@ -1,13 +1,15 @@
 """What a user waits for: `pianobot play` end to end, start-up included, beside the simulation alone.
 
-    python -m benchmarks.command [--runs 5]
+    python -m benchmarks.command [--runs 5] [--peer DIR]
 
 Two commands, each run ``--runs`` times as a fresh process (`python -m pianobot play ... -q`):
 one hand, the longest one-hand example (`mary.mid`, 19.2 s) with the scripted pianist; two
 hands, a two-hand chorale (`chorale-performed.mid`, 41.6 s) with the default controller (the
 packaged general policies through the hold guard). Beside each, in the same run, the same
 performance in this process after start-up (the plan performed and scored: what the command
-adds is the difference). Real-time factor: seconds of music per second of wall clock; medians.
+adds is the difference). With ``--peer DIR`` (a checkout of another pianobot commit, e.g. a
+``git worktree``), the same commands of that checkout, run in turn with ours: the ratio of the
+medians is the speed-up. Real-time factor: seconds of music per second of wall clock; medians.
 Prints a Markdown table for docs/benchmarks.md.
 """
 
@@ -29,11 +31,11 @@ COMMANDS = {
 }
 
 
-def command_seconds(song: str, options: list[str], scratch: Path) -> float:
-    """Wall-clock seconds of `pianobot play <song>` in a fresh process."""
+def command_seconds(song: str, options: list[str], scratch: Path, checkout: Path = ROOT) -> float:
+    """Wall-clock seconds of `pianobot play <song>` in a fresh process, of the package in ``checkout``."""
     args = [sys.executable, "-m", "pianobot", "play", str(EXAMPLES / song), "-o", str(scratch / "o.mid"), "-q"]
     started = time.perf_counter()
-    subprocess.run([*args, *options], check=True, capture_output=True)
+    subprocess.run([*args, *options], check=True, capture_output=True, cwd=checkout)
     return time.perf_counter() - started
 
 
@@ -59,27 +61,34 @@ def library_seconds(song: str, options: list[str]) -> float:
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--runs", type=int, default=5)
+    parser.add_argument("--peer", type=Path, default=None, help="a checkout of another commit to time beside")
     args = parser.parse_args(argv)
     import torch
 
     torch.set_num_threads(1)
     import pianobot
 
-    print(
-        "| command | music (s) | `pianobot play`, end to end: s, real-time factor | in process after start-up: s, factor |"
-    )
-    print("| --- | ---: | ---: | ---: |")
+    head = "| command | music (s) | `pianobot play`, end to end: s, real-time factor | in process after start-up: s, factor"
+    peer = " | the peer, end to end | speed-up" if args.peer else ""
+    print(f"{head}{peer} |")
+    print("| --- | ---: | ---: | ---: |" + (" ---: | ---: |" if args.peer else ""))
     with tempfile.TemporaryDirectory() as scratch:
         for name, (song, options) in COMMANDS.items():
             duration = pianobot.load_piece(EXAMPLES / song).duration
             library_seconds(song, options)  # (warm: imports and the policies' first load)
-            ends, insides = [], []
+            ends, insides, peers = [], [], []
             for _ in range(args.runs):
                 ends.append(command_seconds(song, options, Path(scratch)))
                 insides.append(library_seconds(song, options))
+                if args.peer:
+                    peers.append(command_seconds(song, options, Path(scratch), args.peer))
             end, inside = statistics.median(ends), statistics.median(insides)
+            beside = ""
+            if args.peer:
+                them = statistics.median(peers)
+                beside = f" | {them:.2f} s, {duration / them:.1f}× | {them / end:.2f}×"
             print(
-                f"| {name} | {duration:.1f} | {end:.2f} s, {duration / end:.1f}× | {inside:.2f} s, {duration / inside:.1f}× |",
+                f"| {name} | {duration:.1f} | {end:.2f} s, {duration / end:.1f}× | {inside:.2f} s, {duration / inside:.1f}×{beside} |",
                 flush=True,
             )
     return 0

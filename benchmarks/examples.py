@@ -107,16 +107,22 @@ def _f1s(entry: dict) -> str:
     return f"{f1s[0]:.3f} ×{len(f1s)}" if len(set(f1s)) == 1 else " / ".join(f"{f:.3f}" for f in f1s)
 
 
+def _who(performer: str) -> str:
+    """A performer in few words: 'own policies', 'task-parts-v2-... (hold guard)'."""
+    who = performer.removeprefix("general policy ").replace(" (both hands in one simulation)", "")
+    return who.replace(" through the hold guard", " (hold guard)")
+
+
 def tables(record: dict) -> dict[str, str]:
     """The Markdown each marker pair holds, from ``record``."""
     rows = {"phrase": [], "two-hand": []}
     for name, entry in record["examples"].items():
         seeds = list(entry["seeds"].values())
-        performers = " / ".join(dict.fromkeys(v["performer"] for v in seeds))
+        performers = " / ".join(dict.fromkeys(_who(v["performer"]) for v in seeds))
         judged = sum(bool(v["judged"]) for v in seeds)
         said = f" (judged {judged}×: policies from another simulator)" if judged else ""
         rows[entry["kind"]].append(
-            f"| `{name}.mid` ({seeds[0]['notes']} notes) | {performers}{said} | {_f1s(entry)} | "
+            f"| `{name}.mid` ({seeds[0]['notes']} note{'s' * (seeds[0]['notes'] != 1)}) | {performers}{said} | {_f1s(entry)} | "
             f"{_span([round(v['velocity_mae'], 1) for v in seeds if v['velocity_mae'] is not None])} | "
             f"{_span([v['onset_error_ms'] for v in seeds])} |"
         )
@@ -152,7 +158,11 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--check", action="store_true", help="compare with models/examples.json; write nothing")
     parser.add_argument("--only", default=None, help="these examples only (names separated by commas)")
+    parser.add_argument("--tables", action="store_true", help="write the tables from the record; play nothing")
     args = parser.parse_args(argv)
+    if args.tables:
+        write_tables(json.loads(RECORD.read_text()))
+        return 0
     names = args.only.split(",") if args.only else [*PHRASE_POLICIES, *TWO_HANDS]
     played = play_all(names)
     recorded = json.loads(RECORD.read_text())["examples"] if RECORD.exists() else {}

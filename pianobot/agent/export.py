@@ -28,7 +28,8 @@ class DeterministicPolicy(nn.Module):
 
     def __init__(self, agent: SAC):
         super().__init__()
-        self.encoder, self.actor = agent.critic.encoder, agent.actor
+        self.actor = agent.actor
+        self.encoder = agent.critic.encoder if agent.actor.reads_features else None
 
     def forward(self, vector: torch.Tensor, tactile: torch.Tensor | None = None) -> torch.Tensor:
         features = self.encoder(vector, tactile) if self.actor.reads_features else None

@@ -355,7 +355,10 @@ class SAC:
         self.config = config
         self.device = torch.device(device)
         self.training = training
-        self.critic = Critic(vector_dim, score_dim, tactile_shape, action_dim, config).to(self.device)
+        acting_alone = not training and config.actor == "fingers"  # (an actor that reads no encoder: none is built)
+        self.critic = (
+            None if acting_alone else Critic(vector_dim, score_dim, tactile_shape, action_dim, config).to(self.device)
+        )
         if config.actor == "fingers":
             if layout is None:
                 raise ValueError(
@@ -368,7 +371,8 @@ class SAC:
         self.target_entropy = -config.target_entropy_scale * action_dim
         self.updates = 0
         if not training:
-            self.critic.requires_grad_(False)
+            if self.critic is not None:
+                self.critic.requires_grad_(False)
             self.actor.requires_grad_(False)
             return
         self.target = Critic(vector_dim, score_dim, tactile_shape, action_dim, config).to(self.device)
@@ -484,7 +488,8 @@ class SAC:
     def tensors(self, with_training_state: bool = True) -> dict[str, torch.Tensor]:
         """Every tensor of the agent under a flat name. Without training state: the actor and encoder only."""
         out = {f"actor.{k}": v for k, v in self.actor.state_dict().items()}
-        out.update({f"encoder.{k}": v for k, v in self.critic.encoder.state_dict().items()})
+        if self.critic is not None:
+            out.update({f"encoder.{k}": v for k, v in self.critic.encoder.state_dict().items()})
         if with_training_state:
             out.update({f"critic.{k}": v for k, v in self.critic.state_dict().items() if not k.startswith("encoder.")})
             out.update({f"target.{k}": v for k, v in self.target.state_dict().items()})
@@ -505,6 +510,8 @@ class SAC:
             return {k[len(prefix) :]: v for k, v in tensors.items() if k.startswith(prefix)}
 
         _load_checked(self.actor, section("actor."), "actor.")
+        if self.critic is None:  # (built to act, with an actor that reads no encoder)
+            return
         _load_checked(self.critic.encoder, section("encoder."), "encoder.")
         if not with_training_state:
             return

@@ -16,7 +16,8 @@ beat it. What happens to the old folder:
 - nothing trained beat an imperfect start: nothing changes (the policy stays one of the earlier
   simulator, which ``play`` judges beside the general policy).
 
-Run it as ``python -m pianobot.learn.again models/<folder> ...`` (``--steps`` caps the budget);
+Run it as ``python -m pianobot.learn.again models/<folder> ...`` (``--steps`` caps the budget;
+``--dagger-rounds N`` imitates the scripted pianist instead, as ``pianobot train --learner dagger`` does);
 :func:`pianobot.perform.plan.plan_performance` plays a policy from an earlier simulator only
 where it plays its stretch better than the general policy.
 """
@@ -41,10 +42,13 @@ from pianobot.learn.jobs import learner
 from pianobot.music.piece import Piece
 
 
-def train_again(folder: Path, steps: int | None = None, report=lambda progress: None) -> Path:
+def train_again(
+    folder: Path, steps: int | None = None, report=lambda progress: None, dagger_rounds: int | None = None
+) -> Path:
     """Train the phrase policy in ``folder`` again on today's simulator (the module's notes);
-    ``steps``: at most this many environment steps (default: the recorded budget). Returns the
-    folder that now holds the phrase's policy."""
+    ``steps``: at most this many environment steps (default: the recorded budget);
+    ``dagger_rounds``: learn by imitating the scripted pianist (DAgger, rounds of this many steps)
+    instead of the recorded learner. Returns the folder that now holds the phrase's policy."""
     folder = Path(folder)
     manifest = store.read_manifest(folder)
     if manifest["simulator"] == VERSION:
@@ -53,8 +57,17 @@ def train_again(folder: Path, steps: int | None = None, report=lambda progress: 
     if not isinstance(target, Piece):
         raise PianobotError(f"{folder} holds a task family's policy: train the family again with pianobot train --task")
     config = config_from_manifest(manifest)
+    imitate = {}
+    if dagger_rounds is not None:
+        imitate = {"learner": "dagger", "dagger": replace(config.dagger, round_steps=dagger_rounds)}
     config = replace(
-        config, until_f1=None, from_general=True, finetune_until_f1=1.0, envs=1, steps=steps or config.steps
+        config,
+        until_f1=None,
+        from_general=True,
+        finetune_until_f1=1.0,
+        envs=1,
+        steps=steps or config.steps,
+        **imitate,
     )
     into = store.model_dir(folder.parent, manifest["key"], config)
     if into == folder:
@@ -82,6 +95,12 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m pianobot.learn.again", description=__doc__.splitlines()[0])
     parser.add_argument("folders", nargs="+", type=Path, help="phrase policy folders of a model store")
     parser.add_argument("--steps", type=int, default=None, help="at most this many steps each")
+    parser.add_argument(
+        "--dagger-rounds",
+        type=int,
+        default=None,
+        help="imitate the scripted pianist (DAgger), rounds of this many steps",
+    )
     args = parser.parse_args(argv)
     import torch
 
@@ -94,8 +113,8 @@ def main(argv: list[str] | None = None) -> int:
     for folder in args.folders:
         print(f"{folder}: training again on simulator v{VERSION}", flush=True)
         try:
-            now = train_again(folder, args.steps, report)
-        except PianobotError as e:
+            now = train_again(folder, args.steps, report, args.dagger_rounds)
+        except (PianobotError, ValueError) as e:
             print(f"{folder}: {e}", file=sys.stderr)
             continue
         if now != folder:

@@ -370,7 +370,15 @@ def plan_performance(
             "play.fallback scripted needs policies trained with train.env.world.control velocity or position",
             "play.fallback",
         )
-    return PerformancePlan(piece, replace(env, world=replace(env.world, gui=gui)), stretches, wrist_guard, hold_guard)
+    config = replace(env, world=replace(env.world, gui=gui))
+    if config.tactile and not any(_reads_touch(s.policy) for s in stretches if s.policy is not None):
+        config = replace(config, tactile=False)  # (no player reads touch: its images would be drawn for nobody)
+    return PerformancePlan(piece, config, stretches, wrist_guard, hold_guard)
+
+
+def _reads_touch(policy: Path) -> bool:
+    """Whether a stored policy's actor reads the fingertips' images (the 'fingers' actor does not)."""
+    return policy_configs(policy)[1].actor != "fingers"
 
 
 def controller_for(plan: PerformancePlan, env: PianoEnv, seed: int = 0) -> Controller:
