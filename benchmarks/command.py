@@ -44,7 +44,7 @@ def library_seconds(song: str, options: list[str]) -> float:
     import warnings
 
     import pianobot
-    from pianobot.perform.hands import read_hands
+    from pianobot.perform.together import read_hands
 
     controller = "scripted" if "scripted" in options else "sac"
     started = time.perf_counter()

@@ -21,16 +21,16 @@ writes excerpts of other chorales (:func:`write_training`: the first ``--count``
 chorales by corpus path, none of the test or validation pieces) for ``pianobot train --task parts
 --pieces out/chorales``, the recipe of the packaged thumb's policy (models/README.md).
 
-Both players play each file as ``pianobot play`` reads it (:func:`pianobot.perform.hands.two_hands`):
+Both players play each file as ``pianobot play`` reads it (:func:`pianobot.perform.together.two_hands`):
 the general policies (the packaged ones: the parts policy on both hands, through the hold guard)
 from hand start 0, and the scripted pianist; figures against the file as written, so notes the
 reduction left out (faster than the hand moves, chords wider than it reaches, more notes than it
 has fingers) count as missed. ``notes`` is the file as ``pianobot play`` reads it (a chord of
 more notes than two hands have fingers thinned), ``notes given`` how many of them the hands were
 given to play after that reduction: the most a player can strike. ``--apart`` plays each hand in a
-simulation of its own (``pianobot.perform.hands.play_hands(..., together=False)``): what the
+simulation of its own (``pianobot.perform.together.play_hands(..., together=False)``): what the
 hands lose by getting in each other's way. The hands' fingers are chosen per file as ``pianobot
-play`` chooses them (:func:`pianobot.perform.hands.fingers_for_file`: the thumbs too where they
+play`` chooses them (:func:`pianobot.perform.together.fingers_for_file`: the thumbs too where they
 keep notes three fingers leave out; the row's ``fingers``); ``--thumb`` gives each hand its thumb
 everywhere (``pianobot play --thumb``), ``--no-thumb`` three fingers everywhere; the general
 policy plays where one for that hand is packaged (else the scripted pianist alone plays);
@@ -50,11 +50,11 @@ import numpy as np
 import torch
 
 from benchmarks.hands import figures
-from pianobot.agent.general import left_hand_policy
+from pianobot.agent.general import parts_policy
 from pianobot.errors import PianobotError, PianobotWarning
 from pianobot.music.instrument import THUMB, HandSpec
 from pianobot.music.load import LoadOptions
-from pianobot.perform.hands import fingers_for_file, two_hands
+from pianobot.perform.together import fingers_for_file, two_hands
 
 EXCERPTS = (
     # (name, music21 corpus path, the parts that are the piano's staves (None: all), first measure)
@@ -187,7 +187,7 @@ def play_corpus(
         file = folder / f"{name}.mid"
         row = {"piece": name, **write_excerpt(path, parts, first, file)}
         fingers = hand if hand is not None else fingers_for_file(file, LoadOptions())[0]
-        plays = general is not None or left_hand_policy(None, None, fingers) is not None
+        plays = general is not None or parts_policy(None, None, fingers) is not None
         row["fingers"] = list(fingers.fingers)
         try:
             with warnings.catch_warnings():

@@ -1,4 +1,4 @@
-"""Two-hand pieces played with both hands (pianobot/perform/hands.py): the general policy zero-shot,
+"""Two-hand pieces played with both hands (pianobot/perform/together.py): the general policy zero-shot,
 beside the scripted pianist, against the pieces as written.
 
     python -m benchmarks.hands [--duets 50] [--seed 35] [--polyphonic 20] [--general DIR]
@@ -30,7 +30,7 @@ as ``play`` plays them, unless ``--no-hold-guard``) and by the scripted pianist;
 the keys its player takes (the general policy's 24, or a wider part's own octaves; the scripted
 pianist's own), or with ``--lowest-note``/``--keys`` on those keys for both players. Both hands
 take their thumbs where that gives them more of the notes than three fingers, as ``pianobot play``
-chooses (:func:`pianobot.perform.hands.thumbs_keep_more`; a polyphonic part: for the part alone;
+chooses (:func:`pianobot.perform.together.thumbs_keep_more`; a polyphonic part: for the part alone;
 each row's ``fingers``), everywhere with ``--thumb``, nowhere with ``--no-thumb``.
 A polyphonic part is played as ``play`` plays that hand of a two-hand file: by the parts policy (the
 packaged left hand's), the left hands and the right hands alike (``pianobot play`` of a one-hand
@@ -57,7 +57,7 @@ from pianobot.music.duets import duet_set, random_duet
 from pianobot.music.instrument import THUMB, HandSpec, KeyboardSpec
 from pianobot.music.load import LoadOptions
 from pianobot.music.piece import parse_pitch
-from pianobot.perform.hands import fingers_for_file, play_hands, two_hands
+from pianobot.perform.together import fingers_for_file, play_hands, two_hands
 
 PLAYERS = ("sac", "scripted")
 POLYPHONIC = ("block", "voices", "right-voices")
@@ -154,7 +154,7 @@ def play_set(
     parts policy, :func:`with_parts`; ``hold_guard``: the general policies through the hold guard,
     as ``pianobot play`` plays them; ``keyboard``: every part on these keys, as ``pianobot play
     --lowest-note/--keys`` plays it, else each player's own; ``hand``: each hand's fingers, as
-    ``pianobot play --thumb`` gives them; default: as :func:`~pianobot.perform.hands.play_hands`
+    ``pianobot play --thumb`` gives them; default: as :func:`~pianobot.perform.together.play_hands`
     chooses them for each piece)."""
     rows = []
     with tempfile.TemporaryDirectory() as models:
@@ -176,7 +176,7 @@ def play_set(
 def example_set(folder: Path, hand: HandSpec | None = None) -> list[tuple[str, object, HandSpec]]:
     """The files in ``folder`` that ``pianobot play`` plays with both hands, each as it reads them,
     with the hands' fingers: ``hand``'s, default as ``pianobot play`` chooses them for the file
-    (:func:`~pianobot.perform.hands.fingers_for_file`)."""
+    (:func:`~pianobot.perform.together.fingers_for_file`)."""
     out = []
     for path in sorted(folder.glob("*.mid")):
         fingers = hand if hand is not None else fingers_for_file(path, LoadOptions())[0]

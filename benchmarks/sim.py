@@ -18,7 +18,7 @@ Each figure is the median of ``--repeats`` runs on the same work:
   one-hand example, mary.mid) as ``pianobot play --controller scripted`` does after start-up;
 - play's real-time factor for both hands: the scripted pianist performing both hands of
   ``--play-hands`` (default the longest two-hand example, nocturne-performed.mid) as ``pianobot
-  play --controller scripted`` does after start-up (:func:`~pianobot.perform.hands.play_hands`:
+  play --controller scripted`` does after start-up (:func:`~pianobot.perform.together.play_hands`:
   each part mirrored, moved, reduced and fingered, both hands in one simulation, the
   performance scored);
 - tactile frames/s: the renderer alone, on every fingertip state of that performance in which
@@ -48,14 +48,14 @@ import numpy as np
 
 import pianobot.env.piano as piano
 import pianobot.sim.world as world_module
-from pianobot.env.hands import HandsEnv
 from pianobot.env.piano import EnvConfig, PianoEnv, idle_pose
+from pianobot.env.two_hands import HandsEnv
 from pianobot.errors import PianobotWarning
 from pianobot.music.instrument import KeyboardSpec
 from pianobot.music.load import load_piece
 from pianobot.music.window import Window
-from pianobot.perform.hands import play_hands, read_hands
 from pianobot.perform.perform import perform
+from pianobot.perform.together import play_hands, read_hands
 from pianobot.pianist.scripted import ScriptedPianist
 from pianobot.sim.keyboard import KeyboardConfig, KeySensor, key_x
 from pianobot.sim.tactile import TactileConfig, TactileRenderer

@@ -34,8 +34,8 @@ _API = {
     "load_policy": "pianobot.agent.policy",
     "policy_configs": "pianobot.agent.policy",
     "rollout": "pianobot.perform.rollout",
-    "play": "pianobot.perform.hands",
-    "load_two_hands": "pianobot.pianist.hands",
+    "play": "pianobot.perform.together",
+    "load_two_hands": "pianobot.pianist.assign",
     "plan_performance": "pianobot.perform.plan",
     "perform_plan": "pianobot.perform.plan",
 }

@@ -1,11 +1,11 @@
-"""Both hands in one simulation (pianobot/env/hands.py, pianobot/sim/frame.py): each hand sees
+"""Both hands in one simulation (pianobot/env/two_hands.py, pianobot/sim/frame.py): each hand sees
 itself as the one-hand environment's right hand, the left one mirrored, and plays its own part."""
 
 import numpy as np
 import pytest
 
-from pianobot.env.hands import HandsEnv, world_keyboard
 from pianobot.env.piano import EnvConfig, PianoEnv
+from pianobot.env.two_hands import HandsEnv, world_keyboard
 from pianobot.music.instrument import KeyboardSpec
 from pianobot.music.metrics import compare
 from pianobot.music.piece import Note, Piece

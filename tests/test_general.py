@@ -418,23 +418,23 @@ def test_the_packaged_left_hand_policy_plays_left_hands_only_while_the_store_has
     """The packaged `task-parts` policy is the left hand's by default, never the general policy of
     one hand; a general policy of the user's own plays both hands (none is offered then), and so
     does the packaged general policy where the left hand's cannot play the keys (fewer than its own)."""
-    from pianobot.agent.general import LEFT_KEY, general_candidates, left_hand_policy
+    from pianobot.agent.general import PARTS_KEY, general_candidates, parts_policy
     from pianobot.music.instrument import HandSpec, KeyboardSpec
 
     empty = tmp_path / "empty"
     empty.mkdir()
-    left = left_hand_policy(empty)
-    assert left is not None and left.name.startswith(f"{LEFT_KEY}-") and PACKAGED in left.resolve().parents
+    left = parts_policy(empty)
+    assert left is not None and left.name.startswith(f"{PARTS_KEY}-") and PACKAGED in left.resolve().parents
     # the packaged general policy, then the parts policies (for a hand the general policy does not fit: the thumb)
     assert [f.name.split("-")[1] for f in general_candidates(empty)] == ["melody", "parts", "parts"]
-    assert left_hand_policy(empty, hand=HandSpec((1, 2, 3, 4))) not in (None, left)  # the thumb's
-    assert left_hand_policy(empty, KeyboardSpec()) == left
-    assert left_hand_policy(empty, KeyboardSpec(lowest=36, count=36)) == left  # it plays any wider keyboard
-    assert left_hand_policy(empty, KeyboardSpec(lowest=60, count=12)) is None  # not a narrower one
-    assert left_hand_policy(models) is None  # the user's own general policy plays both hands
+    assert parts_policy(empty, hand=HandSpec((1, 2, 3, 4))) not in (None, left)  # the thumb's
+    assert parts_policy(empty, KeyboardSpec()) == left
+    assert parts_policy(empty, KeyboardSpec(lowest=36, count=36)) == left  # it plays any wider keyboard
+    assert parts_policy(empty, KeyboardSpec(lowest=60, count=12)) is None  # not a narrower one
+    assert parts_policy(models) is None  # the user's own general policy plays both hands
     # ... but not one trained for other keys: it plays neither hand here, so the left keeps its own
     (mine,) = models.iterdir()
     manifest = manifest_of(mine)
     manifest["config"]["env"]["world"]["keyboard"]["spec"] = {"lowest": 36, "count": 36}
     (mine / store.MANIFEST_FILE).write_text(json.dumps(manifest))
-    assert left_hand_policy(models, KeyboardSpec()) == left
+    assert parts_policy(models, KeyboardSpec()) == left

@@ -1,4 +1,4 @@
-"""Hand assignment by planning (pianobot.pianist.hands): small pieces with known answers."""
+"""Hand assignment by planning (pianobot.pianist.assign): small pieces with known answers."""
 
 import warnings
 from dataclasses import replace
@@ -9,7 +9,7 @@ from test_two_hands import warning_lines
 from pianobot.errors import PianobotWarning
 from pianobot.music.instrument import HandSpec
 from pianobot.music.piece import Note, Piece, parse_pitch
-from pianobot.pianist.hands import assign_hands, finger_apart, finger_hands, reaches, stands, thin_for_hands
+from pianobot.pianist.assign import assign_hands, finger_apart, finger_hands, reaches, stands, thin_for_hands
 
 
 def notes(*items, hand=None):
@@ -96,7 +96,7 @@ def test_finger_hands_needs_every_notes_hand():
 
 def test_a_two_hand_file_without_named_tracks_is_read_with_every_notes_hand(tmp_path):
     from pianobot.music.midi_io import write_midi
-    from pianobot.pianist.hands import load_two_hands
+    from pianobot.pianist.assign import load_two_hands
 
     bass = notes(("C3", 0, 1), ("G2", 1, 2))
     melody = notes(("E5", 0, 0.5), ("D5", 0.5, 1), ("C5", 1, 2))
@@ -153,7 +153,7 @@ def interleaved(count: int = 12) -> Piece:
 
 
 def fingered_parts(piece: Piece) -> dict:
-    from pianobot.perform.hands import prepare_part
+    from pianobot.perform.together import prepare_part
 
     parts = {}
     for hand in ("right", "left"):
@@ -220,9 +220,9 @@ def test_where_finger_apart_puts_a_hand_is_where_the_world_puts_it(fingers):
     """finger_apart's frames against the simulator's own (pianobot.sim.frame.HandView)."""
     import numpy as np
 
-    from pianobot.env.hands import world_keyboard
+    from pianobot.env.two_hands import world_keyboard
+    from pianobot.pianist.assign import _frame, _world_x
     from pianobot.pianist.fingering import Planner
-    from pianobot.pianist.hands import _frame, _world_x
     from pianobot.sim.frame import HandView
     from pianobot.sim.hand import FINGER_BASE_X, HandConfig
     from pianobot.sim.keyboard import KeyboardConfig

@@ -1,4 +1,4 @@
-"""Both hands of a piece played (pianobot/perform/hands.py): in one simulation and hand by hand, and the random two-hand
+"""Both hands of a piece played (pianobot/perform/together.py): in one simulation and hand by hand, and the random two-hand
 pieces they are measured on (pianobot/music/duets.py)."""
 
 import itertools
@@ -12,7 +12,7 @@ from pianobot.music.duets import TEXTURES, duet_set, random_duet
 from pianobot.music.instrument import HandSpec, KeyboardSpec, check_playable
 from pianobot.music.piece import Note, Piece
 from pianobot.music.window import Window, window_for
-from pianobot.perform.hands import play_hands
+from pianobot.perform.together import play_hands
 
 BLACK = {1, 3, 6, 8, 10}
 
@@ -114,10 +114,10 @@ def test_a_part_wider_than_the_policys_keys_is_played_whole_on_its_own_octaves()
 def test_a_policy_that_reads_no_key_count_plays_any_keyboard_of_at_least_its_keys(tmp_path):
     from dataclasses import replace
 
-    from pianobot.agent.general import LEFT_KEY, PACKAGED, find_general, plays_keyboard
+    from pianobot.agent.general import PACKAGED, PARTS_KEY, find_general, plays_keyboard
     from pianobot.agent.policy import policy_configs
 
-    env, sac = policy_configs(next(PACKAGED.glob(f"{LEFT_KEY}-*")))
+    env, sac = policy_configs(next(PACKAGED.glob(f"{PARTS_KEY}-*")))
     wide, narrow = KeyboardSpec(48, 36), KeyboardSpec(60, 12)
     assert plays_keyboard(env, sac, wide) and not plays_keyboard(env, sac, narrow)
     assert not plays_keyboard(env, replace(sac, score_input=True), wide)  # a score window's size is the keys'
@@ -223,13 +223,13 @@ def test_the_parts_familys_versions_train_into_folders_of_their_own(tmp_path):
     job.folder.mkdir()
     (job.folder / store.MANIFEST_FILE).write_text("{}")
     (job.folder / store.POLICY_FILE).write_bytes(b"")
-    assert set(store.find_policies(tmp_path, general.LEFT_KEY)) == {*older, job.folder}
+    assert set(store.find_policies(tmp_path, general.PARTS_KEY)) == {*older, job.folder}
 
 
 def test_pianobot_play_plays_both_hands_of_a_piece_with_both_and_one_hand_as_before():
     import pianobot
-    from pianobot.perform.hands import HandsPerformance
     from pianobot.perform.plan import Performance
+    from pianobot.perform.together import HandsPerformance
 
     right = [Note(0.5 * i, p, 0.5 * i + 0.4, hand="right") for i, p in enumerate([72, 74, 76])]
     both = Piece((*right, Note(0.0, 48, 0.9, hand="left")))
@@ -271,7 +271,7 @@ def test_judging_both_hands_after_training_says_a_warning_of_its_plays_once(tmp_
     import pianobot.learn.accept as accept
     from pianobot.agent.general import GENERAL_KEY, PACKAGED
     from pianobot.music.phrases import split_phrases
-    from pianobot.perform.hands import prepare_parts
+    from pianobot.perform.together import prepare_parts
 
     general = next(PACKAGED.glob(f"{GENERAL_KEY}-*"))
     right = [Note(float(i), 72 + 2 * i, i + 1.0, 80, hand="right") for i in range(3)]
@@ -307,7 +307,7 @@ def test_both_hands_take_their_thumbs_only_where_the_thumbs_keep_more_notes():
     their thumbs all four; play_hands then plays with the thumbs (said in one warning line), and
     a piece three fingers are given whole keeps three fingers, silently."""
     from pianobot.music.instrument import THUMB
-    from pianobot.perform.hands import thumbs_keep_more
+    from pianobot.perform.together import thumbs_keep_more
 
     chord = [Note(0.0, p, 2.0, 80, hand="right") for p in (72, 76, 79, 84)]
     bass = [Note(0.0, 48, 2.0, 80, hand="left"), Note(2.0, 43, 4.0, 80, hand="left")]

@@ -92,7 +92,7 @@ def test_a_note_let_go_before_its_end_is_not_pressed_again():
     """A left hand holds C3 and G3 and strikes C3 again under the held G3 (a new user's organ
     file): the pianist let go of G3 for the repeat, then pressed it again while it was still
     written to sound, a second G3 (and, with the finger off its key, an F3) that nobody wrote."""
-    from pianobot.perform.hands import play_hands
+    from pianobot.perform.together import play_hands
 
     beat = 60 / 72
 

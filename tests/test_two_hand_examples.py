@@ -10,7 +10,7 @@ import pytest
 from pianobot.errors import PianobotWarning
 from pianobot.music.load import load_hands
 from pianobot.music.midi_io import describe_tracks
-from pianobot.pianist.hands import assign_hands, finger_hands
+from pianobot.pianist.assign import assign_hands, finger_hands
 
 MIDI = Path(__file__).parent.parent / "examples" / "midi"
 TWO_HANDS = ["chorale-performed", "ode-to-joy-performed", "prelude-performed"]

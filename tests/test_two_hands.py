@@ -11,7 +11,7 @@ from pianobot.errors import PianobotWarning, SettingError
 from pianobot.music.load import LoadOptions, load_hands
 from pianobot.music.piece import Note, Piece
 from pianobot.music.pig import write_pig
-from pianobot.pianist.hands import load_two_hands
+from pianobot.pianist.assign import load_two_hands
 
 
 def warning_lines(read, *args):

@@ -46,9 +46,9 @@ folders, ``task-parts-``, ``task-parts-v2-``, ``task-parts-v3-``)."""
 PACKAGED = Path(__file__).resolve().parent.parent / "policies"
 """The policies that ship with pianobot (package data): the committed general policy (a
 ``task-melody`` folder), and the ``task-parts`` folders: the three-finger hand's policy for both
-hands of a two-hand piece (:func:`left_hand_policy`) and the thumb's (fingers 1-4), which plays
+hands of a two-hand piece (:func:`parts_policy`) and the thumb's (fingers 1-4), which plays
 every piece read for that hand."""
-LEFT_KEY = store.task_key(PARTS)
+PARTS_KEY = store.task_key(PARTS)
 """The packaged parts policies' key: the ``parts`` family's (any version), which learnt hands'
 whole parts (chords, held notes under a moving voice, bass lines)."""
 
@@ -144,14 +144,14 @@ def general_candidates(models: Path | None) -> list[Path]:
     """Every general policy there is: the newest first in ``models`` (the user's store), then the
     packaged general policy (:data:`PACKAGED`'s ``task-melody`` folder), then the packaged
     ``task-parts`` policies, which play a one-hand piece only where no policy before them fits it
-    (the packaged thumb's, for a hand with fingers 1-4; :func:`left_hand_policy` gives them both
+    (the packaged thumb's, for a hand with fingers 1-4; :func:`parts_policy` gives them both
     hands of a two-hand piece)."""
     found = _newest_first(models) if models is not None else []
-    packaged = _newest_first(PACKAGED, (GENERAL_KEY,)) + _newest_first(PACKAGED, (LEFT_KEY,))
+    packaged = _newest_first(PACKAGED, (GENERAL_KEY,)) + _newest_first(PACKAGED, (PARTS_KEY,))
     return found + [p for p in packaged if p.resolve() not in {f.resolve() for f in found}]
 
 
-def left_hand_policy(models: Path | None, keyboard: Any = None, hand: Any = HandSpec()) -> Path | None:
+def parts_policy(models: Path | None, keyboard: Any = None, hand: Any = HandSpec()) -> Path | None:
     """The general policy that plays both hands of a two-hand piece by default (one-hand pieces have
     the general policy, :func:`general_candidates`): the packaged ``parts`` policy for ``hand``'s
     fingers (a spec; default the three-finger hand), when the user's store holds no general policy
@@ -165,7 +165,7 @@ def left_hand_policy(models: Path | None, keyboard: Any = None, hand: Any = Hand
 
     if models is not None and any(fits(folder) for folder in _newest_first(Path(models))):
         return None
-    return next((folder for folder in _newest_first(PACKAGED, (LEFT_KEY,)) if fits(folder)), None)
+    return next((folder for folder in _newest_first(PACKAGED, (PARTS_KEY,)) if fits(folder)), None)
 
 
 def _newest_first(root: Path, keys: tuple[str, ...] = GENERAL_KEYS) -> list[Path]:

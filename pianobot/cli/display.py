@@ -134,7 +134,7 @@ def _figures(report: Report) -> list[str]:
 
 
 def hands_table(performance) -> Table:
-    """A two-hand performance (:class:`~pianobot.perform.hands.HandsPerformance`): the whole piece
+    """A two-hand performance (:class:`~pianobot.perform.together.HandsPerformance`): the whole piece
     and each hand, who played it and where, and its first figures."""
     table = Table(title=performance.simulated)
     columns = ("part", "played by", "played as", "notes given", "notes played", "note F1", "key-press F1 per step")
@@ -155,7 +155,7 @@ def hands_table(performance) -> Table:
 
 
 def hands_scores_table(scores) -> Table:
-    """A two-hand performance scored (:class:`~pianobot.music.hand_scores.HandsReport`): the whole
+    """A two-hand performance scored (:class:`~pianobot.music.per_hand.HandsReport`): the whole
     piece and each hand of the reference."""
     table = Table(title="the whole piece and each hand")
     for column in ("part", "notes played", "note F1", "key-press F1 per step", "fingering"):

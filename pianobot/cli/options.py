@@ -71,27 +71,20 @@ PhraseNotes = typer.Option(
 GeneralPolicy = typer.Option(
     None,
     "--general-policy",
-    help="The general policy's folder (any trained policy; default: the newest `pianobot train --task melody` or `--task parts` "
-    "policy in --models whose environment fits, else the packaged one). On a two-hand file it plays both hands "
-    "unless --left-policy names the left's (by default both hands of a two-hand file have the packaged left hand's "
-    "policy, a `--task parts` one, unless --models holds a general policy that fits).",
+    help="The general policy's folder (default: the newest that fits in --models, else the packaged one).",
 )
 PlayPhraseNotes = typer.Option(
     None,
     "--phrase-notes",
-    help=f"Most notes in one phrase (default: the longest phrases, up to {DEFAULT_MAX_NOTES} notes, whose policies are all trained).",
+    help=f"Most notes in one phrase (default: the longest, up to {DEFAULT_MAX_NOTES}, whose policies are trained).",
     min=1,
 )
 HtmlReport = typer.Option(
     None,
     "--html",
-    help="Also write a report to open in a browser, offline: every figure with what it means, the piano roll of "
-    "score against performance (fingers coloured), each note's errors; from play, also who played each phrase, "
-    "and the video and sound made with --video, --wav.",
+    help="Also write a report to open in a browser, offline.",
 )
-AllFigures = typer.Option(
-    False, "--all", help="Print every figure, each with what it means (by default the few to read first)."
-)
+AllFigures = typer.Option(False, "--all", help="Print every figure (by default the few to read first).")
 AllRows = typer.Option(False, "--all", help="List every note and phrase (by default the tables stop after 100 rows).")
 
 # -- reading a piece, once for every command that reads one ---------------------------------------
@@ -106,17 +99,17 @@ def _reading(kind, default, flag: str, text: str, panel: str = PIECE) -> tuple:
 
 # fmt: off
 READING = {  # parameter name: (type, option); the commands' --help shows them in two panels of their own
-    "track": _reading(Optional[str], None, "--track", "Read only this track (index or name), or these tracks, separated by commas (e.g. 2,3); two or more are read as a whole file is (both hands where tracks are named for them or one hand cannot play the notes); one is one hand's part; default: all tracks."),
-    "tempo": _reading(Optional[float], None, "--tempo", "Re-time the piece at this constant tempo in bpm (the paper uses 60)."),
+    "track": _reading(Optional[str], None, "--track", "Read only these tracks (indices or names, e.g. 2,3; default: all)."),
+    "tempo": _reading(Optional[float], None, "--tempo", "Re-time the piece at this tempo (bpm)."),
     "transpose": _reading(int, LoadOptions.transpose, "--transpose", "Shift every note by this many semitones."),
-    "fingering": _reading(Optional[Path], None, "--fingering", "PIG fingering file for the notes (default: <song>_fingering.txt beside the .mid, if any)."),
-    "hand_part": _reading(Optional[HandPart], None, "--hand", "Play one hand's part of a two-hand piece: right or left (tracks named for it, else split by pitch); without it, play plays both hands of a two-hand file, in one simulation."),
-    "split": _reading(str, pitch_name(LoadOptions.split), "--split", "With --hand and no track named for it: lowest note of the right hand's part."),
-    "quantize": _reading(Optional[str], None, "--quantize", "Move onsets and offsets to a grid, e.g. 1/16 (for recordings of human players)."),
-    "refinger": _reading(bool, LoadOptions.refinger, "--refinger/--no-refinger", "Replace the file's fingering with the planner's (e.g. human fingering for five fingers)."),
-    "lowest_note": _reading(Optional[str], None, "--lowest-note", f"Lowest key of the keyboard (name like C4, or MIDI number); default {pitch_name(KeyboardSpec.lowest)}, or a piece's own octaves where its notes lie off the default keys.", INSTRUMENT),
-    "keys": _reading(Optional[int], None, "--keys", f"Number of keys on the keyboard; default {KeyboardSpec.count}, or as many as a piece's own octaves need.", INSTRUMENT),
-    "thumb": _reading(Optional[bool], None, "--thumb/--no-thumb", "Let the hand use its thumb (finger 1) too, or not; default: both hands of a two-hand file use theirs where they keep notes three fingers leave out, one hand does not.", INSTRUMENT),
+    "fingering": _reading(Optional[Path], None, "--fingering", "A PIG fingering file (default: <song>_fingering.txt, if any)."),
+    "hand_part": _reading(Optional[HandPart], None, "--hand", "Only this hand's part of a two-hand piece."),
+    "split": _reading(str, pitch_name(LoadOptions.split), "--split", "Lowest note of the right hand's part, where no track names it."),
+    "quantize": _reading(Optional[str], None, "--quantize", "Move notes to a grid, e.g. 1/16 (for recordings)."),
+    "refinger": _reading(bool, LoadOptions.refinger, "--refinger/--no-refinger", "Replace the file's fingering with the planner's."),
+    "lowest_note": _reading(Optional[str], None, "--lowest-note", f"Lowest key (C4, or a MIDI number; default {pitch_name(KeyboardSpec.lowest)} or the piece's own octaves).", INSTRUMENT),
+    "keys": _reading(Optional[int], None, "--keys", f"Number of keys (default {KeyboardSpec.count} or the piece's own octaves).", INSTRUMENT),
+    "thumb": _reading(Optional[bool], None, "--thumb/--no-thumb", "Play with the thumb too (default: where it keeps more notes).", INSTRUMENT),
 }
 # fmt: on
 

@@ -32,7 +32,7 @@ leaves the default environment playing as before keeps it:
   differently: finger joints move 0.004 rad apart from v0's on average over a performance, and
   now and then a note one physics step or one velocity unit. Also added, without changing how
   a one-hand environment plays: ``length=`` and ``view=`` (one hand of a two-hand world,
-  :mod:`pianobot.env.hands`).
+  :mod:`pianobot.env.two_hands`).
 - v0: the first registered version: the whole keyboard one body; finger targets with the next
   note's velocity (``target_velocity``) that point at note onsets with the time left to hold a
   held key (``target_onsets``), both of which can be turned off to reproduce the observations
@@ -217,7 +217,7 @@ class PianoEnv(gym.Env):
     ``length``: seconds the episode's score lasts at least (the piece's duration by default; the
     rest silent). ``view``: one hand of a two-hand world, seen through its window
     (:class:`~pianobot.sim.frame.HandView`), instead of a world of its own; the world's owner
-    (:class:`~pianobot.env.hands.HandsEnv`) resets it between :meth:`draw_start` and
+    (:class:`~pianobot.env.two_hands.HandsEnv`) resets it between :meth:`draw_start` and
     :meth:`begin`, and steps it before :meth:`absorb`."""
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": WorldConfig.control_hz}
@@ -256,7 +256,7 @@ class PianoEnv(gym.Env):
         self.length = length
         self.world = view if view is not None else PianoWorld(config.world)
         self.owns_world = view is None
-        """False for one hand of a world of two (:class:`pianobot.env.hands.HandsEnv` steps and resets it)."""
+        """False for one hand of a world of two (:class:`pianobot.env.two_hands.HandsEnv` steps and resets it)."""
         self.n_fingers = len(config.world.hand.spec.fingers)
         self.n_joints = len(joint_names(config.world.hand.spec))
         keys = self.spec_score.keyboard.count

@@ -39,8 +39,8 @@ from pianobot.music.instrument import KeyboardSpec
 from pianobot.music.phrases import Phrase
 from pianobot.music.piece import Piece
 from pianobot.perform.compose import find_policy
-from pianobot.perform.hands import perform_hands
 from pianobot.perform.plan import PerformancePlan, perform_plan, stretches_for
+from pianobot.perform.together import perform_hands
 
 Key = TypeVar("Key", int, str)
 """A phrase: its number in a one-hand piece, '<hand> <number>' in a two-hand one."""
@@ -209,9 +209,9 @@ def settle_hands(
     on_play: Callable[[str], None] = lambda what: None,
 ) -> Verdict:
     """:func:`settle_piece` for a two-hand piece: the whole piece, both hands as ``pianobot play``
-    plays them (:func:`~pianobot.perform.hands.perform_hands`), is judged against the piece as
+    plays them (:func:`~pianobot.perform.together.perform_hands`), is judged against the piece as
     written, each hand's phrase policies beside that hand's general policy (``generals``).
-    ``parts``: :func:`~pianobot.perform.hands.prepare_parts`'; ``phrases`` and ``started`` by
+    ``parts``: :func:`~pianobot.perform.together.prepare_parts`'; ``phrases`` and ``started`` by
     hand. A policy that plays phrases of both hands is judged once, for all of them. The
     verdict's phrases are named '<hand> <number>'."""
     abouts = {hand: describe(general) for hand, general in generals.items()}

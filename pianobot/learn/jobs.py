@@ -146,7 +146,7 @@ def given_parts(folder: Path, env: EnvConfig, share: float = GIVEN_SHARE) -> Giv
     parts --pieces DIR``): each hand's part of every .mid file in ``folder`` (sorted by name) that
     ``pianobot play`` plays with both hands, read as ``play`` reads it (the hands named by its
     tracks or given by the fingering planner, for ``env``'s hand), and given to a player as
-    :func:`~pianobot.perform.hands.prepare_part` gives it: the left hand's mirrored, moved by
+    :func:`~pianobot.perform.together.prepare_part` gives it: the left hand's mirrored, moved by
     octaves onto ``env``'s keys (notes still off them left out), what the hand cannot reach reduced,
     fingered by the planner, from the part's own first note. Unlike ``play``, each hand is fingered
     alone (``play`` plans both hands' fingerings together to keep the wrists apart) and a part wider

@@ -63,7 +63,7 @@ class TrainingPlan:
     phrases: dict[str | None, list[Phrase]] = field(default_factory=dict)
     """Each hand's phrases (None: a one-hand piece's)."""
     parts: dict[str, tuple] | None = None
-    """A two-hand piece: each hand's part as ``play`` gives it (:func:`~pianobot.perform.hands.prepare_parts`)."""
+    """A two-hand piece: each hand's part as ``play`` gives it (:func:`~pianobot.perform.together.prepare_parts`)."""
     offered: dict[str | None, Path | None] = field(default_factory=dict)
     """The general policy ``play`` gives each hand of a two-hand piece."""
     keyboard: KeyboardSpec | None = None
@@ -120,11 +120,11 @@ def hand_groups(
     keys_named: bool = False,
 ) -> tuple[dict, dict, dict, list[TrainingGroup]]:
     """A two-hand piece's training, hand by hand: (each hand's part as ``play`` gives it to that hand
-    (:func:`~pianobot.perform.hands.prepare_parts`), its phrases, the general policy ``play`` gives
+    (:func:`~pianobot.perform.together.prepare_parts`), its phrases, the general policy ``play`` gives
     it, and the groups to train). ``base``: the run's config before a start policy was picked. A
     phrase both hands play is one job, in the right hand's group."""
     from pianobot.agent.general import find_general
-    from pianobot.perform.hands import hand_players, prepare_parts
+    from pianobot.perform.together import hand_players, prepare_parts
 
     parts = prepare_parts(
         piece, keyboard, fingers, grow=not keys_named

@@ -221,7 +221,7 @@ def load_hands(path: str | Path | midi_io.MidiSource, options: LoadOptions = Loa
     """A two-hand piece (a .mid file, or a PIG .txt file with both hands' notes), each note with
     the hand its track's name says, else the channel of its note in the PIG fingering sidecar (or
     the PIG file's), None where nothing says (the fingering planner then gives it one:
-    :func:`pianobot.pianist.hands.load_two_hands`).
+    :func:`pianobot.pianist.assign.load_two_hands`).
 
     Bad input, in one line: notes beyond the piano's 88 keys are refused (:class:`SettingError`
     naming the setting that helps). Said in one warning each: hands that cross (the robot's two

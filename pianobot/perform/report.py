@@ -240,11 +240,11 @@ def _phrases_table(stretches: list[Section]) -> str:
 
 
 def _hands_section(performance, reading) -> str:
-    """Each hand of a two-hand performance (:class:`~pianobot.perform.hands.HandsPerformance`):
+    """Each hand of a two-hand performance (:class:`~pianobot.perform.together.HandsPerformance`):
     who played it, where, what it was given, its figures, what was left out or reduced."""
     from html import escape
 
-    from pianobot.perform.hands import AGAINST
+    from pianobot.perform.together import AGAINST
 
     head = "".join(
         f"<th>{h}</th>"
@@ -277,7 +277,7 @@ def _hands_section(performance, reading) -> str:
 
 
 def _scores_section(scores) -> str:
-    """Each hand of a two-hand reference, scored (:class:`~pianobot.music.hand_scores.HandsReport`)."""
+    """Each hand of a two-hand reference, scored (:class:`~pianobot.music.per_hand.HandsReport`)."""
     from html import escape
 
     head = "".join(f"<th>{h}</th>" for h in ("part", "notes played", "note F1", "key-press F1 per step", "fingering"))
@@ -324,9 +324,9 @@ def html_report(
     they mean, the video (with its sound) and the audio when given, the piano roll of the score
     against what was played, each note's velocity and timing errors, who played each phrase
     (``plan``: a :class:`~pianobot.perform.plan.PerformancePlan`) and every note; for a two-hand
-    performance (``hands``: a :class:`~pianobot.perform.hands.HandsPerformance`, ``reading``
+    performance (``hands``: a :class:`~pianobot.perform.together.HandsPerformance`, ``reading``
     what the file named) or a two-hand reference scored (``scores``: a
-    :class:`~pianobot.music.hand_scores.HandsReport`), each hand."""
+    :class:`~pianobot.music.per_hand.HandsReport`), each hand."""
     from html import escape
 
     stretches = sections(plan) if plan is not None else []

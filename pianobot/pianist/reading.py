@@ -37,8 +37,8 @@ from pianobot.music.load import LoadOptions, end_legato, load_hands, load_part, 
 from pianobot.music.midi_io import MidiSource, TrackInfo, source_path
 from pianobot.music.piece import HANDS, Note, Piece, pitch_name
 from pianobot.music.window import Window, window_for
+from pianobot.pianist.assign import load_two_hands, reduce_hand
 from pianobot.pianist.fingering import FingeringPlan, ensure_fingering
-from pianobot.pianist.hands import load_two_hands, reduce_hand
 from pianobot.pianist.reduce import load_for_hand
 
 Source = Path | MidiSource
@@ -238,7 +238,7 @@ def finger_read(read: ReadPiece, options: LoadOptions, wording: Wording = Wordin
 class HandsReading:
     """A two-hand file as read for both hands: every note with its hand, and how many of each
     hand's notes the file named (its tracks' names, or a PIG file's channels) rather than the
-    fingering planner (:func:`~pianobot.pianist.hands.assign_hands`)."""
+    fingering planner (:func:`~pianobot.pianist.assign.assign_hands`)."""
 
     piece: Piece
     named: dict[str, int]
@@ -273,7 +273,7 @@ class HandsReading:
 def read_hands(
     path: str | Path | MidiSource, options: LoadOptions = LoadOptions(), spec: HandSpec = HandSpec()
 ) -> HandsReading:
-    """Both hands of the file at ``path``: :func:`~pianobot.pianist.hands.load_two_hands` (its
+    """Both hands of the file at ``path``: :func:`~pianobot.pianist.assign.load_two_hands` (its
     warnings and its one-line refusals), with what the file named."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", PianobotWarning)  # said by load_two_hands

@@ -13,7 +13,7 @@ every octave and are symmetric about D, and the left hand's links are the right'
 A view offers what the environment reads of a one-hand world (the wrist, the joints, fingertip
 points and forces, link poses, key angles, the keys' boxes and the keyboard's width), each in
 the view's frame; stepping and resetting the world belong to the world's owner
-(:class:`pianobot.env.hands.HandsEnv`), which turns each hand's action and start into the
+(:class:`pianobot.env.two_hands.HandsEnv`), which turns each hand's action and start into the
 world's with :meth:`HandView.world_action` and :meth:`HandView.world_wrist`, and each step's
 result into the hand's with :meth:`HandView.result`.
 """

@@ -14,7 +14,7 @@ from music21 import corpus
 from benchmarks.corpus import EXCERPTS, VALIDATION, write_excerpt
 from pianobot.music.instrument import THUMB
 from pianobot.music.load import LoadOptions
-from pianobot.perform.hands import two_hands
+from pianobot.perform.together import two_hands
 
 warnings.simplefilter("ignore")
 used = {path for _, path, *_ in EXCERPTS + VALIDATION} | {"bach/bwv846"}

@@ -13,7 +13,7 @@ from pianobot.cli.app import app
 from pianobot.errors import PianobotError
 from pianobot.music.instrument import check_playable
 from pianobot.music.piece import HANDS
-from pianobot.perform.hands import prepare_part
+from pianobot.perform.together import prepare_part
 
 share = float(sys.argv.pop(1))
 with open("out/s23/chorales.pkl", "rb") as f:

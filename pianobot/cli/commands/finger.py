@@ -33,8 +33,8 @@ def finger(
     from pianobot.music.instrument import check_playable
     from pianobot.music.midi_io import write_midi
     from pianobot.music.phrases import split_phrases
+    from pianobot.pianist.assign import finger_hands
     from pianobot.pianist.fingering import ensure_fingering
-    from pianobot.pianist.hands import finger_hands
 
     check_midi_output(output, song, "the fingered piece")
     check_files({"the input": song, "the fingering file": reading.options.fingering}, {"-o": output})

@@ -187,7 +187,7 @@ def _summary(piece, tempi: list[float] | None = None) -> tuple[str, dict]:
 
 def _both_hands(console, reading, tracks, json_path, tempi=None) -> None:
     """What `inspect` says of a file `play` plays with both hands: each hand in play's words."""
-    from pianobot.perform.hands import TOGETHER
+    from pianobot.perform.together import TOGETHER
 
     line, data = _summary(reading.piece, tempi)
     console.print(line)

@@ -48,74 +48,57 @@ def progress(what: str):
 
 SONG_OPTION = typer.Argument(
     ...,
-    help="The piece to play: a .mid file (or a PIG .txt file); notes without fingering are fingered by the planner.",
+    help="The piece: a .mid file or a PIG .txt file (unfingered notes are fingered by the planner).",
 )
-OUTPUT_OPTION = typer.Option(..., "--output", "-o", help="Write what the simulated piano sounded to this .mid file.")
+OUTPUT_OPTION = typer.Option(..., "--output", "-o", help="The .mid file of what was played.")
 CONTROLLER_OPTION = typer.Option(
     CONTROLLERS[0],
     "--controller",
-    help="Who plays: 'sac' (each phrase's trained policy, else the general policy), 'scripted' (the hand-written pianist) or 'random'.",
+    help="Who plays: 'sac' (the trained policies), 'scripted' (the hand-written pianist) or 'random'.",
 )
 FALLBACK_OPTION = typer.Option(
     None,
     "--fallback",
-    help="'scripted': play phrases that have no trained policy with the scripted pianist (when no general policy "
-    "plays them: a phrase's own policy first, then the general policy, then the fallback).",
+    help="Who plays a phrase no policy plays.",
 )
 USE_GENERAL_OPTION = typer.Option(
     True,
     "--general/--no-general",
-    help="Play phrases without a policy of their own with the general policy (--general-policy, else the newest "
-    "`pianobot train --task melody` or `--task parts` policy in --models, else the packaged one), when there is one.",
+    help="Let the general policy play phrases without a policy of their own.",
 )
 LEFT_POLICY_OPTION = typer.Option(
     None,
     "--left-policy",
-    help="On a two-hand file, the general policy that plays the left hand (default: --general-policy when given, "
-    "else the newest general policy in --models, else the packaged left hand's policy, a `--task parts` one; "
-    "the right hand has --general-policy, or the newest general policy in --models, or the packaged left hand's "
-    "policy too; one-hand files have the general policy).",
+    help="The left hand's general policy (default: the right hand's).",
 )
 WRIST_GUARD_OPTION = typer.Option(
     False,
     "--wrist-guard/--no-wrist-guard",
-    help="While a fingertip is low over the keys, the general policy's wrist slides no faster than the scripted "
-    "pianist's does while holding a key (PianistTuning.hold_slide, 8 mm a step), so that a late release drags a "
-    "finger across the keys less often (no effect on a policy trained with a discrete wrist).",
+    help="Slow the general policy's wrist while a fingertip is low (docs/play.md).",
 )
 HOLD_GUARD_OPTION = typer.Option(
     None,  # PerformancePlan.hold_guard (a test holds them equal; the plan module is slow to import)
     "--hold-guard/--no-hold-guard",
-    help="While a finger holds a written note, the scripted pianist moves that finger (it keeps the key down until "
-    "the note ends, or until its own plan needs the finger for the next note) and the general policy the rest of "
-    "the hand. Default: for a general policy trained on hands' parts (`--task parts`: the packaged left hand's "
-    "policy), not for a melody policy (`--task melody`, which plays melodies better alone); --hold-guard: for "
-    "every general policy; --no-hold-guard: for none. Phrase policies always play alone; no effect on a policy "
-    "without finger targets or with torque control.",
+    help="The scripted pianist holds written notes for the general policy (default: for `--task parts` policies; docs/play.md).",
 )
 SEED_OPTION = typer.Option(
     0,
     "--seed",
-    help="Seed of the simulation (the hand's start position) and of the random controller.",
+    help="Seed of the hand's start position (and of 'random').",
     min=0,
 )
 SOUNDFONT_OPTION = typer.Option(
     None,
     "--soundfont",
-    help="A General MIDI .sf2 soundfont for --wav and --video's sound (FluidSynth; default: an installed one, "
-    "else sine waves).",
+    help="A .sf2 soundfont for the sound (default: an installed one, else sine waves).",
 )
 JSON_PATH_OPTION = typer.Option(
     None,
     "--json",
-    help="Also write the report (who played, every figure, every note) to this JSON file ('-': standard output).",
+    help="Also write the report to this JSON file ('-': standard output).",
 )
-NOTES_OPTION = typer.Option(
-    0, "--notes", min=0, help="Print the per-note table's first N rows (the report file has every note)."
-)
-QUIET_OPTION = typer.Option(
-    False, "--quiet", "-q", help="Print only where the files went (and warnings and errors): no figures, no tables."
-)
+NOTES_OPTION = typer.Option(0, "--notes", min=0, help="Print the first N rows of the per-note table.")
+QUIET_OPTION = typer.Option(False, "--quiet", "-q", help="Print only where the files went, warnings and errors.")
 
 
 @reads()
@@ -123,7 +106,7 @@ def play(
     song: Path = SONG_OPTION,
     output: Path = OUTPUT_OPTION,
     controller: Controller = CONTROLLER_OPTION,
-    models: Path = typer.Option(DEFAULT_STORE, "--models", help="Folder of the model store (for --controller sac)."),
+    models: Path = typer.Option(DEFAULT_STORE, "--models", help="The model store's folder."),
     fallback: Optional[Fallback] = FALLBACK_OPTION,
     use_general: bool = USE_GENERAL_OPTION,
     general_policy: Optional[Path] = GeneralPolicy,
@@ -132,10 +115,10 @@ def play(
     hold_guard: Optional[bool] = HOLD_GUARD_OPTION,
     phrase_notes: Optional[int] = PlayPhraseNotes,
     seed: int = SEED_OPTION,
-    video: Optional[Path] = typer.Option(None, "--video", help="Also record the performance to this .mp4 file."),
-    wav: Optional[Path] = typer.Option(None, "--wav", help="Also synthesise what was played to this .wav file."),
+    video: Optional[Path] = typer.Option(None, "--video", help="Also record a video (.mp4)."),
+    wav: Optional[Path] = typer.Option(None, "--wav", help="Also write the sound (.wav)."),
     soundfont: Optional[Path] = SOUNDFONT_OPTION,
-    gui: bool = typer.Option(False, "--gui", help="Show the simulation in a PyBullet window (needs a display)."),
+    gui: bool = typer.Option(False, "--gui", help="Show the simulation in a window."),
     html: Optional[Path] = HtmlReport,
     json_path: Optional[Path] = JSON_PATH_OPTION,
     notes: int = NOTES_OPTION,
@@ -337,8 +320,8 @@ def play_one(
 def play_both(
     song: Path, output: Path, reading, *, controller, models, seed, keyboard, hand, options, files, shown
 ) -> None:
-    """`play` of a two-hand file (``reading``: a :class:`~pianobot.perform.hands.HandsReading`):
-    both hands in one simulation (:func:`~pianobot.perform.hands.play_hands`), one
+    """`play` of a two-hand file (``reading``: a :class:`~pianobot.perform.together.HandsReading`):
+    both hands in one simulation (:func:`~pianobot.perform.together.play_hands`), one
     track per hand in ``output``, and the report of the whole piece and each hand (``hand``: both
     hands' fingers, as the reading chose them: :func:`~pianobot.pianist.reading.choose_fingers`)."""
     import warnings
@@ -347,7 +330,7 @@ def play_both(
     from pianobot.errors import PianobotWarning
     from pianobot.music.midi_io import write_midi
     from pianobot.perform.audio import write_wav
-    from pianobot.perform.hands import AGAINST, TOGETHER, play_hands
+    from pianobot.perform.together import AGAINST, TOGETHER, play_hands
 
     console, quiet = shown["console"], shown["quiet"]
     if not quiet:

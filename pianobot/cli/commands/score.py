@@ -47,8 +47,8 @@ def score(
     A two-hand reference (as `play` reads it) is scored as a whole and for each hand."""
     from pianobot.cli import display
     from pianobot.music import midi_io
-    from pianobot.music.hand_scores import compare_hands
     from pianobot.music.metrics import plot_report
+    from pianobot.music.per_hand import compare_hands
 
     if not 0 < onset_tolerance <= 1:
         raise PianobotError(f"--onset-tolerance {onset_tolerance}: give seconds between 0 and 1, e.g. 0.05")

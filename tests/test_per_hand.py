@@ -1,9 +1,9 @@
-"""Scoring a two-hand performance as a whole and hand by hand (pianobot.music.hand_scores)."""
+"""Scoring a two-hand performance as a whole and hand by hand (pianobot.music.per_hand)."""
 
 import pytest
 
-from pianobot.music.hand_scores import compare_hands
 from pianobot.music.metrics import compare
+from pianobot.music.per_hand import compare_hands
 from pianobot.music.piece import Note, Piece
 
 

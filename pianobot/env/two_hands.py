@@ -21,7 +21,7 @@ also the world's key events with the finger and hand of each strike.
 
 Version: :data:`pianobot.env.VERSION`, as :mod:`pianobot.env.piano`'s (v1 the first with two
 hands, on v1's physics); no id is registered with gymnasium (a two-hand piece's parts need the fingering planner and the windows, above this layer:
-:func:`pianobot.perform.hands.play_hands` builds one).
+:func:`pianobot.perform.together.play_hands` builds one).
 """
 
 from __future__ import annotations

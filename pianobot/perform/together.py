@@ -15,7 +15,7 @@ Notes outside the window (only where ``--lowest-note``/``--keys`` name the keys)
 (:func:`~pianobot.pianist.reduce.reduce_part`), each kind of change said in one warning line; the
 figures are always against the piece as written, so what was left out counts as missed.
 
-By default both hands then play in one simulation (:class:`~pianobot.env.hands.HandsEnv`): two
+By default both hands then play in one simulation (:class:`~pianobot.env.two_hands.HandsEnv`): two
 hands on one keyboard of the keys both windows need, each player seeing its hand through its
 window, the hands kept apart by the world (the right wrist at least a hand's thumb reach above
 the left; their links collide), a key struck by one sounding for both. Where that cannot be
@@ -35,17 +35,17 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Callable
 
-from pianobot.agent.general import left_hand_policy
+from pianobot.agent.general import parts_policy
 from pianobot.errors import PianobotError, PianobotWarning, SettingError
-from pianobot.music.hand_scores import HandsReport, compare_hands
 from pianobot.music.instrument import THUMB, HandSpec, KeyboardSpec
 from pianobot.music.metrics import Report
+from pianobot.music.per_hand import HandsReport, compare_hands
 from pianobot.music.piece import FINGER_NAMES, HANDS, Piece
 from pianobot.music.window import Window
 from pianobot.perform import compose, plan
 from pianobot.perform.plan import Performance
 from pianobot.perform.rollout import Rollout
-from pianobot.pianist.hands import finger_apart
+from pianobot.pianist.assign import finger_apart
 from pianobot.pianist.reading import (  # noqa: F401 (the reading, pianist/reading.py's: these names kept here too)
     THUMBS_CHOSEN,
     HandsReading,
@@ -63,7 +63,7 @@ from pianobot.pianist.reading import (  # noqa: F401 (the reading, pianist/readi
 APART = "each hand in a simulation of its own"
 """How both hands play with ``together=False``: said wherever such a performance is reported."""
 TOGETHER = "both hands in one simulation"
-"""How both hands play by default (:class:`~pianobot.env.hands.HandsEnv`)."""
+"""How both hands play by default (:class:`~pianobot.env.two_hands.HandsEnv`)."""
 AGAINST = "figures against the piece as read from the file (notes left out or reduced for a hand count as missed)"
 """What the figures of both hands are against: the file's notes, but for a chord of more notes than both
 hands have fingers, thinned as the file is read (said in its own line)."""
@@ -141,7 +141,7 @@ class HandsPerformance:
     played: Piece = field(init=False)
     """What both keyboards sounded, as one piece at the written pitches, each note with its hand."""
     scores: HandsReport = field(init=False, repr=False, compare=False)
-    """The figures for the whole piece and each hand (:func:`~pianobot.music.hand_scores.compare_hands`)."""
+    """The figures for the whole piece and each hand (:func:`~pianobot.music.per_hand.compare_hands`)."""
 
     def __post_init__(self) -> None:
         played = Piece(tuple(n for h in self.hands for n in h.played.notes), self.piece.bpm)
@@ -350,12 +350,12 @@ def _hand_options(options: dict, hand: str) -> dict:
 
 
 def _parts_default(options: dict, models, keyboard: KeyboardSpec, fingers: HandSpec) -> dict:
-    """A hand's options with the packaged parts policy (:func:`~pianobot.agent.general.left_hand_policy`:
+    """A hand's options with the packaged parts policy (:func:`~pianobot.agent.general.parts_policy`:
     each hand's of a two-hand piece) where none was named for it (``general_policy`` for both
     hands, or by hand) and the general policy may play."""
     if not options.get("general", True) or options.get("general_policy") is not None:
         return options
-    policy = left_hand_policy(Path(models) if models is not None else plan.DEFAULT_MODELS, keyboard, fingers)
+    policy = parts_policy(Path(models) if models is not None else plan.DEFAULT_MODELS, keyboard, fingers)
     return options if policy is None else {**options, "general_policy": policy}
 
 
@@ -366,8 +366,8 @@ class HandsApart(Exception):
 def _play_together(
     piece: Piece, parts: dict, plans: dict[str, plan.PerformancePlan], seed: int, on_step: Callable | None, video: bool
 ) -> HandsPerformance:
-    """Both hands' plans played in one :class:`~pianobot.env.hands.HandsEnv` from hand start ``seed``."""
-    from pianobot.env.hands import HandsEnv  # (the simulator loads only when something plays)
+    """Both hands' plans played in one :class:`~pianobot.env.two_hands.HandsEnv` from hand start ``seed``."""
+    from pianobot.env.two_hands import HandsEnv  # (the simulator loads only when something plays)
     from pianobot.sim.recorder import NoteRecorder
 
     try:
