@@ -3,7 +3,8 @@ beside the scripted pianist, against the pieces as written.
 
     python -m benchmarks.hands [--duets 50] [--seed 35] [--polyphonic 20] [--general DIR]
                                [--general-left DIR] [--parts DIR] [--apart] [--hold-guard | --no-hold-guard]
-                               [--examples [FOLDER]] [--lowest-note C2 --keys 48] [--thumb | --no-thumb]
+                               [--examples [FOLDER]] [--lowest-note C2 --keys 48]
+                               [--thumb | --no-thumb | --hand-model pianist]
                                [--json out.json]
 
 (``python -m benchmarks.zeroshot --sets duets polyphonic`` plays the same sets beside the
@@ -58,6 +59,7 @@ from pianobot.music.instrument import THUMB, HandSpec, KeyboardSpec
 from pianobot.music.load import LoadOptions
 from pianobot.music.piece import parse_pitch
 from pianobot.perform.together import fingers_for_file, play_hands, two_hands
+from pianobot.sim.hand import HAND_MODELS, default_fingers
 
 PLAYERS = ("sac", "scripted")
 POLYPHONIC = ("block", "voices", "right-voices")
@@ -109,28 +111,29 @@ def polyphonic_set(seed: int, count: int) -> list[tuple[str, object]]:
     return out
 
 
-def table(name: str, rows: list[dict]) -> str:
+def table(name: str, rows: list[dict], players=PLAYERS) -> str:
     def mean(player: str, key: str) -> str:
         values = [r[player][key] for r in rows if key in r[player]]
         return f"{np.mean(values):.3f}" if values else "–"
 
-    general = np.mean([r["sac"]["f1"] for r in rows])
-    scripted = np.mean([r["scripted"]["f1"] for r in rows])
     lines = [
         f"**{name}** ({len(rows)} pieces, {sum(r['notes'] for r in rows)} notes)",
         "",
         "| player | note F1 | right hand | left hand | per-step F1 | note F1 with offsets | notes left out | pieces at F1 ≥ 0.9 |",
         "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |",
     ]
-    for player in PLAYERS:
+    for player in players:
         at = sum(r[player]["f1"] >= 0.9 for r in rows)
         lines.append(
             f"| {NAMES[player]} | {mean(player, 'f1')} | {mean(player, 'f1_right')} | {mean(player, 'f1_left')} | "
             f"{mean(player, 'step_f1')} | {mean(player, 'f1_offsets')} | "
             f"{sum(r[player]['left_out'] for r in rows)} | {at}/{len(rows)} |"
         )
-    lines += ["", f"general / scripted: {general / scripted:.1%}", ""]
-    return "\n".join(lines)
+    if "sac" in players:
+        general = np.mean([r["sac"]["f1"] for r in rows])
+        scripted = np.mean([r["scripted"]["f1"] for r in rows])
+        lines += ["", f"general / scripted: {general / scripted:.1%}"]
+    return "\n".join(lines + [""])
 
 
 def with_parts(piece, general, parts):
@@ -149,8 +152,9 @@ def play_set(
     hold_guard: bool | None = None,
     keyboard: KeyboardSpec | None = None,
     hand: HandSpec | None = None,
+    players=PLAYERS,
 ) -> list[dict]:
-    """Every piece of a set played by both players: one row of figures per piece (``parts``: the
+    """Every piece of a set played by ``players`` (both): one row of figures per piece (``parts``: the
     parts policy, :func:`with_parts`; ``hold_guard``: the general policies through the hold guard,
     as ``pianobot play`` plays them; ``keyboard``: every part on these keys, as ``pianobot play
     --lowest-note/--keys`` plays it, else each player's own; ``hand``: each hand's fingers, as
@@ -165,11 +169,11 @@ def play_set(
             row.update(
                 {
                     player: figures(piece, player, models, policies, together, hold_guard, 0, keyboard, hand=hand)
-                    for player in PLAYERS
+                    for player in players
                 }
             )
             rows.append(row)
-            print(f"{label}: general {row['sac']['f1']:.3f}, scripted {row['scripted']['f1']:.3f}", flush=True)
+            print(f"{label}: " + ", ".join(f"{NAMES[p]} {row[p]['f1']:.3f}" for p in players), flush=True)
     return rows
 
 
@@ -188,24 +192,30 @@ def example_set(folder: Path, hand: HandSpec | None = None) -> list[tuple[str, o
     return out
 
 
-def play_examples(pieces, general=None, hold_guard: bool | None = None, starts=EXAMPLE_STARTS) -> list[dict]:
+def play_examples(
+    pieces, general=None, hold_guard: bool | None = None, starts=EXAMPLE_STARTS, players=PLAYERS
+) -> list[dict]:
     """Each two-hand example (:func:`example_set`'s: with its hands' fingers) as ``pianobot play``
     plays it: the general policies from each of ``starts`` (hand starts: ``--seed``), the scripted
     pianist from 0; each play's figures."""
     rows = []
     with tempfile.TemporaryDirectory() as models:
         for label, piece, hand in pieces:
-            general_figures = [figures(piece, "sac", models, general, True, hold_guard, s, hand=hand) for s in starts]
+            general_figures = [
+                figures(piece, "sac", models, general, True, hold_guard, s, hand=hand)
+                for s in starts
+                if "sac" in players
+            ]
             scripted = figures(piece, "scripted", models, hand=hand)
             rows.append({"piece": label, "notes": len(piece), "sac": general_figures, "scripted": scripted})
-            f1s = ", ".join(f"{f['f1']:.3f}" for f in general_figures)
+            f1s = ", ".join(f"{f['f1']:.3f}" for f in general_figures) or "-"
             print(f"{label}: general {f1s}; scripted {scripted['f1']:.3f}", flush=True)
     return rows
 
 
 def example_table(rows: list[dict], starts=EXAMPLE_STARTS) -> str:
     def mean(row: dict, key: str) -> float:
-        return float(np.mean([f[key] for f in row["sac"]]))
+        return float(np.mean([f[key] for f in row["sac"]])) if row["sac"] else float("nan")
 
     lines = [
         f"**two-hand examples** (against each file; the general policies from hand starts {', '.join(map(str, starts))})",
@@ -225,7 +235,7 @@ def example_table(rows: list[dict], starts=EXAMPLE_STARTS) -> str:
             f"| mean | | | {np.mean(means):.3f} | {np.mean([mean(r, 'step_f1') for r in rows]):.3f} | "
             f"{np.mean([r['scripted']['f1'] for r in rows]):.3f} | {np.mean([r['scripted']['step_f1'] for r in rows]):.3f} |"
         )
-        every = sum(min(f["f1"] for f in r["sac"]) >= 0.9 for r in rows)
+        every = sum(bool(r["sac"]) and min(f["f1"] for f in r["sac"]) >= 0.9 for r in rows)
         lines += ["", f"examples at note F1 0.9 or more from every hand start: {every} of {len(rows)}", ""]
     return "\n".join(lines)
 
@@ -270,9 +280,18 @@ def main() -> None:
     fingers = parser.add_mutually_exclusive_group()
     fingers.add_argument("--thumb", action="store_true", help="each hand with its thumb too (as play --thumb)")
     fingers.add_argument("--no-thumb", action="store_true", help="three fingers on each hand (as play --no-thumb)")
+    fingers.add_argument(
+        "--hand-model",
+        choices=tuple(HAND_MODELS),
+        help="each hand this model with its fingers (as play --hand-model); one no general policy is packaged for "
+        "(the pianist's hand) is played by the scripted pianist only",
+    )
     parser.add_argument("--json", help="write every piece's figures here")
     args = parser.parse_args()
     hand = THUMB if args.thumb else HandSpec() if args.no_thumb else None  # (None: as play_hands chooses)
+    players = PLAYERS
+    if args.hand_model is not None and args.hand_model != HandSpec.model:
+        hand, players = default_fingers(args.hand_model), ("scripted",)
     if (args.lowest_note is None) != (args.keys is None):
         parser.error("--lowest-note and --keys go together")
     keyboard = KeyboardSpec(args.lowest_note, args.keys) if args.keys is not None else None
@@ -287,11 +306,11 @@ def main() -> None:
         if not pieces:
             continue
         general = {"right": args.general, "left": args.general_left} if args.general_left else args.general
-        results[name] = play_set(pieces, general, not args.apart, args.parts, args.hold_guard, keyboard, hand)
-        print(table(name, results[name]), flush=True)
+        results[name] = play_set(pieces, general, not args.apart, args.parts, args.hold_guard, keyboard, hand, players)
+        print(table(name, results[name], players), flush=True)
     if args.examples is not None:
         general = {"right": args.general, "left": args.general_left} if args.general_left else args.general
-        results["examples"] = play_examples(example_set(args.examples, hand), general, args.hold_guard)
+        results["examples"] = play_examples(example_set(args.examples, hand), general, args.hold_guard, players=players)
         print(example_table(results["examples"]), flush=True)
     print(f"{time.perf_counter() - started:.0f} s")
     if args.json:

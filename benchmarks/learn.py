@@ -26,7 +26,7 @@ from pianobot.agent.policy import load_policy, make_agent
 from pianobot.env.piano import EnvConfig
 from pianobot.learn.config import TrainConfig, config_from_manifest
 from pianobot.learn.train import TASK_EVAL_EPISODES, best_policy_tensors, evaluate, make_env, train_policy
-from pianobot.sim.world import CONTROL_MODES, WorldConfig
+from pianobot.sim.world_config import CONTROL_MODES, WorldConfig
 
 CHECK_SEED = 20_000
 """Seeds of the held-out check's instances (the training evaluations use 10000, 10001, ...)."""

@@ -561,7 +561,7 @@ def test_committed_policies_play_their_example_from_a_fresh_checkout(tmp_path, s
         result = run("play", song, "-o", tmp_path / "o.mid", "--controller", "sac", "--models", MODELS, "--seed", seed)
         assert result.exit_code == 0, result.output
         report = json.loads((tmp_path / "o.report.json").read_text())
-        judged = "played both ways" in result.output  # (a policy of another simulator: plan.perform_judged)
+        judged = "played both ways" in result.output  # (a policy of another simulator: judge.perform_judged)
         assert judged or all(source.startswith("own policy ") for source in report["phrases"].values())
         f1s.append(report["f1"])
     assert sum(f1s) / 3 >= 0.9, f1s

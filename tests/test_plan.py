@@ -101,7 +101,7 @@ def test_a_phrase_policy_that_makes_the_piece_worse_is_not_used(tmp_path):
     import torch
 
     from pianobot.learn.accept import JUDGE_SEEDS, settle_piece
-    from pianobot.perform.plan import play
+    from pianobot.perform.judge import play_one_hand as play
 
     mary = pianobot.load_piece(EXAMPLES / "mary.mid")
     piece = Piece(mary.notes[:12], bpm=mary.bpm)  # two phrases

@@ -17,7 +17,8 @@ from pianobot.agent import store
 from pianobot.agent.general import describe
 from pianobot.env import VERSION, env_id
 from pianobot.errors import PianobotWarning
-from pianobot.perform.plan import Player, doubted, plan_performance, play
+from pianobot.perform.judge import doubted, play_one_hand
+from pianobot.perform.plan import Player, plan_performance
 
 ROOT = Path(__file__).parent.parent
 ONE_NOTE = "5755063dc478979f-080639abf744"  # the committed one-note policy: plays its phrase on this simulator
@@ -61,7 +62,7 @@ def test_a_policy_of_this_simulator_plays_as_it_is(tmp_path):
     piece = pianobot.load_piece(PIECE)
     with warnings.catch_warnings():
         warnings.simplefilter("error", PianobotWarning)
-        performance = play(piece, models=models)
+        performance = play_one_hand(piece, models=models)
     assert performance.plan.players == (Player.OWN,)
 
 
@@ -74,7 +75,7 @@ def test_a_policy_of_another_simulator_is_played_both_ways_and_the_better_kept(t
     with pytest.warns(
         PianobotWarning, match=r"played both ways, kept (it|the general policy task-melody-[0-9a-f]+) \(note F1"
     ):
-        performance = play(piece, models=models)
+        performance = play_one_hand(piece, models=models)
     own = plan_performance(piece, models=models)
     general = plan_performance(piece, models=models, leave_out=frozenset({ONE_NOTE}))
     assert general.players == (Player.GENERAL,)
@@ -90,7 +91,7 @@ def test_a_policy_kept_beside_another_general_policy_is_judged_again(tmp_path):
     plan = plan_performance(piece, models=models)
     assert "another general policy" in doubted(plan, models, general)[models / ONE_NOTE]
     with pytest.warns(PianobotWarning, match="played both ways"):
-        play(piece, models=models)
+        play_one_hand(piece, models=models)
     store.mark_judged(models, {ONE_NOTE: describe(general)})  # judged beside the one that plays now
     assert doubted(plan, models, general) == {}
 

@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 import torch
 
+from pianobot.agent.actors import FingerActor, FingerLayout
 from pianobot.agent.config import SACConfig
-from pianobot.agent.sac import FingerActor, FingerLayout
 from pianobot.agent.store import read_manifest
 from pianobot.agent.widen import WIDENED, context_sources, widen_actor, widen_policy
 from pianobot.errors import PianobotError

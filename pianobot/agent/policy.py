@@ -32,7 +32,8 @@ if TYPE_CHECKING:
 def make_agent(env, config: SACConfig, device: str | torch.device = "cpu", training: bool = True) -> SAC:
     """A fresh agent, on ``device``, for the observation and action spaces of ``env`` (a
     :class:`PianoEnv`, or a gymnasium vector of them); ``training`` False: only what acting needs."""
-    from pianobot.agent.sac import SAC, finger_layout, score_size, vector_size  # torch: only once an agent is built
+    from pianobot.agent.actors import finger_layout
+    from pianobot.agent.sac import SAC, score_size, vector_size  # torch: only once an agent is built
 
     space = getattr(env, "single_observation_space", env.observation_space)
     actions = getattr(env, "single_action_space", env.action_space)

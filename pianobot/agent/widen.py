@@ -1,6 +1,6 @@
 """A trained policy of the finger-shared actor given a hand with more fingers (the thumb).
 
-The 'fingers' actor (:class:`~pianobot.agent.sac.FingerActor`) moves every finger with one
+The 'fingers' actor (:class:`~pianobot.agent.actors.FingerActor`) moves every finger with one
 network, which reads the finger's own joints, joint speeds and target, its one-hot index and the
 whole observation vector; the wrist's network reads the vector. Nothing in either is sized for
 one finger, so a policy trained for fingers 2-4 can start a hand with fingers 1-4 (``python -m
@@ -25,8 +25,8 @@ import numpy as np
 import torch
 
 from pianobot.agent import store
+from pianobot.agent.actors import FingerLayout, finger_layout
 from pianobot.agent.policy import make_agent, policy_configs, policy_target
-from pianobot.agent.sac import FingerLayout, finger_layout
 from pianobot.agent.tasks import make_env
 from pianobot.config import to_dict
 from pianobot.errors import PianobotError

@@ -19,13 +19,14 @@ from pianobot.env.rewards import REWARDS
 from pianobot.errors import PianobotError, SettingError, quote
 from pianobot.learn.config import LEARNERS
 from pianobot.learn.explore import EXPLORATIONS
-from pianobot.music.instrument import PIANO, THUMB, HandSpec, KeyboardSpec
+from pianobot.music.instrument import PIANO, HandSpec, KeyboardSpec
 from pianobot.music.load import HANDS, LoadOptions
 from pianobot.music.phrases import DEFAULT_MAX_NOTES
 from pianobot.music.piece import parse_pitch, pitch_name
 from pianobot.music.tasks import FAMILIES
 from pianobot.perform.controllers import CONTROLLERS
-from pianobot.sim.world import CONTROL_MODES
+from pianobot.sim.hand import HAND_MODELS, default_fingers, hand_model
+from pianobot.sim.world_config import CONTROL_MODES
 
 
 @contextlib.contextmanager
@@ -57,6 +58,7 @@ Explore = choices("Explore", EXPLORATIONS)
 Actor = choices("Actor", ACTORS)
 HandPart = choices("HandPart", HANDS)
 Device = choices("Device", DEVICES)
+HandModelName = choices("HandModelName", tuple(HAND_MODELS))
 
 
 def value(choice: StrEnum | None) -> str | None:
@@ -109,7 +111,8 @@ READING = {  # parameter name: (type, option); the commands' --help shows them i
     "refinger": _reading(bool, LoadOptions.refinger, "--refinger/--no-refinger", "Replace the file's fingering with the planner's."),
     "lowest_note": _reading(Optional[str], None, "--lowest-note", f"Lowest key (C4, or a MIDI number; default {pitch_name(KeyboardSpec.lowest)} or the piece's own octaves).", INSTRUMENT),
     "keys": _reading(Optional[int], None, "--keys", f"Number of keys (default {KeyboardSpec.count} or the piece's own octaves).", INSTRUMENT),
-    "thumb": _reading(Optional[bool], None, "--thumb/--no-thumb", "Play with the thumb too (default: where it keeps more notes).", INSTRUMENT),
+    "hand_model": _reading(HandModelName, HandSpec.model, "--hand-model", "The hand: allegro (the paper's Allegro-like hand) or pianist (five fingers of human size).", INSTRUMENT),
+    "thumb": _reading(Optional[bool], None, "--thumb/--no-thumb", "The Allegro-like hand with its thumb too (default: where it keeps more notes).", INSTRUMENT),
 }
 # fmt: on
 
@@ -125,7 +128,8 @@ class Reading:
     """Whether --lowest-note or --keys was given (else the reading (:func:`~pianobot.pianist.reading.choose_keys`) may choose the keys,
     and both hands' parts go on their players' keys)."""
     hand_named: bool = False
-    """Whether --thumb or --no-thumb was given (else the reading (:func:`~pianobot.pianist.reading.choose_fingers`) may give both hands their thumbs)."""
+    """Whether the fingers are named: --thumb or --no-thumb given, or a hand with one finger set (else the reading
+    (:func:`~pianobot.pianist.reading.choose_fingers`) may give both hands their thumbs)."""
 
 
 def make_reading(**given) -> Reading:
@@ -144,6 +148,7 @@ def make_reading(**given) -> Reading:
             "keyboard.lowest",
             "keyboard.count",
         )
+    hand, hand_named = _fingers(value(values["hand_model"]) or HandSpec.model, values["thumb"])
     return Reading(
         options=LoadOptions(
             track=values["track"],
@@ -156,10 +161,26 @@ def make_reading(**given) -> Reading:
             refinger=values["refinger"],
         ),
         keyboard=keyboard,
-        hand=THUMB if values["thumb"] else HandSpec(),
+        hand=hand,
         keyboard_named=named,
-        hand_named=values["thumb"] is not None,
+        hand_named=hand_named,
     )
+
+
+def _fingers(model_name: str, thumb: bool | None) -> tuple[HandSpec, bool]:
+    """The hand --hand-model names, with the fingers --thumb/--no-thumb choose among its finger
+    sets (none given: its first), and whether they are named (given, or the hand has one set only)."""
+    model = hand_model(model_name)
+    if thumb is None:
+        return default_fingers(model_name), len(model.finger_sets) == 1
+    sets = [s for s in model.finger_sets if (1 in s) == thumb]
+    if not sets:
+        raise SettingError(
+            f"--{'' if thumb else 'no-'}thumb: the {model_name} hand plays with fingers "
+            f"{', '.join(map(str, model.finger_sets[0]))}: leave --thumb/--no-thumb out",
+            "hand.fingers",
+        )
+    return HandSpec(fingers=sets[0], model=model_name), True
 
 
 def reads(*, without: tuple[str, ...] = ()):

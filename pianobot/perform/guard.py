@@ -48,7 +48,7 @@ from pianobot.perform.rollout import Controller
 from pianobot.pianist.layout import KeyLayout
 from pianobot.pianist.motion import Motion
 from pianobot.pianist.scripted import ScriptedPianist
-from pianobot.pianist.tuning import PianistTuning
+from pianobot.pianist.tuning import PianistTuning, tuning_for
 
 QUIET_STEPS = PianistTuning.prepare_steps + PianistTuning.settle_steps
 """While a finger holds and no finger's next note starts within this many control steps, the hold
@@ -75,7 +75,7 @@ class HoldGuard:
     hand as it would have, had it played the piece itself, and holds, never strikes, a key it is
     handed."""
 
-    def __init__(self, policy: Controller, config: EnvConfig, tuning: PianistTuning = PianistTuning()):
+    def __init__(self, policy: Controller, config: EnvConfig, tuning: PianistTuning | None = None):
         if not self.fits(config):
             raise ValueError(
                 "the hold guard reads which finger holds a note from the finger targets and drives joint speeds or "
@@ -135,11 +135,12 @@ class WristGuard:
     """Wraps ``policy`` (a :class:`~pianobot.perform.rollout.Controller`): while any fingertip is
     low over the keys, the wrist's action is clipped to ``tuning.hold_slide`` a control step."""
 
-    def __init__(self, policy: Controller, config: EnvConfig, tuning: PianistTuning = PianistTuning()):
+    def __init__(self, policy: Controller, config: EnvConfig, tuning: PianistTuning | None = None):
         world = config.world
         if world.discrete_wrist:
             raise ValueError("the wrist guard limits the wrist's speed: it needs discrete_wrist=False")
         self.policy = policy
+        tuning = tuning or tuning_for(world.hand)
         self.motion = Motion(world, KeyLayout(world), tuning)
         self.fingers = len(world.hand.spec.fingers)
         self.limit = tuning.hold_slide * world.control_hz / world.hand.max_wrist_speed

@@ -43,6 +43,7 @@ from pianobot.music.per_hand import HandsReport, compare_hands
 from pianobot.music.piece import FINGER_NAMES, HANDS, Piece
 from pianobot.music.window import Window
 from pianobot.perform import compose, plan
+from pianobot.perform.judge import play_one_hand
 from pianobot.perform.plan import Performance
 from pianobot.perform.rollout import Rollout
 from pianobot.pianist.assign import finger_apart
@@ -178,6 +179,7 @@ class HandsPerformance:
                 "performer": h.performer,
                 **(reading.to_dict(h.hand) if reading is not None else {}),
                 "played_as": h.describe(),
+                "hand_model": h.performance.plan.config.world.hand.spec.model,
                 "fingers": list(h.performance.plan.config.world.hand.spec.fingers),
                 "given_to_the_hand": len(h.part),
                 "left_out_or_reduced": list(h.changes),
@@ -430,8 +432,8 @@ def play(
 ) -> Performance | HandsPerformance:
     """``pianobot.play``: a piece with both hands (every note with its hand, both hands with notes)
     plays both, :func:`play_hands` (``options`` as there);
-    any other piece plays as one hand, :func:`pianobot.perform.plan.play` (``options`` as there:
+    any other piece plays as one hand, :func:`pianobot.perform.judge.play_one_hand` (``options`` as there:
     ``video``, ``on_step``, ``keyboard``, ``hand``, ``general``, ...)."""
     if len(piece.hands) < 2:
-        return plan.play(piece, controller, models, seed, **options)
+        return play_one_hand(piece, controller, models, seed, **options)
     return play_hands(piece, controller, models, seed, **options)

@@ -20,7 +20,9 @@ states with the lowest total cost:
 Hard constraints (what this hand cannot do): a finger reaches at most :data:`REACH_FRACTION` of
 what its abduction limit allows; simultaneous notes take distinct fingers in pitch order; a
 finger still holding a key is not reused and the wrist keeps that key in its reach; fingertips
-never cross each other in the hand's frame between consecutive chords; the wrist moves at
+never cross each other in the hand's frame between consecutive chords, but where the hand lets
+two fingers pass (:attr:`~pianobot.sim.hand.HandModel.passes`: the thumb under, a finger over it),
+at a cost; the wrist moves at
 most as fast as its motor allows in the time between onsets, less the time a finger needs to
 lift and settle; and a finger strikes again no sooner than the scripted pianist can let go,
 move over and strike. Where the tempo makes those last two impossible, the planner still
@@ -48,7 +50,7 @@ from pianobot.music.instrument import HandSpec, KeyboardSpec, check_playable
 from pianobot.music.piece import Note, Piece, pitch_name
 from pianobot.pianist.layout import KeyLayout
 from pianobot.pianist.strikes import Run, StrikePlanner
-from pianobot.pianist.tuning import PianistTuning
+from pianobot.pianist.tuning import PianistTuning, tuning_for
 from pianobot.sim.hand import HandConfig, hand_config
 from pianobot.sim.keyboard import KeyboardConfig, key_boxes, keyboard_width, strike_points
 from pianobot.sim.world import WorldConfig
@@ -69,6 +71,8 @@ HARD_HOP_COST = 3.0
 """The same when the onsets are less than :data:`HOP_TIME` apart (lift, move over, strike), or
 from or to a black key (the fingertip must rise over it and move along the keys too)."""
 HOP_TIME = 0.4
+PASS_COST = 0.5
+"""Cost of one finger passing another (the thumb under, a finger over it) where the hand lets them."""
 TIP_GAP = 0.015
 """Least sideways distance (m) between two fingertips, in the hand's frame."""
 SETTLE_TIME = 0.2
@@ -114,8 +118,12 @@ class Planner:
     """Fingering for one hand on one keyboard."""
 
     def __init__(
-        self, keyboard: KeyboardConfig = KeyboardConfig(), hand: HandConfig = HandConfig(), tuning=PianistTuning()
+        self,
+        keyboard: KeyboardConfig = KeyboardConfig(),
+        hand: HandConfig = HandConfig(),
+        tuning: PianistTuning | None = None,
     ):
+        tuning = tuning or tuning_for(hand)
         self.keyboard, self.hand = keyboard, hand
         self.spec = keyboard.spec
         self.fingers = hand.spec.fingers
@@ -126,9 +134,11 @@ class Planner:
         # slanted fingertip easily slips off their narrow tops
         forward = hand.palm_y - strike_points(keyboard)[:, 1].max()
         self.black = np.array([b.black for b in key_boxes(keyboard)])
-        self.reach = (
-            REACH_FRACTION * forward * math.tan(hand.geometry.abduction_limit) * np.where(self.black, BLACK_REACH, 1.0)
-        )
+        share = REACH_FRACTION * forward * np.where(self.black, BLACK_REACH, 1.0)
+        self.reach = {f: share * math.tan(hand.model.abduction_limit(f)) for f in self.fingers}
+        """Each finger's sideways reach (m) at each key."""
+        self.passes = {(a, b) for a in self.fingers for b in self.fingers if hand.model.passes_by(a, b)}
+        """The pairs of fingers that may cross (both orders)."""
         self.pitch = keyboard.geometry.white_pitch
         self.grid = np.arange(0.0, keyboard_width(keyboard) + 1e-9, self.pitch / GRID)
         self._move = self.grid[None, :] - self.grid[:, None]
@@ -153,7 +163,7 @@ class Planner:
         cost = np.zeros((len(assignments), len(self.grid)))
         for a, fingers in enumerate(assignments):
             for key, finger in zip(keys, fingers):
-                offset = (self.key_x[key] - self.grid - self.base_x[finger]) / self.reach[key]
+                offset = (self.key_x[key] - self.grid - self.base_x[finger]) / self.reach[finger][key]
                 cost[a] += np.where(np.abs(offset) <= 1.0, STRETCH_COST * offset**2, _INFEASIBLE)
         return assignments, keys, cost
 
@@ -172,9 +182,11 @@ class Planner:
                     easy = time >= HOP_TIME and not (self.black[key] or self.black[key_p])
                     cost = cost + (0.0 if key == key_p else HOP_COST if easy else HARD_HOP_COST)
                     continue
-                # in the hand's frame the new fingertip lies on its own side of the old one
+                # in the hand's frame the new fingertip lies on its own side of the old one, or
+                # passes it (the thumb under, a finger over it) where the hand lets them cross
                 relative = (self.key_x[key] - self.key_x[key_p]) - move
-                cost = cost + np.where(np.sign(finger - finger_p) * relative >= TIP_GAP, 0.0, _INFEASIBLE)
+                crossing = PASS_COST if (finger, finger_p) in self.passes else _INFEASIBLE
+                cost = cost + np.where(np.sign(finger - finger_p) * relative >= TIP_GAP, 0.0, crossing)
         return cost
 
     # -- from chord to chord: the queries behind plan() -----------------------------------
@@ -253,7 +265,7 @@ class Planner:
         """Whether ``finger`` reaches ``key`` from each wrist position of the grid (read-only, cached)."""
         reaches = self._in_reach.get((key, finger))
         if reaches is None:
-            reaches = np.abs(self.key_x[key] - self.grid - self.base_x[finger]) / self.reach[key] <= 1.0
+            reaches = np.abs(self.key_x[key] - self.grid - self.base_x[finger]) / self.reach[finger][key] <= 1.0
             reaches.flags.writeable = False
             self._in_reach[key, finger] = reaches
         return reaches
@@ -269,7 +281,8 @@ class Planner:
         limit = speed * max(0.0, time - SETTLE_TIME)
         leap_limit = speed * max(0.0, time - SETTLE_TIME - lead * self.strikes.dt)
         move = np.asarray(move)
-        return (move > limit + 1e-9) | ((move > self.reach.max()) & (move > leap_limit + 1e-9))
+        farthest = max(r.max() for r in self.reach.values())
+        return (move > limit + 1e-9) | ((move > farthest) & (move > leap_limit + 1e-9))
 
     def _fast_hop(
         self,

@@ -123,14 +123,15 @@ class Motion:
         abduction's limit. A finger not yet over its key waits at idle height ('idle'), and one
         over it but not yet in front of it hovers ('ready'): a strike from there would hit the
         key's edge. ``now_reach``: the fingertip's reach now."""
-        layout, tuning, geometry = self.layout, self.tuning, self.geometry
+        layout, tuning = self.layout, self.tuning
         phase = plan.phase if plan is not None else "idle"
         key = plan.key if plan is not None else None
         contact_y = layout.contact_y(key) if key is not None else layout.white_contact_y
         top = float(layout.key_top[key]) if key is not None else 0.0
         forward = self.hand.palm_y - contact_y
         offset = layout.key_x[key] - (wrist_next + layout.model.base_x(finger)) if key is not None else 0.0
-        abduction = min(max(math.atan2(offset, forward), -geometry.abduction_limit), geometry.abduction_limit)
+        limit = layout.model.abduction_limit(finger)
+        abduction = min(max(math.atan2(offset, forward), -limit), limit)
         reach = forward / math.cos(abduction)  # keeps the tip at contact_y even when the key is out of reach
         if phase in ("ready", "strike") and abs(offset - forward * math.tan(abduction)) > tuning.aim_tolerance:
             phase = "idle"  # not over the key yet: wait high

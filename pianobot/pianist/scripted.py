@@ -26,18 +26,18 @@ from pianobot.env.piano import EnvConfig, actuated_indices
 from pianobot.pianist.layout import KeyLayout
 from pianobot.pianist.motion import Motion
 from pianobot.pianist.strikes import StrikePlanner
-from pianobot.pianist.tuning import PianistTuning
+from pianobot.pianist.tuning import PianistTuning, tuning_for
 from pianobot.sim.hand import JOINT_KINDS
 
 
 class ScriptedPianist:
     """A hand-written pianist for velocity or position control. See the module docstring."""
 
-    def __init__(self, config: EnvConfig, tuning: PianistTuning = PianistTuning()):
+    def __init__(self, config: EnvConfig, tuning: PianistTuning | None = None):
         if config.world.control not in ("velocity", "position"):
             raise ValueError("the scripted pianist drives joint speeds or angles: use control='velocity' or 'position'")
         self.config = config
-        self.tuning = tuning
+        self.tuning = tuning = tuning or tuning_for(config.world.hand)
         self.fingers = config.world.hand.spec.fingers
         model = config.world.hand.model
         if any(model.joints_of(f) != JOINT_KINDS for f in self.fingers):

@@ -9,7 +9,9 @@ They were tuned by hand on the examples and the task families (tests/test_contro
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
+
+from pianobot.sim.hand import HandConfig
 
 
 @dataclass(frozen=True)
@@ -77,3 +79,9 @@ class PianistTuning:
     """Farthest the wrist may move in one step while a finger holds a key (m per control step)."""
     tilt_step: float = 0.15
     """Most change of the fingertip's tilt the inverse kinematics asks for in one step (rad per control step)."""
+
+
+def tuning_for(hand: HandConfig) -> PianistTuning:
+    """The tuning of ``hand``'s model: the defaults, with what its model sets
+    (:attr:`~pianobot.sim.hand.HandModel.tuning`)."""
+    return replace(PianistTuning(), **dict(hand.model.tuning))

@@ -83,6 +83,15 @@ class HandModel:
     """Each finger's joints, in action order (names from :data:`JOINT_KINDS`); the others are fixed."""
     finger_joints: tuple[tuple[int, tuple[str, ...]], ...] = ()
     """(finger, joints): fingers whose joints are not :attr:`joints` (a thumb with fewer, say)."""
+    abduction: tuple[tuple[int, float], ...] = ()
+    """(finger, limit): fingers whose sideways reach is not :attr:`FingerGeometry.abduction_limit`
+    (rad; a thumb that reaches under the palm, say)."""
+    tuning: tuple[tuple[str, float], ...] = ()
+    """(name, value): the scripted pianist's and the fingering planner's constants for this hand
+    other than their defaults (:class:`~pianobot.pianist.tuning.PianistTuning`'s fields)."""
+    settings: tuple[tuple[str, float], ...] = ()
+    """(name, value): the :class:`HandConfig` settings this body has other than their defaults
+    (the palm's pose over the keys, its motors), as :func:`hand_config` applies them."""
 
     def __post_init__(self) -> None:
         numbers = [f for f, _, _ in self.bases]
@@ -96,6 +105,14 @@ class HandModel:
                 raise ValueError(f"hand model {self.name!r}: joints {joints} must be distinct names from {JOINT_KINDS}")
             if finger is not None and finger not in numbers:
                 raise ValueError(f"hand model {self.name!r}: joints given for finger {finger}, which it lacks")
+        for finger, limit in self.abduction:
+            if finger not in numbers or not 0.0 <= limit <= 1.6:
+                raise ValueError(
+                    f"hand model {self.name!r}: abduction ({finger}, {limit}): one of its fingers, 0-1.6 rad"
+                )
+        for a, b in self.passes:
+            if a not in numbers or b not in numbers or a == b:
+                raise ValueError(f"hand model {self.name!r}: ({a}, {b}) in passes: two of its fingers {numbers}")
 
     @property
     def fingers(self) -> tuple[int, ...]:
@@ -113,6 +130,14 @@ class HandModel:
         """A finger's actuated joints, in action order."""
         return dict(self.finger_joints).get(finger, self.joints)
 
+    def abduction_limit(self, finger: int) -> float:
+        """How far (rad) a finger turns sideways either way."""
+        return dict(self.abduction).get(finger, self.geometry.abduction_limit)
+
+    def passes_by(self, a: int, b: int) -> bool:
+        """Whether fingers ``a`` and ``b`` may cross (one under or over the other)."""
+        return (a, b) in self.passes or (b, a) in self.passes
+
     def joint_kinds(self, fingers: tuple[int, ...]) -> list[str]:
         """The kind of every joint of ``fingers``, finger by finger, in action order."""
         return [j for f in fingers for j in self.joints_of(f)]
@@ -127,6 +152,50 @@ ALLEGRO = HandModel(
 modelled as a fourth finger beside the index (the Allegro's four joints each); no finger passes
 another."""
 
+PIANIST = HandModel(
+    name="pianist",
+    bases=((1, -0.055, 0.0), (2, -0.033, 0.0), (3, -0.011, 0.0), (4, 0.011, 0.0), (5, 0.033, 0.0)),
+    geometry=FingerGeometry(
+        base_to_mcp=0.004,
+        proximal=0.045,
+        middle=0.025,
+        distal=0.026,
+        tip_radius=0.0085,
+        link_radius=0.0075,
+        abduction_limit=0.349,
+        flexion_limits=((-0.35, 1.57), (0.0, 1.92), (-0.17, 1.4)),
+    ),
+    finger_sets=((1, 2, 3, 4, 5),),
+    abduction=((1, 1.0),),
+    tuning=(
+        ("legato_cost", 10.0),
+        ("hold_reach", 0.014),
+        ("strike_reach", 0.014),
+        ("black_strike_reach", 0.009),
+        ("hold_slide", 0.004),
+    ),
+    passes=frozenset({(1, 2), (1, 3), (1, 4)}),
+    settings=(
+        ("palm_height", 0.0575),
+        ("palm_y", 0.1575),
+        ("max_joint_speed", 8.0),
+        ("joint_force", 1.0),
+        ("max_joint_torque", 1.0),
+        ("finger_mass", 0.02),
+    ),
+)
+"""A pianist's hand of human size (the Shadow hand's proportions, docs/simulator.md): five fingers,
+thumb to little, their knuckles 22 mm apart, phalanges 45, 25 and 26 mm, a human finger's joint
+ranges, the Shadow hand's joint speed and torque. The thumb is a finger like the others beside the
+index (as the Allegro-like hand's) that turns farther sideways (1 rad either way, as a thumb
+reaches under the palm); it passes under the index, middle and ring fingers and they over it
+(:attr:`HandModel.passes`: the fingering planner lets their fingertips cross). Its planner holds
+notes to their written end as a pianist does (a higher ``legato_cost``): the thumb passes under
+in a scale rather than the hand jumping. Its fingers turn sideways less far than the
+Allegro-like hand's longer ones, so the wrist strays less from straight over a held or struck
+key (``hold_reach``, ``strike_reach``) and slides more slowly while a finger holds one
+(``hold_slide``)."""
+
 HAND_MODELS: dict[str, HandModel] = {}
 """The hand models pianobot knows, by name (:func:`register_hand_model`)."""
 
@@ -138,6 +207,7 @@ def register_hand_model(model: HandModel) -> HandModel:
 
 
 register_hand_model(ALLEGRO)
+register_hand_model(PIANIST)
 
 
 def hand_model(name: str) -> HandModel:
@@ -205,14 +275,24 @@ class HandConfig:
 def hand_config(spec: HandSpec) -> HandConfig:
     """The configuration of the hand ``spec`` names, with its model's finger geometry (every other
     setting the default): the one way code that knows only a spec makes a hand."""
-    return HandConfig(spec=spec, geometry=hand_model(spec.model).geometry)
+    model = hand_model(spec.model)
+    return HandConfig(spec=spec, geometry=model.geometry, **dict(model.settings))
+
+
+def default_fingers(model: str) -> HandSpec:
+    """The hand ``model`` names with the fingers it plays with by default (its first finger set)."""
+    return HandSpec(fingers=hand_model(model).finger_sets[0], model=model)
 
 
 def joint_limits(config: HandConfig) -> np.ndarray:
     """(2, J): the lower and upper limit (rad) of every finger joint, in action order."""
-    g = config.geometry
-    limits = dict(zip(JOINT_KINDS, [(-g.abduction_limit, g.abduction_limit), *g.flexion_limits]))
-    return np.array([limits[j] for j in config.model.joint_kinds(config.spec.fingers)]).T
+    g, model = config.geometry, config.model
+    limits = []
+    for f in config.spec.fingers:
+        reach = model.abduction_limit(f)
+        by_kind = dict(zip(JOINT_KINDS, [(-reach, reach), *g.flexion_limits]))
+        limits += [by_kind[j] for j in model.joints_of(f)]
+    return np.array(limits).T
 
 
 def joint_names(spec: HandSpec) -> list[str]:
@@ -317,7 +397,7 @@ def hand_urdf(config: HandConfig, rail: tuple[float, float], side: str = "right"
                 f"{prefix}_base",
                 (config.model.base_x(f, side), config.model.base_y(f), 0.0),
                 f"0 0 {mirror}",
-                (-g.abduction_limit, g.abduction_limit),
+                (-config.model.abduction_limit(f), config.model.abduction_limit(f)),
             )
         )
         chain = [("mcp", "proximal", g.proximal), ("pip", "middle", g.middle), ("dip", "distal", g.distal)]

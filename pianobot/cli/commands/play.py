@@ -242,13 +242,14 @@ def play_one(
 ) -> None:
     """`play` of a one-hand piece (``read``: a :class:`~pianobot.pianist.reading.ReadPiece`, fingered):
     planned (:func:`~pianobot.perform.plan.plan_performance`), performed as judged
-    (:func:`~pianobot.perform.plan.perform_judged`), written, and reported."""
+    (:func:`~pianobot.perform.judge.perform_judged`), written, and reported."""
     from pianobot.cli import display
     from pianobot.music.midi_io import write_midi
     from pianobot.music.phrases import split_phrases
     from pianobot.perform.audio import write_wav
+    from pianobot.perform.judge import perform_judged
     from pianobot.perform.perform import write_video
-    from pianobot.perform.plan import Player, perform_judged, plan_performance
+    from pianobot.perform.plan import Player, plan_performance
 
     console, quiet, notes, every = shown["console"], shown["quiet"], shown["notes"], shown["every"]
     report_path, json_path, video, wav, html = (

@@ -1,0 +1,85 @@
+"""The pianist's hand (``--hand-model pianist``): five fingers of human size, a thumb that passes
+under the fingers, chosen on the command line and recorded in every report."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+from conftest import assert_one_line_error, run
+
+from pianobot.music.instrument import HandSpec, KeyboardSpec
+from pianobot.music.piece import Note, Piece
+from pianobot.perform.plan import perform_plan, plan_performance
+from pianobot.pianist.fingering import Planner, plan_fingering
+from pianobot.sim.hand import ALLEGRO, PIANIST, HandModel, default_fingers, hand_config, joint_limits
+from pianobot.sim.keyboard import KeyboardConfig
+from pianobot.sim.world import PianoWorld, WorldConfig
+
+FIVE = default_fingers("pianist")
+
+
+def _scale(seconds: float = 0.6) -> Piece:
+    """C major up an octave and down again, one note every ``seconds``."""
+    up = [60, 62, 64, 65, 67, 69, 71, 72]
+    pitches = up + up[-2::-1]
+    return Piece(tuple(Note(seconds * i, p, seconds * (i + 1), 80) for i, p in enumerate(pitches)), bpm=100)
+
+
+def test_the_pianist_s_hand_has_five_fingers_a_white_key_apart_and_a_thumb_that_turns_farther():
+    assert FIVE == HandSpec((1, 2, 3, 4, 5), model="pianist")
+    gaps = [b - a for a, b in zip(PIANIST.fingers[:-1], PIANIST.fingers[1:])]
+    assert gaps == [1, 1, 1, 1]
+    spacing = [PIANIST.base_x(f + 1) - PIANIST.base_x(f) for f in (1, 2, 3, 4)]
+    assert spacing == pytest.approx([0.022] * 4)  # the Shadow hand's knuckles, 22 mm apart
+    low, high = joint_limits(hand_config(FIVE))
+    assert high[0] == pytest.approx(1.0) and high[4] == pytest.approx(PIANIST.geometry.abduction_limit)  # thumb, index
+    config = hand_config(FIVE)
+    assert (config.palm_height, config.max_joint_speed) == (0.0575, 8.0)  # the model's body, not the Allegro's
+    assert hand_config(HandSpec()).palm_height == 0.070
+
+
+def test_its_world_builds_five_fingers_and_its_mirror_image_for_the_left_hand():
+    world = PianoWorld(WorldConfig(hand=hand_config(FIVE), keyboard=KeyboardConfig(spec=KeyboardSpec(36, 48))))
+    try:
+        assert sorted(world.hands[0].tips) == [1, 2, 3, 4, 5] and len(world.finger_joints) == 20
+    finally:
+        world.close()
+
+
+def test_the_planner_passes_the_thumb_under_in_a_scale_where_the_allegro_hand_cannot():
+    fingers = [n.finger for n in plan_fingering(_scale(), KeyboardConfig(), hand_config(FIVE)).piece.notes]
+    assert fingers[:8] == [1, 2, 3, 1, 2, 3, 4, 5]  # the thumb under after E, as pianists finger it
+    assert fingers[8:] == [4, 3, 2, 1, 3, 2, 1]  # and the third finger over it on the way down
+    planner = Planner(KeyboardConfig(), hand_config(FIVE))
+    assert (1, 3) in planner.passes and (3, 1) in planner.passes and (4, 5) not in planner.passes
+    assert Planner().passes == set()  # the Allegro-like hand: no finger passes another, as before
+
+
+def test_a_model_refuses_passes_between_fingers_it_lacks():
+    with pytest.raises(ValueError, match="passes"):
+        HandModel(name="bad", bases=ALLEGRO.bases, finger_sets=((2, 3, 4),), passes=frozenset({(1, 5)}))
+
+
+def test_the_scripted_pianist_plays_the_scale_with_the_thumb_under():
+    piece = plan_fingering(_scale(), KeyboardConfig(), hand_config(FIVE)).piece
+    performance = perform_plan(plan_performance(piece, "scripted", hand=FIVE))
+    report = performance.report()
+    assert report.f1 == 1.0 and report.fingering_accuracy == 1.0
+
+
+def test_hand_model_pianist_plays_with_five_fingers_and_the_report_says_so(tmp_path):
+    out = tmp_path / "out.mid"
+    result = run(
+        "play", "examples/midi/c-major-scale.mid", "-o", out, "--hand-model", "pianist", "--controller", "scripted"
+    )
+    assert result.exit_code == 0, result.output
+    report = json.loads(out.with_suffix(".report.json").read_text())
+    assert report["hand_model"] == "pianist" and report["fingers"] == [1, 2, 3, 4, 5]
+    assert report["f1"] >= 0.9
+
+
+def test_thumb_options_belong_to_the_allegro_hand(tmp_path):
+    result = run("play", "examples/midi/mary.mid", "-o", tmp_path / "o.mid", "--hand-model", "pianist", "--no-thumb")
+    assert_one_line_error(result, "--no-thumb", "leave --thumb/--no-thumb out")
+    assert run("play", "examples/midi/mary.mid", "--hand-model", "shadow").exit_code == 2
