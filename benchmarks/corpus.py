@@ -32,7 +32,8 @@ simulation of its own (``pianobot.perform.together.play_hands(..., together=Fals
 hands lose by getting in each other's way. The hands' fingers are chosen per file as ``pianobot
 play`` chooses them (:func:`pianobot.perform.together.fingers_for_file`: the thumbs too where they
 keep notes three fingers leave out; the row's ``fingers``); ``--thumb`` gives each hand its thumb
-everywhere (``pianobot play --thumb``), ``--no-thumb`` three fingers everywhere; the general
+everywhere (``pianobot play --thumb``), ``--no-thumb`` three fingers everywhere, ``--hand-model
+pianist`` the pianist's five fingers (scripted pianist only: no general policy plays it yet); the general
 policy plays where one for that hand is packaged (else the scripted pianist alone plays);
 ``--general DIR`` names the general policy to play both hands.
 """
@@ -55,6 +56,7 @@ from pianobot.errors import PianobotError, PianobotWarning
 from pianobot.music.instrument import THUMB, HandSpec
 from pianobot.music.load import LoadOptions
 from pianobot.perform.together import fingers_for_file, two_hands
+from pianobot.sim.hand import HAND_MODELS, default_fingers
 
 EXCERPTS = (
     # (name, music21 corpus path, the parts that are the piano's staves (None: all), first measure)
@@ -268,6 +270,12 @@ def main() -> None:
     fingers = parser.add_mutually_exclusive_group()
     fingers.add_argument("--thumb", action="store_true", help="each hand with its thumb too, in every file")
     fingers.add_argument("--no-thumb", action="store_true", help="three fingers in every file")
+    fingers.add_argument(
+        "--hand-model",
+        choices=tuple(HAND_MODELS),
+        help="each hand this model with its fingers (as play --hand-model); where no general policy is packaged "
+        "for it (the pianist's hand), the scripted pianist alone plays",
+    )
     parser.add_argument(
         "--general",
         type=Path,
@@ -300,12 +308,16 @@ def main() -> None:
         return
     started = time.perf_counter()
     hand = THUMB if args.thumb else HandSpec() if args.no_thumb else None  # (None: as play chooses)
+    if args.hand_model is not None and args.hand_model != HandSpec.model:
+        hand = default_fingers(args.hand_model)
     out = args.out or Path("out/corpus" if args.set == "test" else "out/corpus-validation")
     rows = play_corpus(out, tuple(args.only), not args.apart, hand, args.general, SETS[args.set])
     seconds = time.perf_counter() - started
     print()
     print(table(rows))
     chosen = "with thumbs; " if args.thumb else "three fingers; " if args.no_thumb else "fingers as play chooses; "
+    if args.hand_model is not None:
+        chosen = f"the {args.hand_model} hand; "
     how = ("each hand apart; " if args.apart else "") + chosen
     print(f"\nmusic21 {music21.__version__}; {how}{seconds:.0f} s")
     if args.json:
@@ -314,6 +326,7 @@ def main() -> None:
             "set": args.set,
             "apart": args.apart,
             "thumb": True if args.thumb else False if args.no_thumb else "as play chooses",
+            "hand_model": hand.model if hand is not None else HandSpec.model,
             "general": None if args.general is None else str(args.general),
             "seconds": round(seconds),
             "rows": rows,

@@ -235,8 +235,10 @@ def example_table(rows: list[dict], starts=EXAMPLE_STARTS) -> str:
             f"| mean | | | {np.mean(means):.3f} | {np.mean([mean(r, 'step_f1') for r in rows]):.3f} | "
             f"{np.mean([r['scripted']['f1'] for r in rows]):.3f} | {np.mean([r['scripted']['step_f1'] for r in rows]):.3f} |"
         )
-        every = sum(bool(r["sac"]) and min(f["f1"] for f in r["sac"]) >= 0.9 for r in rows)
-        lines += ["", f"examples at note F1 0.9 or more from every hand start: {every} of {len(rows)}", ""]
+        if any(r["sac"] for r in rows):
+            every = sum(bool(r["sac"]) and min(f["f1"] for f in r["sac"]) >= 0.9 for r in rows)
+            lines += ["", f"examples at note F1 0.9 or more from every hand start: {every} of {len(rows)}"]
+        lines += [""]
     return "\n".join(lines)
 
 

@@ -1,6 +1,6 @@
 """The scripted pianist on random single-voice melodies in all 12 keys.
 
-    python benchmarks/melodies.py [--per-key 4] [--json out.json] [--failures]
+    python benchmarks/melodies.py [--per-key 4] [--json out.json] [--failures] [--hand-model pianist]
 
 Draws ``--per-key`` melodies per key (:func:`pianobot.music.melodies.melody_set`, fixed seeds;
 major and minor in turn), fingers each with the planner (a melody the planner says this hand
@@ -10,7 +10,8 @@ velocity MAE (MIDI units, matched notes), mean absolute onset error (ms), extra 
 notes the score does not ask for), mean note F1 with offsets and per-step key-press F1, and the
 median played/written duration of notes written < 0.35 s, 0.35-0.7 s and longer (articulation,
 docs/metrics.md); then the totals and every melody short of the targets
-(note F1 >= 0.95, velocity MAE <= 5, no extra notes).
+(note F1 >= 0.95, velocity MAE <= 5, no extra notes). ``--hand-model`` plays them with that hand
+and its fingers (default the Allegro-like hand's three).
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ from __future__ import annotations
 import argparse
 import json
 import time
+from dataclasses import replace
 
 import numpy as np
 
@@ -25,31 +27,33 @@ from pianobot.music.instrument import HandSpec, KeyboardSpec
 from pianobot.music.melodies import TONICS, describe, melody_set
 from pianobot.music.metrics import LENGTH_CLASSES, duration_ratios
 from pianobot.music.piece import Piece
-from pianobot.perform.perform import perform
+from pianobot.perform.perform import PLAY_CONFIG, perform
 from pianobot.pianist.fingering import ensure_fingering
+from pianobot.sim.hand import HAND_MODELS, default_fingers, hand_config
 
 F1_TARGET, VELOCITY_TARGET, MEAN_F1_TARGET = 0.95, 5.0, 0.98
 
 
-def playable(piece: Piece) -> Piece | None:
+def playable(piece: Piece, hand: HandSpec = HandSpec()) -> Piece | None:
     """The piece fingered by the planner, or None when the planner reports notes too fast for the hand."""
-    fingered, plan = ensure_fingering(piece, KeyboardSpec(), HandSpec())
+    fingered, plan = ensure_fingering(piece, KeyboardSpec(), hand)
     return None if plan is not None and plan.problems else fingered
 
 
-def play_set(per_key: int) -> tuple[list[dict], int]:
-    """Every melody's figures, and how many draws the planner turned down."""
+def play_set(per_key: int, hand: HandSpec = HandSpec()) -> tuple[list[dict], int]:
+    """Every melody's figures, played by ``hand``, and how many draws the planner turned down."""
+    config = replace(PLAY_CONFIG, world=replace(PLAY_CONFIG.world, hand=hand_config(hand)))
     rejected = 0
 
     def accept(piece: Piece) -> Piece | None:
         nonlocal rejected
-        kept = playable(piece)
+        kept = playable(piece, hand)
         rejected += kept is None
         return kept
 
     results = []
     for melody in melody_set(per_key, accept):
-        report = perform(melody.piece, "scripted", seed=melody.index).report()
+        report = perform(melody.piece, "scripted", config, seed=melody.index).report()
         onset_errors = [abs(r.onset_error) for r in report.rows if r.onset_error is not None]
         results.append(
             {
@@ -112,9 +116,10 @@ def main() -> None:
     parser.add_argument("--per-key", type=int, default=4, help="melodies per key (default 4: 48 in all)")
     parser.add_argument("--json", help="write every melody's figures here")
     parser.add_argument("--failures", action="store_true", help="list every melody short of the targets")
+    parser.add_argument("--hand-model", choices=tuple(HAND_MODELS), default=HandSpec.model, help="the hand that plays")
     args = parser.parse_args()
     began = time.perf_counter()
-    results, rejected = play_set(args.per_key)
+    results, rejected = play_set(args.per_key, default_fingers(args.hand_model))
     print(table(results, rejected))
     f1 = [r["f1"] for r in results]
     ok = all(passes(r) for r in results) and np.mean(f1) >= MEAN_F1_TARGET

@@ -19,7 +19,7 @@ from pianobot.sim.world import PianoWorld, WorldConfig
 FIVE = default_fingers("pianist")
 
 
-def _scale(seconds: float = 0.6) -> Piece:
+def _scale(seconds: float = 0.3) -> Piece:
     """C major up an octave and down again, one note every ``seconds``."""
     up = [60, 62, 64, 65, 67, 69, 71, 72]
     pitches = up + up[-2::-1]
@@ -33,7 +33,7 @@ def test_the_pianist_s_hand_has_five_fingers_a_white_key_apart_and_a_thumb_that_
     spacing = [PIANIST.base_x(f + 1) - PIANIST.base_x(f) for f in (1, 2, 3, 4)]
     assert spacing == pytest.approx([0.022] * 4)  # the Shadow hand's knuckles, 22 mm apart
     low, high = joint_limits(hand_config(FIVE))
-    assert high[0] == pytest.approx(1.0) and high[4] == pytest.approx(PIANIST.geometry.abduction_limit)  # thumb, index
+    assert high[0] == pytest.approx(0.6) and high[4] == pytest.approx(PIANIST.geometry.abduction_limit)  # thumb, index
     config = hand_config(FIVE)
     assert (config.palm_height, config.max_joint_speed) == (0.0575, 8.0)  # the model's body, not the Allegro's
     assert hand_config(HandSpec()).palm_height == 0.070
@@ -83,3 +83,24 @@ def test_thumb_options_belong_to_the_allegro_hand(tmp_path):
     result = run("play", "examples/midi/mary.mid", "-o", tmp_path / "o.mid", "--hand-model", "pianist", "--no-thumb")
     assert_one_line_error(result, "--no-thumb", "leave --thumb/--no-thumb out")
     assert run("play", "examples/midi/mary.mid", "--hand-model", "shadow").exit_code == 2
+
+
+def test_a_file_s_own_five_finger_fingering_plays_as_written_on_the_pianist_s_hand(tmp_path):
+    """The file's fingering, written for a human hand (the thumb under after E), is the pianist's
+    hand's own: played as written. The Allegro-like hand cannot play it as written: one line
+    says so, and how to play it (its planner's fingering, or the pianist's hand)."""
+    from pianobot.music.midi_out import write_midi
+    from pianobot.music.pig import sidecar_for, write_pig
+
+    written = [1, 2, 3, 1, 2, 3, 4, 5, 4, 3, 2, 1, 3, 2, 1]
+    piece = _scale().with_fingers(written)
+    song = write_midi(piece.without_fingering(), tmp_path / "scale.mid")
+    write_pig(piece, sidecar_for(song))
+    out = tmp_path / "out.mid"
+    result = run("play", song, "-o", out, "--hand-model", "pianist", "--controller", "scripted", "--notes", "0")
+    assert result.exit_code == 0, result.output
+    report = json.loads(out.with_suffix(".report.json").read_text())
+    assert report["f1"] == 1.0 and report["fingering_accuracy"] == 1.0
+    assert [row["played_finger"] for row in report["notes"]] == written
+    result = run("play", song, "-o", tmp_path / "allegro.mid", "--controller", "scripted")
+    assert_one_line_error(result, "fingered 1 (thumb)", "--refinger", "--hand-model pianist")

@@ -247,7 +247,7 @@ def passed_over(keyboard: KeyboardSpec, hand: HandSpec) -> str:
     if hand not in hands:
         return (
             f"the packaged general policies play with fingers {' or '.join(h.describe() for h in hands)}; this "
-            f"piece is read for fingers {hand.describe()} (hand.fingers)"
+            f"piece is read for fingers {hand.describe()} (hand.fingers, hand.model)"
         )
     return (
         f"the packaged general policies play keyboards of {world.keyboard.spec.count} keys or more; this piece is "

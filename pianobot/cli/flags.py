@@ -23,6 +23,7 @@ FLAGS = {
     "keyboard.lowest": "--lowest-note",
     "keyboard.count": "--keys",
     "hand.fingers": "--thumb",
+    "hand.model": "--hand-model",
     "phrases.max_notes": "--phrase-notes",
     "jobs.force": "--force",
     "train.device": "--device",

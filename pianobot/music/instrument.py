@@ -112,7 +112,8 @@ class HandSpec:
         return self.fingers.index(finger)
 
     def describe(self) -> str:
-        return ", ".join(f"{f} ({FINGER_NAMES[f]})" for f in self.fingers)
+        fingers = ", ".join(f"{f} ({FINGER_NAMES[f]})" for f in self.fingers)
+        return fingers if self.model == "allegro" else f"{fingers} of the {self.model} hand"
 
 
 THUMB = HandSpec(fingers=(1,) + HandSpec.fingers)
@@ -174,7 +175,12 @@ def check_playable(piece: Piece, keyboard: KeyboardSpec, hand: HandSpec, transpo
                 f"{note.describe()} is fingered {note.finger} ({FINGER_NAMES[note.finger]}) but the hand "
                 f"plays with fingers {hand.describe()}: change that note's fingering, or let the fingering planner "
                 "finger the piece with load.refinger"
-                + (", or enable the thumb with hand.fingers" if note.finger == 1 else "")
+                + (", or enable the thumb with hand.fingers" if note.finger == 1 and hand.model == "allegro" else "")
+                + (
+                    ", or play it with the pianist's five fingers (hand.model pianist)"
+                    if hand.model != "pianist"
+                    else ""
+                )
             )
     busy: dict[int, float] = {}
     for note in piece.notes:

@@ -9,6 +9,8 @@ the white keys' top surface.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from pianobot.sim.keyboard import BLACK_STRIKE_FROM_FRONT, WHITE_STRIKE_FROM_FRONT, key_boxes
@@ -47,6 +49,12 @@ class KeyLayout:
     def contact_y(self, key: int) -> float:
         """Where on ``key`` the fingertip strikes (m from the hinge)."""
         return self.black_contact_y if self.black[key] else self.white_contact_y
+
+    def reach_scale(self, finger: int) -> float:
+        """How far ``finger`` turns sideways beside the model's fingers (the tan of its abduction
+        limit over theirs): the scripted pianist's sideways reaches (``hold_reach``,
+        ``strike_reach``) are for those, and a thumb that turns farther reaches farther."""
+        return math.tan(self.model.abduction_limit(finger)) / math.tan(self.model.geometry.abduction_limit)
 
     def wrist_for(self, finger: int, key: int) -> float:
         """Wrist position that puts ``finger`` straight over ``key`` (m)."""

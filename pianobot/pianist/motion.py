@@ -81,10 +81,14 @@ class Motion:
             else:
                 wanted = [layout.wrist_for(f, plan.key) for f, plan in plans.items()]
             target = min(max(float(np.mean(wanted)), 0.0), layout.width)
-            holds = [layout.wrist_for(f, plan.key) for f, plan in plans.items() if plan.phase == "hold"]
+            holds = [
+                (layout.wrist_for(f, plan.key), tuning.hold_reach * layout.reach_scale(f))
+                for f, plan in plans.items()
+                if plan.phase == "hold"
+            ]
             if holds:  # a held key's finger may follow a small move only, and only while all held keys allow it
-                low = max(max(holds) - tuning.hold_reach, wrist - tuning.hold_slide)
-                high = min(min(holds) + tuning.hold_reach, wrist + tuning.hold_slide)
+                low = max(max(at - reach for at, reach in holds), wrist - tuning.hold_slide)
+                high = min(min(at + reach for at, reach in holds), wrist + tuning.hold_slide)
                 target = float(min(max(target, low), high)) if low <= high else wrist
         if any(
             self.low(joints[slot]) for slot, f in enumerate(self.fingers) if f not in plans or plans[f].phase == "ready"

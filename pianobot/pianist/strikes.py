@@ -149,7 +149,7 @@ class StrikePlanner:
     def tip_speed(self, key: int, velocity: float) -> float:
         """Downward fingertip speed (m/s) at which a strike on ``key`` sounds at ``velocity``."""
         front_speed = float(self.curve.speed(velocity))  # the keyboard's curve is in front-edge speed
-        return front_speed * self.layout.contact_y(key) / self.layout.white_length
+        return min(front_speed * self.layout.contact_y(key) / self.layout.white_length, self.tuning.max_strike_speed)
 
     def strike_depth(self, key: int) -> float:
         """How far below the key's top surface the fingertip is when the key sounds (m)."""
@@ -284,9 +284,10 @@ class StrikePlanner:
             key, "strike", height=height, goal=float(min(max(goal, floor), tip_height)), start=start, lead=steps
         )
 
-    def strike_reach(self, key: int) -> float:
-        """Farthest the wrist may be from straight over ``key`` for a finger to strike it (m)."""
-        return self.tuning.black_strike_reach if self.layout.black[key] else self.tuning.strike_reach
+    def strike_reach(self, key: int, finger: int) -> float:
+        """Farthest the wrist may be from straight over ``key`` for ``finger`` to strike it (m)."""
+        reach = self.tuning.black_strike_reach if self.layout.black[key] else self.tuning.strike_reach
+        return reach * self.layout.reach_scale(finger)
 
     def _let_go(self, plans: dict[int, Plan], tips: dict[int, Tip], wrist: float | None) -> None:
         """Release held keys early when the hand must get ready for what comes next.
@@ -318,8 +319,8 @@ class StrikePlanner:
         holds = {f: p for f, p in plans.items() if p.phase == "hold"}
         if not holds:
             return
-        low = max(layout.wrist_for(f, p.key) for f, p in holds.items()) - tuning.hold_reach
-        high = min(layout.wrist_for(f, p.key) for f, p in holds.items()) + tuning.hold_reach
+        low = max(layout.wrist_for(f, p.key) - tuning.hold_reach * layout.reach_scale(f) for f, p in holds.items())
+        high = min(layout.wrist_for(f, p.key) + tuning.hold_reach * layout.reach_scale(f) for f, p in holds.items())
         # (finger, key, onset, lead, extra): the wrist slides only once the fingers that let go have risen. A free
         # finger's strike needs prepare_steps on top of its lead (it aims and settles once the wrist is there:
         # tidying that overlap away cost a melody, measured); a holding finger's next_lead already counts its
@@ -332,7 +333,7 @@ class StrikePlanner:
         ]
         for finger, key, start, lead, extra in strikes:
             wanted = layout.wrist_for(finger, key)
-            if self._strike_while_holding(wanted, self.strike_reach(key), low, high, start - lead, wrist):
+            if self._strike_while_holding(wanted, self.strike_reach(key, finger), low, high, start - lead, wrist):
                 continue
             travel = max(0.0, low - wanted, wanted - high)
             shift_steps = math.ceil(travel / (self.max_wrist_speed * self.dt))

@@ -9,6 +9,7 @@ They were tuned by hand on the examples and the task families (tests/test_contro
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, replace
 
 from pianobot.sim.hand import HandConfig
@@ -27,6 +28,10 @@ class PianistTuning:
     """A struck key is pressed this far past its strike depth before the finger just holds it (m).
     It also bounds when in the onset's step a loud strike sounds: the fingertip must not reach
     the key's bottom within that step, or the step's speed, and the note, would be softer."""
+    max_strike_speed: float = math.inf
+    """Fastest downward fingertip speed a strike is planned at (m/s): a louder note is struck at this
+    speed, softer than written but on time, where the hand's fingers are too slow to strike it as
+    written (none: the Allegro-like hand's strike any velocity)."""
     min_lead_steps: int = 0
     """Fewest control steps of constant-speed travel before the onset's step (0: a loud strike starts
     from rest at the onset step's start; the finger's motors reach the strike speed within a few
