@@ -12,8 +12,9 @@ from pianobot.music.instrument import HandSpec, KeyboardSpec
 from pianobot.music.piece import Note, Piece
 from pianobot.perform.plan import perform_plan, plan_performance
 from pianobot.pianist.fingering import Planner, plan_fingering
-from pianobot.sim.hand import ALLEGRO, PIANIST, HandModel, default_fingers, hand_config, joint_limits
+from pianobot.sim.hand import ALLEGRO, HandModel, default_fingers, hand_config, joint_limits
 from pianobot.sim.keyboard import KeyboardConfig
+from pianobot.sim.pianist_hand import PIANIST
 from pianobot.sim.world import PianoWorld, WorldConfig
 
 FIVE = default_fingers("pianist")

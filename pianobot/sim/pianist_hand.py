@@ -1,0 +1,58 @@
+"""The pianist's hand: five fingers of human size, thumb to little (``--hand-model pianist``).
+
+A hand model is one module like this one: it makes a :class:`~pianobot.sim.hand.HandModel` and
+registers it. Where each figure comes from (the Shadow Dexterous Hand's proportions and motors):
+docs/simulator.md#pianist; how its settings were chosen: docs/history.md.
+"""
+
+from __future__ import annotations
+
+from pianobot.sim.hand import FingerGeometry, HandModel, register_hand_model
+
+PIANIST = HandModel(
+    name="pianist",
+    bases=((1, -0.055, 0.0), (2, -0.033, 0.0), (3, -0.011, 0.0), (4, 0.011, 0.0), (5, 0.033, 0.0)),
+    geometry=FingerGeometry(
+        base_to_mcp=0.004,
+        proximal=0.045,
+        middle=0.025,
+        distal=0.026,
+        tip_radius=0.0085,
+        link_radius=0.0075,
+        abduction_limit=0.349,
+        flexion_limits=((-0.35, 1.57), (0.0, 1.92), (-0.17, 1.4)),
+    ),
+    finger_sets=((1, 2, 3, 4, 5),),
+    abduction=((1, 0.6),),
+    tuning=(
+        ("legato_cost", 10.0),
+        ("hold_reach", 0.014),
+        ("strike_reach", 0.014),
+        ("black_strike_reach", 0.009),
+        ("hold_slide", 0.004),
+        ("max_strike_speed", 0.2),
+    ),
+    passes=frozenset({(1, 2), (1, 3), (1, 4)}),
+    settings=(
+        ("palm_height", 0.0575),
+        ("palm_y", 0.1575),
+        ("max_joint_speed", 8.0),
+        ("joint_force", 1.0),
+        ("max_joint_torque", 1.0),
+        ("finger_mass", 0.02),
+    ),
+)
+"""A pianist's hand of human size (the Shadow hand's proportions, docs/simulator.md): five fingers,
+thumb to little, their knuckles 22 mm apart, phalanges 45, 25 and 26 mm, a human finger's joint
+ranges, the Shadow hand's joint speed and torque. The thumb is a finger like the others beside the
+index (as the Allegro-like hand's) that turns farther sideways (0.6 rad either way, as a thumb
+reaches under the palm); it passes under the index, middle and ring fingers and they over it
+(:attr:`HandModel.passes`: the fingering planner lets their fingertips cross). Its planner holds
+notes to their written end as a pianist does (a higher ``legato_cost``): the thumb passes under
+in a scale rather than the hand jumping. Its fingers turn sideways less far than the
+Allegro-like hand's longer ones, so the wrist strays less from straight over a held or struck
+key (``hold_reach``, ``strike_reach``; the thumb's as far farther as it turns) and slides more
+slowly while a finger holds one (``hold_slide``); and its joints, at the Shadow hand's speed,
+strike no faster than 0.2 m/s (``max_strike_speed``: about MIDI velocity 97 on a white key)."""
+
+register_hand_model(PIANIST)
