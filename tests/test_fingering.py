@@ -68,7 +68,7 @@ def test_planner_gives_distinct_fingers_in_pitch_order_within_reach(seed):
         for note in chord:
             key = note.pitch - planner.spec.lowest
             offset = planner.key_x[key] - wrist - FINGER_BASE_X[note.finger]
-            assert abs(offset) <= planner.reach[key] + 1e-9, f"{note} out of reach"
+            assert abs(offset) <= planner.reach[note.finger][key] + 1e-9, f"{note} out of reach"
         assert 0.0 <= wrist <= planner.grid[-1]
 
 

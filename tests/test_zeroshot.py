@@ -176,7 +176,7 @@ def test_benchmarks_hands_thumb_gives_every_player_and_the_examples_reading_each
 
     asked = []
     monkeypatch.setattr(hands, "figures", lambda *args, hand=None, **kw: asked.append(hand) or {"f1": 1.0})
-    monkeypatch.setattr(hands, "table", lambda name, rows: "")
+    monkeypatch.setattr(hands, "table", lambda name, rows, players=None: "")
     monkeypatch.setattr(hands, "example_table", lambda rows: "")
     read = []
     monkeypatch.setattr(hands, "two_hands", lambda path, options, spec: read.append(spec))
@@ -187,3 +187,20 @@ def test_benchmarks_hands_thumb_gives_every_player_and_the_examples_reading_each
     thumb = HandSpec((1, 2, 3, 4))
     assert read == [thumb]  # (the example file was read for that hand; here it is no two-hand file)
     assert asked == [thumb, thumb]  # both players of the one duet
+
+
+def test_benchmarks_hands_hand_model_pianist_plays_the_scripted_pianist_with_five_fingers(monkeypatch):
+    """No general policy plays the pianist's hand: only the scripted pianist plays, with its five fingers."""
+    import sys
+
+    from benchmarks import hands
+    from pianobot.sim.hand import default_fingers
+
+    asked = []
+    monkeypatch.setattr(
+        hands, "figures", lambda piece, player, *args, hand=None, **kw: asked.append((player, hand)) or {"f1": 1.0}
+    )
+    monkeypatch.setattr(hands, "table", lambda name, rows, players=None: "")
+    monkeypatch.setattr(sys, "argv", ["hands", "--duets", "1", "--polyphonic", "0", "--hand-model", "pianist"])
+    hands.main()
+    assert asked == [("scripted", default_fingers("pianist"))]
