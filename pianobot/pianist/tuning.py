@@ -2,9 +2,11 @@
 
 Lengths are in metres (m), angles in radians (rad), times in control steps (50 ms at the
 default 20 Hz). Heights are measured from a fingertip's lowest point to a key's top surface.
-They were tuned by hand on the examples and the task families (tests/test_controllers.py);
-:mod:`~pianobot.pianist.strikes` reads the strike constants and
-:mod:`~pianobot.pianist.motion` the positioning ones.
+They were tuned by hand on the examples and the task families (tests/test_controllers.py), for
+the Allegro-like hand; a hand model sets its own where it differs
+(:attr:`~pianobot.sim.hand.HandModel.tuning`, applied by :func:`tuning_for`; the pianist's
+hand's are in docs/simulator.md). :mod:`~pianobot.pianist.strikes` reads the strike constants
+and :mod:`~pianobot.pianist.motion` the positioning ones.
 """
 
 from __future__ import annotations
