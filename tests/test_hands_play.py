@@ -3,6 +3,7 @@ pieces they are measured on (pianobot/music/duets.py)."""
 
 import itertools
 import warnings
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -331,3 +332,26 @@ def test_both_hands_take_their_thumbs_only_where_the_thumbs_keep_more_notes():
         performance = play_hands(whole, "scripted")
     assert not [w for w in caught if "thumbs" in str(w.message)]
     assert all(h.performance.plan.config.world.hand.spec == HandSpec() for h in performance.hands)
+
+
+def test_the_finger_set_is_chosen_among_the_model_s_sets_in_its_order_of_preference():
+    """keeps_more: the first set, unless a later one gives the hands more notes (then the one that
+    gives the most, the earlier on a tie); a hand model with one set plays it, nothing compared."""
+    from pianobot.music.instrument import THUMB
+    from pianobot.music.load import LoadOptions
+    from pianobot.pianist.reading import fingers_for_file, keeps_more
+    from pianobot.sim.hand import default_fingers
+
+    chord = [Note(0.0, p, 2.0, 80, hand="right") for p in (72, 76, 79, 84)]
+    bass = [Note(0.0, 48, 2.0, 80, hand="left"), Note(2.0, 43, 4.0, 80, hand="left")]
+    piece = Piece(tuple(chord + bass + [Note(2.0, 81, 4.0, 80, hand="right")]), bpm=60)
+    three = HandSpec()
+    assert keeps_more([(three, piece), (THUMB, piece)]) == (1, (6, 7))
+    assert keeps_more([(THUMB, piece), (three, piece)]) == (0, None)  # the preferred set keeps more: kept
+    assert keeps_more([(three, piece), (three, piece), (THUMB, piece), (THUMB, piece)]) == (2, (6, 7))
+    pianist = default_fingers("pianist")
+    examples = Path(__file__).parent.parent / "examples" / "midi"
+    assert fingers_for_file(examples / "prelude-performed.mid", LoadOptions(), "pianist") == (
+        pianist,
+        None,
+    )

@@ -292,6 +292,7 @@ def read_file(song, reading: Reading, *, finger: bool = True, quiet: bool = Fals
         fit=fit,
         quiet=quiet,
         wording=Wording(**WORDING),
+        model=reading.hand.model,
     )
 
 

@@ -5,8 +5,8 @@ Every command that reads a piece (``play``, ``score``, ``inspect``, ``finger``, 
 
 1. :func:`open_song`: the file read and parsed, once (a PIG .txt file is read as text where
    needed); every later step derives what it needs from what was read;
-2. :func:`choose_fingers`: the fingers both hands play with where none are named (their thumbs
-   too where those keep notes that three fingers leave out: :func:`thumbs_keep_more`);
+2. :func:`choose_fingers`: the hand model's finger set both hands play with where none is named
+   (:func:`keeps_more`: the Allegro-like hand's thumbs where they keep notes three fingers leave out);
 3. :func:`read_both_hands`: whether the file plays both hands (:func:`two_hands`), and then every
    note with its hand (:class:`HandsReading`);
 4. otherwise one hand's part: :func:`choose_keys` (the keys it needs where none are named) and
@@ -40,6 +40,7 @@ from pianobot.music.window import Window, window_for
 from pianobot.pianist.assign import load_two_hands, reduce_hand
 from pianobot.pianist.fingering import FingeringPlan, ensure_fingering
 from pianobot.pianist.reduce import load_for_hand
+from pianobot.sim.hand import hand_model
 
 Source = Path | MidiSource
 """A file to read: a PIG .txt file's path, or a .mid file read once (:func:`open_song`)."""
@@ -113,11 +114,10 @@ def tracks_of(source: Source) -> tuple[TrackInfo, ...]:
 
 
 def choose_fingers(
-    source: Source, options: LoadOptions, quiet: bool = False, wording: Wording = Wording()
+    source: Source, options: LoadOptions, quiet: bool = False, wording: Wording = Wording(), model: str = HandSpec.model
 ) -> tuple[HandSpec, tuple[int, int] | None]:
-    """Both hands' fingers where none are named: :func:`fingers_for_file`, and where it gives
-    both hands their thumbs, one line saying so (not ``quiet``)."""
-    hand, counts = fingers_for_file(source, options)
+    """Both hands' fingers where none are named (:func:`fingers_for_file`), said where they change (not ``quiet``)."""
+    hand, counts = fingers_for_file(source, options, model)
     if counts is not None and not quiet:
         said = THUMBS_CHOSEN.format(more=counts[1], given=counts[0])
         warnings.warn(PianobotWarning(f"{source_path(source).name}: {said} ({wording.three})"))
@@ -203,19 +203,19 @@ def read_piece(
     fit: bool = True,
     quiet: bool = False,
     wording: Wording = Wording(),
+    model: str = HandSpec.model,
 ) -> ReadPiece:
-    """The file at ``path`` read for its players, step by step (the module's notes), the file
-    read once. ``keyboard``, ``fingers``: None where none are named (then chosen, each choice
-    said in one line unless ``quiet``). ``finger``: one hand's part also checked and fingered
-    (:func:`finger_part`; else :attr:`ReadPiece.piece` is None for one hand). ``both``: ask
-    whether it plays both hands (else one hand's part, as before two hands). ``fit``: as
-    :func:`~pianobot.pianist.reduce.load_for_hand`'s (a part wider than the keys refused)."""
+    """The file at ``path`` read once for its players, step by step (the module's notes).
+    ``keyboard``, ``fingers``: None where none are named (then chosen, ``fingers`` among ``model``'s
+    finger sets, each choice said unless ``quiet``). ``finger``: one hand's part also fingered
+    (:func:`finger_part`; else :attr:`ReadPiece.piece` is None for one hand). ``both``: ask whether
+    it plays both hands. ``fit``: as :func:`~pianobot.pianist.reduce.load_for_hand`'s."""
     source = open_song(path)
     name = source_path(source)
     tracks = tracks_of(source)
     thumbs = None
     if fingers is None:
-        fingers, thumbs = choose_fingers(source, options, quiet, wording)
+        fingers, thumbs = choose_fingers(source, options, quiet, wording, model)
     hands = read_both_hands(source, options, fingers, keyboard or KeyboardSpec()) if both else None
     if hands is not None:
         return ReadPiece(name, source, tracks, keyboard or KeyboardSpec(), fingers, thumbs, hands, piece=hands.piece)
@@ -440,43 +440,60 @@ def given_notes(piece: Piece, fingers: HandSpec, keyboard: KeyboardSpec | None =
             return None
 
 
+def keeps_more(
+    readings: list[tuple[HandSpec, Piece]], keyboard: KeyboardSpec | None = None
+) -> tuple[int, tuple[int, int] | None]:
+    """Which finger set both hands play with where none are named, of ``readings``: each of a hand
+    model's sets with the piece as read for it, in its order of preference. The first, unless a later
+    one gives the hands more notes (:func:`given_notes`): then the one that gives the most. Returns
+    (its index, (notes given with the first set, with it)), the counts None for the first."""
+    (_, first), *others = readings
+    given = given_notes(first, readings[0][0], keyboard)
+    if given is None:
+        return 0, None
+    best, most = 0, given
+    for index, (fingers, piece) in enumerate(others, start=1):
+        if most >= len(piece):  # (a later set's reading may keep notes of a chord the first thins)
+            continue
+        more = given_notes(piece, fingers, keyboard)
+        if more is not None and more > most:
+            best, most = index, more
+    return (best, (given, most)) if best else (0, None)
+
+
 def thumbs_keep_more(
     three: Piece, thumbs: Piece | None = None, keyboard: KeyboardSpec | None = None
 ) -> tuple[int, int] | None:
-    """(notes both hands are given with three fingers, with their thumbs too), where the thumbs
-    keep more of them; else None. ``three``: the piece with every note's hand as read for three
-    fingers; ``thumbs``: as read for hands with their thumbs (default the same); ``keyboard``: as
-    :func:`given_notes`'. This is how both hands choose their fingers where none are named: the
-    thumbs play wherever they keep notes that three fingers leave out (a chord wider than three
-    fingers reach, more notes at once, a passage too fast to play without one)."""
-    thumbs = three if thumbs is None else thumbs
-    given = given_notes(three, HandSpec(), keyboard)
-    if given is None or given >= len(thumbs):  # (the thumbs' reading may keep notes of a chord three fingers' thins)
-        return None
-    more = given_notes(thumbs, THUMB, keyboard)
-    return (given, more) if more is not None and more > given else None
+    """(notes both hands are given with three fingers, with their thumbs too) where the thumbs keep
+    more of them, else None: :func:`keeps_more` of the Allegro-like hand's sets, ``three`` and
+    ``thumbs`` (default the same) the piece as read for each."""
+    return keeps_more([(HandSpec(), three), (THUMB, three if thumbs is None else thumbs)], keyboard)[1]
 
 
-def fingers_for_file(path: str | Path | MidiSource, options: LoadOptions) -> tuple[HandSpec, tuple[int, int] | None]:
-    """Both hands' fingers for the file at ``path`` where none are named, as ``pianobot play``
-    chooses them: (:data:`~pianobot.music.instrument.THUMB`, (notes given with three fingers, with
-    thumbs)) where the file plays both hands read either way (:func:`two_hands`) and
-    :func:`thumbs_keep_more` says so, else (three fingers, None). Always on the default keys and
-    each player's own, whatever keys a command names, so that ``pianobot score``, which names
-    none, reads the hands as ``play`` did. A file the reading refuses keeps three fingers: that
-    reading says why. Nothing is said."""
+def fingers_for_file(
+    path: str | Path | MidiSource, options: LoadOptions, model: str = HandSpec.model
+) -> tuple[HandSpec, tuple[int, int] | None]:
+    """Both hands' fingers for the file at ``path`` where none are named, as ``pianobot play`` chooses
+    them among ``model``'s finger sets (:func:`keeps_more`, with its counts), where the file plays
+    both hands read with each (:func:`two_hands`), else the first set. On the default keys whatever
+    keys a command names, so that ``pianobot score`` reads the hands as ``play`` did. Nothing is said."""
+    sets = [HandSpec(fingers=fingers, model=model) for fingers in hand_model(model).finger_sets]
+    readings = []
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", PianobotWarning)
         try:
             source = open_song(path)
-            three = two_hands(source, options, HandSpec())
-            thumbs = None if three is None else two_hands(source, options, THUMB)
+            for fingers in sets if len(sets) > 1 else ():
+                reading = two_hands(source, options, fingers)
+                if reading is None:
+                    return sets[0], None
+                readings.append((fingers, reading.piece))
         except PianobotError:
-            return HandSpec(), None
-    if three is None or thumbs is None:
-        return HandSpec(), None
-    counts = thumbs_keep_more(three.piece, thumbs.piece)
-    return (HandSpec(), None) if counts is None else (THUMB, counts)
+            return sets[0], None
+    if not readings:
+        return sets[0], None
+    index, counts = keeps_more(readings)
+    return sets[index], counts
 
 
 THUMBS_CHOSEN = "both hands play with their thumbs too: they are given {more} of the notes, three fingers {given}"
