@@ -105,3 +105,21 @@ def test_a_file_s_own_five_finger_fingering_plays_as_written_on_the_pianist_s_ha
     assert [row["played_finger"] for row in report["notes"]] == written
     result = run("play", song, "-o", tmp_path / "allegro.mid", "--controller", "scripted")
     assert_one_line_error(result, "fingered 1 (thumb)", "--refinger", "--hand-model pianist")
+
+
+def test_under_position_control_each_finger_is_commanded_within_its_own_limits():
+    """The thumb turns farther than the fingers: position commands map each finger's angles to its
+    own limits (on the thumb's scale an index at its limit would be commanded short of it)."""
+
+    import numpy as np
+
+    from pianobot.pianist.layout import KeyLayout
+    from pianobot.pianist.motion import Motion
+    from pianobot.pianist.tuning import tuning_for
+
+    world = WorldConfig(hand=hand_config(FIVE), control="position")
+    motion = Motion(world, KeyLayout(world), tuning_for(world.hand))
+    assert motion.limits[1][1][0] == pytest.approx(0.6) and motion.limits[2][1][0] == pytest.approx(0.349)
+    index_at_limit = np.array([0.349, 0.5, 0.5, 0.5])
+    command = motion._finger_command(2, None, index_at_limit, wrist_next=0.1)
+    assert command[0] <= 1.0 and command[0] > 0.5  # near its own upper limit (+1), not mid-range on the thumb's

@@ -45,6 +45,10 @@ class KeyLayout:
         """A fingertip closer than this to the hinges (m) is over the black keys' band."""
         self.model = world.hand.model
         """The hand model: where its fingers' bases sit on the palm."""
+        self._reach_scale = {
+            f: math.tan(self.model.abduction_limit(f)) / math.tan(self.model.geometry.abduction_limit)
+            for f in self.model.fingers
+        }
 
     def contact_y(self, key: int) -> float:
         """Where on ``key`` the fingertip strikes (m from the hinge)."""
@@ -54,7 +58,7 @@ class KeyLayout:
         """How far ``finger`` turns sideways beside the model's fingers (the tan of its abduction
         limit over theirs): the scripted pianist's sideways reaches (``hold_reach``,
         ``strike_reach``) are for those, and a thumb that turns farther reaches farther."""
-        return math.tan(self.model.abduction_limit(finger)) / math.tan(self.model.geometry.abduction_limit)
+        return self._reach_scale[finger]
 
     def wrist_for(self, finger: int, key: int) -> float:
         """Wrist position that puts ``finger`` straight over ``key`` (m)."""

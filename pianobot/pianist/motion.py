@@ -46,8 +46,9 @@ class Motion:
         self.dt = 1.0 / world.control_hz
         self.position = world.control == "position"
         """Actions are joint angle targets (else joint speeds)."""
-        self.limits = joint_limits(world.hand)[:, :4]
-        """(lower, upper) limits of one finger's four joints (rad)."""
+        limits = joint_limits(world.hand)
+        self.limits = {f: limits[:, 4 * slot : 4 * slot + 4] for slot, f in enumerate(self.fingers)}
+        """Each finger's (lower, upper) limits of its four joints (rad): a thumb may turn farther."""
 
     def tip(self, q: np.ndarray) -> Tip:
         """Where the fingertip's lowest point is, from its joint angles (abduction first)."""
@@ -113,7 +114,7 @@ class Motion:
         step = self.hand.max_joint_speed * self.dt
         change = np.minimum(np.maximum(desired - q, -step), step)  # the most a joint moves in one control step
         if self.position:  # the angle to be at by the end of the step, -1 and 1 at the joint's limits
-            low, high = self.limits
+            low, high = self.limits[finger]
             return np.minimum(np.maximum((q + change - low) / (high - low) * 2.0 - 1.0, -1.0), 1.0)
         return change / step
 
