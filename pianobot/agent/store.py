@@ -85,8 +85,9 @@ def config_hash(config) -> str:
     configuration, fine-tuned or trained from scratch (the manifest's ``start`` says which).
     A SAC run (``TrainConfig.learner`` 'sac') leaves out ``learner`` and the DAgger settings it
     does not use, so that its folder keeps the name it had before there was another learner; an
-    agent with the default actor (``SACConfig.actor`` 'mlp') leaves out ``sac.actor`` likewise, and
-    a run of the Allegro-like hand (``HandSpec.model`` 'allegro') its hand model."""
+    agent with the default actor (``SACConfig.actor`` 'mlp') leaves out ``sac.actor`` likewise, a run
+    of the Allegro-like hand (``HandSpec.model`` 'allegro') its hand model, and a run whose foot
+    follows the score (``EnvConfig.pedal_action`` False) the pedal's settings."""
     runtime = {f.name for f in dataclasses.fields(config) if f.metadata.get("runtime") or f.metadata.get("start")}
     fields = {k: v for k, v in to_dict(config).items() if k not in runtime}
     if fields.get("learner") == "sac":
@@ -94,6 +95,10 @@ def config_hash(config) -> str:
         fields.pop("dagger", None)
     if isinstance(fields.get("sac"), dict) and fields["sac"].get("actor") == "mlp":
         fields["sac"] = {k: v for k, v in fields["sac"].items() if k != "actor"}
+    env = fields.get("env", {})
+    if isinstance(env, dict) and not env.get("pedal_action", True):  # (the pedal before it could be an action)
+        env.pop("pedal_action")
+        env.get("reward", {}).pop("pedal_weight", None)
     spec = fields.get("env", {}).get("world", {}).get("hand", {}).get("spec", {})
     if isinstance(spec, dict) and spec.get("model") == "allegro":  # (the hand model before there were others)
         spec.pop("model")

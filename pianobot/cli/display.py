@@ -101,14 +101,14 @@ def phrases_table(phrases: list[Phrase], players: dict[int, str] | None = None, 
 def report_tables(report: Report, every: bool = False, notes: int | None = None) -> list[Table]:
     """The figures, each with what it means: the first few (``every``: all of them); then the
     per-note table, its first ``notes`` rows (None: every row; 0: no table)."""
-    from pianobot.perform.report import FIGURES, NOTE_COLUMNS, note_cells
+    from pianobot.perform.figures import figures_for
+    from pianobot.perform.report import NOTE_COLUMNS, note_cells
 
     summary = Table(title="performance against reference")
     for column in ("figure", "value", "what it means"):
         summary.add_column(column, justify="right" if column == "value" else "left")
-    for figure in FIGURES:
-        if every or figure.first:
-            summary.add_row(figure.label, figure.value(report), f"[dim]{figure.meaning}[/dim]")
+    for figure in figures_for(report, every):
+        summary.add_row(figure.label, figure.value(report), f"[dim]{figure.meaning}[/dim]")
     if not every:
         summary.caption = "--all shows every figure; docs/metrics.md says how each is computed"
     if notes == 0:

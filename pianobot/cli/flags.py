@@ -20,6 +20,7 @@ FLAGS = {
     "load.split": "--split",
     "load.quantize": "--quantize",
     "load.refinger": "--refinger",
+    "load.pedal": "--pedal",
     "keyboard.lowest": "--lowest-note",
     "keyboard.count": "--keys",
     "hand.fingers": "--thumb",

@@ -15,11 +15,12 @@ current step and ``lookahead`` following steps; the fingertips' tactile images o
 steps (uint8, pooled to ``tactile_pool``); wrist position and speed; finger joint angles and
 speeds; for each finger, where the next key it has to play lies relative to its fingertip, how
 soon, how loud, and how much longer to hold the key it holds (:func:`finger_targets`, not in the
-paper); and, only when asked for (the paper's ablation), key angles and speeds.
-Actions: the actuated finger joints (of abduction, MCP, PIP, DIP per finger) then the wrist,
-each in [-1, 1]: joint speeds (``WorldConfig.control='velocity'``, the default), joint angle
-targets with -1 and 1 at the joint's limits ('position') or joint torques ('torque'); the wrist's
-is always its speed along the rail (or, with ``discrete_wrist``, a white key to go to).
+paper); only when asked for (the paper's ablation), key angles and speeds; and with the pedal an
+action, the score's pedal.
+Actions, each in [-1, 1]: the actuated finger joints (of abduction, MCP, PIP, DIP per finger):
+joint speeds (``WorldConfig.control='velocity'``, the default), angle targets with -1 and 1 at
+the joint's limits ('position') or torques ('torque'); the wrist's speed along the rail (or, with
+``discrete_wrist``, a white key to go to); with ``pedal_action``, the foot (above 0: pedal down).
 
 Version history (the ids' ``-v<N>``, :data:`pianobot.env.VERSION`; a stored policy records the
 version it was trained on, its manifest's ``simulator``, and the :class:`EnvConfig` it was
@@ -27,6 +28,8 @@ trained with; :data:`pianobot.agent.store.FORMAT` says how older records are rea
 changes whenever the same actions could play differently; a change that adds a setting and
 leaves the default environment playing as before keeps it:
 
+- v1, later: ``pedal=`` (the written sustain pedal, worked by the environment, ``info["pedal"]``)
+  and ``pedal_action``; without a pedal an episode plays as before.
 - v1 (2026-11-24): every key is a body of its own, asleep while at rest and untouched. The
   keys' geometry, mass, hinge, limits and spring are v0's, but the solver orders its work
   differently: finger joints move 0.004 rad apart from v0's on average over a performance, and
@@ -52,6 +55,7 @@ from gymnasium import spaces
 from pianobot.config import check_ranges
 from pianobot.env.rewards import RewardConfig, reward_terms
 from pianobot.music.instrument import check_playable
+from pianobot.music.pedal import Pedal
 from pianobot.music.piece import Piece
 from pianobot.music.tasks import TASKS, make_task
 from pianobot.music.tensor import FINGER, NOTE, VELOCITY, ScoreSpec, score_tensor, steps_for
@@ -187,6 +191,11 @@ class EnvConfig:
     and repeated notes cannot be told apart)."""
     random_start: bool = True
     """Start the wrist at a random position along the keyboard (else at its centre)."""
+    pedal_action: bool = False
+    """The sustain pedal is the action's last value (the foot: above 0 holds it down), the score's
+    pedal is observed (``"pedal"``: down or up now and ``lookahead`` steps ahead) and rewarded
+    (``reward.pedal_weight``). Without it the environment works the pedal as the piece's written
+    pedal says (none for a task instance): the foot follows the score."""
     actuated: tuple[str, ...] = JOINT_KINDS
     """Finger joints the policy moves, all four by default (abduction is needed for chords and
     for keys beside the wrist's line); the others hold their starting angle, as the paper froze
@@ -231,6 +240,7 @@ class PianoEnv(gym.Env):
         sampler: Sampler | None = None,
         length: float | None = None,
         view: HandView | None = None,
+        pedal: Pedal | None = None,
     ):
         if [piece, task, sampler].count(None) != 2:
             raise ValueError("give exactly one of piece=, task= or sampler=")
@@ -254,6 +264,7 @@ class PianoEnv(gym.Env):
             raise ValueError("a hand's view needs the environment's keyboard to be the view's, and no render mode")
         self.piece = piece
         self.length = length
+        self.pedal = pedal or Pedal()  # (the written sustain pedal, in the piece's time; none for a task)
         self.world = view if view is not None else PianoWorld(config.world)
         self.owns_world = view is None
         """False for one hand of a world of two (:class:`pianobot.env.two_hands.HandsEnv` steps and resets it)."""
@@ -283,6 +294,8 @@ class PianoEnv(gym.Env):
         if config.key_observations:
             obs["keys"] = spaces.Box(-SPEED_BOUND, SPEED_BOUND, (keys,), np.float32)
             obs["key_velocities"] = spaces.Box(-SPEED_BOUND, SPEED_BOUND, (keys,), np.float32)
+        if config.pedal_action:
+            obs["pedal"] = spaces.Box(0.0, 1.0, (config.lookahead + 1,), np.float32)
         self.observation_space = spaces.Dict(obs)
         self.actuated = actuated_indices(config)
         # what the joints left out of the action get: no speed, or (position control) their starting angles
@@ -290,7 +303,8 @@ class PianoEnv(gym.Env):
         if config.world.control == "position":
             low, high = joint_limits(config.world.hand)
             self.frozen[:-1] = (start_angles(config.world) - low) / (high - low) * 2.0 - 1.0
-        self.action_space = spaces.Box(-1.0, 1.0, (len(self.actuated),), np.float32)
+        self.action_space = spaces.Box(-1.0, 1.0, (len(self.actuated) + config.pedal_action,), np.float32)
+        self.pedal_down = False  # (whether the foot held the pedal down in the step just taken)
         if piece is not None:
             self._set_piece(piece)
 
@@ -304,6 +318,8 @@ class PianoEnv(gym.Env):
         tensor = score_tensor(piece, spec, steps=body)
         self.score = np.zeros((padded, spec.keyboard.count, spec.channels), dtype=np.float32)
         self.score[self.lead_steps : self.lead_steps + body] = tensor
+        self.pedal_score = np.zeros(padded, np.float32)  # (the written pedal at each score row's middle)
+        self.pedal_score[self.lead_steps : self.lead_steps + body] = self.pedal.steps(body, spec.control_hz)
         finger_numbers = np.array(spec.hand.fingers)
         has_finger = self.score[:, :, FINGER:].max(axis=2) > 0.5
         self.target_finger = np.where(has_finger, finger_numbers[self.score[:, :, FINGER:].argmax(axis=2)], 0)
@@ -343,6 +359,7 @@ class PianoEnv(gym.Env):
         """The episode's first observation and info, once the world is reset."""
         self._tip_cache = None
         self.t = 0
+        self.pedal_down = False
         self.key_finger = np.zeros(self.spec_score.keyboard.count, dtype=int)
         if self.tactile is not None:
             shape = self.observation_space["tactile"].shape[1:]
@@ -359,7 +376,15 @@ class PianoEnv(gym.Env):
         return full
 
     def step(self, action):
-        return self.absorb(self.world.step(self.full_action(np.asarray(action, dtype=np.float64))))
+        action = np.asarray(action, dtype=np.float64)
+        self.pedal_down = self.foot(action)
+        return self.absorb(self.world.step(self.full_action(action[: len(self.actuated)])))
+
+    def foot(self, action: np.ndarray | None = None) -> bool:
+        """Whether the pedal is down this step: the action's foot (``pedal_action``), else the written pedal."""
+        if self.config.pedal_action and action is not None:
+            return bool(action[-1] > 0)
+        return bool(self.pedal_score[self.t] > 0.5)
 
     def absorb(self, result: StepResult):
         """Observe and reward what a step of the world did (``step`` without acting: one hand of a
@@ -382,6 +407,8 @@ class PianoEnv(gym.Env):
             self.target_finger[self.t],
             self._fingertip_distances() if self.config.reward.closeness_weight else None,
         )
+        if self.config.pedal_action:  # (the foot as the score says, down or up)
+            terms["pedal"] = self.config.reward.pedal_weight * (self.pedal_down == (self.pedal_score[self.t] > 0.5))
         reward = float(sum(terms.values()))
         self.t += 1
         truncated = self.t >= self.horizon
@@ -391,6 +418,7 @@ class PianoEnv(gym.Env):
             "fingers": result.fingers,
             "pressed": result.pressed,
             "target": target_row[:, NOTE] > 0.5,
+            "pedal": self.pedal_down,
         }
         return self._observe(), reward, False, truncated, info
 
@@ -453,6 +481,8 @@ class PianoEnv(gym.Env):
             max_angle = cfg.world.keyboard.geometry.max_angle
             obs["keys"] = _bounded(key_angles / max_angle)
             obs["key_velocities"] = _bounded(key_speeds / (max_angle * cfg.world.control_hz))
+        if cfg.pedal_action:
+            obs["pedal"] = self.pedal_score[self.t : self.t + cfg.lookahead + 1].copy()
         return obs
 
     def render(self) -> np.ndarray | None:

@@ -46,6 +46,9 @@ class RewardConfig:
     near the key it is to play next (0 turns it off). Without it SAC learnt to do nothing."""
     closeness_scale: float = 0.02
     """Distance (m) at which the closeness bonus has fallen to 1/e."""
+    pedal_weight: float = 0.2
+    """With the pedal an action (``EnvConfig.pedal_action``): this much per step for a foot that holds
+    the pedal as the score's pedal says, down or up (RoboPianist rewards its sustain likewise)."""
 
     def __post_init__(self) -> None:
         if self.kind not in REWARDS:
@@ -57,6 +60,7 @@ class RewardConfig:
             key_cost=(0.0, 1e3),
             closeness_weight=(0.0, 1e3),
             closeness_scale=(1e-4, 1.0),
+            pedal_weight=(0.0, 1e3),
         )
 
 

@@ -17,7 +17,10 @@ those keys too; no note is written on them.
 
 Spaces are dicts keyed by hand ('right', 'left'); the reward is the sum of the hands'
 (``info["rewards"]`` has each); ``info["hands"]`` holds each hand's step info, and ``info``
-also the world's key events with the finger and hand of each strike.
+also the world's key events with the finger and hand of each strike, and whether the sustain
+pedal was down (``info["pedal"]``). The foot works the piece's written ``pedal``; with
+``pedal_action`` it is an action beside the hands' (``"pedal"``: above 0 holds it down), and the
+written pedal is observed (``"pedal"``: now and the lookahead's steps ahead).
 
 Version: :data:`pianobot.env.VERSION`, as :mod:`pianobot.env.piano`'s (v1 the first with two
 hands, on v1's physics); no id is registered with gymnasium (a two-hand piece's parts need the fingering planner and the windows, above this layer:
@@ -34,6 +37,7 @@ from gymnasium import spaces
 
 from pianobot.env.piano import EnvConfig, PianoEnv
 from pianobot.music.instrument import KeyboardSpec
+from pianobot.music.pedal import Pedal
 from pianobot.music.piece import HANDS, Piece
 from pianobot.music.window import Window
 from pianobot.sim.frame import HandView
@@ -70,6 +74,8 @@ class HandsEnv(gym.Env):
         configs: dict[str, EnvConfig],
         render_mode: str | None = None,
         keyboard: KeyboardSpec | None = None,
+        pedal: Pedal | None = None,
+        pedal_action: bool = False,
     ):
         if render_mode not in (None, *self.metadata["render_modes"]):
             raise ValueError(f"render_mode {render_mode!r}: choose None or 'rgb_array'")
@@ -87,6 +93,8 @@ class HandsEnv(gym.Env):
             raise ValueError("both hands' environments must share their physics (control, rates, hand, keys, solver)")
         if len({(configs[h].lead_in, configs[h].tail) for h in HANDS}) > 1:
             raise ValueError("both hands' environments must share their lead-in and tail (one timeline)")
+        if any(configs[h].pedal_action for h in HANDS):
+            raise ValueError("one foot works the pedal for both hands: give HandsEnv pedal_action, not a hand")
         if configs["right"].world.discrete_wrist:
             raise ValueError(
                 "a discrete wrist picks among the world's keys, not a hand's view's: use a continuous wrist"
@@ -101,12 +109,15 @@ class HandsEnv(gym.Env):
                 window, part = parts[hand]
                 view = HandView(self.world, index, window)
                 config = replace(configs[hand], world=replace(view.config, gui=False))
-                self.hands[hand] = PianoEnv(piece=part, config=config, length=length, view=view)
+                self.hands[hand] = PianoEnv(piece=part, config=config, length=length, view=view, pedal=pedal)
         except Exception:
             self.world.close()
             raise
-        self.observation_space = spaces.Dict({h: env.observation_space for h, env in self.hands.items()})
-        self.action_space = spaces.Dict({h: env.action_space for h, env in self.hands.items()})
+        self.pedal_action = pedal_action
+        foot = {"pedal": spaces.Box(-1.0, 1.0, (1,), np.float32)} if pedal_action else {}
+        written = {"pedal": spaces.Box(0.0, 1.0, (configs["right"].lookahead + 1,), np.float32)} if pedal_action else {}
+        self.observation_space = spaces.Dict({**{h: env.observation_space for h, env in self.hands.items()}, **written})
+        self.action_space = spaces.Dict({**{h: env.action_space for h, env in self.hands.items()}, **foot})
         self.horizon = self.hands["right"].horizon
         self.score_start = self.hands["right"].score_start
 
@@ -123,7 +134,7 @@ class HandsEnv(gym.Env):
         self.holders: dict[int, str] = {}
         """World pitch -> the hand whose strike sounds it now."""
         firsts = {h: env.begin() for h, env in self.hands.items()}
-        return {h: obs for h, (obs, _) in firsts.items()}, {
+        return self._with_pedal({h: obs for h, (obs, _) in firsts.items()}), {
             "pieces": {h: info["piece"] for h, (_, info) in firsts.items()}
         }
 
@@ -139,7 +150,15 @@ class HandsEnv(gym.Env):
                 right, left = width, left - (right - width)
         return right, left
 
+    def _with_pedal(self, observations: dict) -> dict:
+        """The hands' observations, and with the foot an action the written pedal ahead."""
+        if self.pedal_action:
+            right = self.hands["right"]
+            observations["pedal"] = right.pedal_score[right.t : right.t + right.config.lookahead + 1].copy()
+        return observations
+
     def step(self, action: dict):
+        self.pedal_down = bool(action["pedal"][0] > 0) if self.pedal_action else self.hands["right"].foot()
         full = np.concatenate(
             [
                 self.view(h).world_action(env.full_action(np.asarray(action[h], dtype=np.float64)))
@@ -160,6 +179,7 @@ class HandsEnv(gym.Env):
         observations, rewards, infos = {}, {}, {}
         truncated = True
         for hand, env in self.hands.items():
+            env.pedal_down = self.pedal_down
             others = {pitch for pitch, by in played.items() if by != hand}
             observations[hand], rewards[hand], _, done, infos[hand] = env.absorb(self.view(hand).result(result, others))
             truncated = truncated and done
@@ -169,8 +189,9 @@ class HandsEnv(gym.Env):
             "events": result.events,
             "fingers": result.fingers,
             "struck_by": struck,
+            "pedal": self.pedal_down,
         }
-        return observations, float(sum(rewards.values())), False, truncated, info
+        return self._with_pedal(observations), float(sum(rewards.values())), False, truncated, info
 
     def _nearer(self, pitch: int) -> str:
         x = self.world.boxes[pitch - self.world.config.keyboard.spec.lowest].center[0]

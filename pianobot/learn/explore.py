@@ -32,6 +32,8 @@ class Explorer:
         if kind not in EXPLORATIONS:
             raise ValueError(f"exploration must be one of {', '.join(EXPLORATIONS)}; got {kind!r}")
         self.kind, self.size, self.rng = kind, action_size, rng
+        self.foot = int(config.pedal_action)
+        """1 where the action ends with the foot (the wrist's is then the one before it)."""
         self.pianist = ScriptedPianist(config) if kind == "scripted" else None  # needs velocity or position control
         self.previous: np.ndarray | None = None
         self.noise = 0.0
@@ -61,6 +63,6 @@ class Explorer:
         if self.kind in ("repeat", "prior") and self.previous is not None and self.rng.random() < REPEAT_PROBABILITY:
             action = self.previous.copy()
         if self.kind == "prior" and self.rng.random() >= WRIST_MOVE_PROBABILITY:
-            action[-1] = 0.0  # the wrist stays where it is
+            action[self.size - 1 - self.foot] = 0.0  # the wrist stays where it is
         self.previous = action
         return action

@@ -9,6 +9,7 @@ from pathlib import Path
 from pianobot.errors import PianobotError, PianobotWarning, SettingError, quote
 from pianobot.music import midi_io, pig
 from pianobot.music.instrument import PIANO, HandSpec
+from pianobot.music.pedal import Pedal
 from pianobot.music.piece import HANDS, Note, Piece, pitch_name
 
 
@@ -35,6 +36,9 @@ class LoadOptions:
     """Move onsets and offsets to this grid, e.g. '1/16' (for recordings of human players)."""
     refinger: bool = False
     """Replace the file's fingering with the planner's (see pianobot.pianist.fingering)."""
+    pedal: bool = True
+    """Read the file's sustain pedal (control change 64, down at 64 or more), which ``play`` plays
+    as written and ``score`` scores; False: the pedal stays up."""
 
 
 def hand_tracks(tracks: list[midi_io.TrackInfo], hand: str) -> list[int]:
@@ -307,3 +311,11 @@ def _crossing(piece: Piece) -> str:
             return f"{note.onset:.3f} s: the left hand's {left.name} sounds at or above the right hand's {right.name}"
         sounding.append(note)
     return ""
+
+
+def load_pedal(source: Path | midi_io.MidiSource, options: LoadOptions) -> Pedal:
+    """The file's sustain pedal, re-timed as ``options.tempo`` re-times its notes (none for a PIG
+    file, or with ``options.pedal`` off)."""
+    if not options.pedal or not isinstance(source, midi_io.MidiSource):
+        return Pedal()
+    return midi_io.read_pedal(source, bpm=options.tempo)

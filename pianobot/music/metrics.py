@@ -12,12 +12,14 @@ See docs/metrics.md.
 from __future__ import annotations
 
 import io
+import math
 import warnings
 from dataclasses import asdict, dataclass
 
 import numpy as np
 
 from pianobot.files import atomic_write
+from pianobot.music.pedal import Pedal
 from pianobot.music.piece import Note, Piece
 from pianobot.music.tensor import ScoreSpec, note_steps
 
@@ -78,6 +80,14 @@ class Report:
     fingering_accuracy: float | None
     onset_tolerance: float
     rows: tuple[NoteRow, ...]
+    sounding_f1_with_offsets: float | None = None
+    """Note F1 with offsets on sounding durations: each file's own sustain pedal applied to its notes
+    (:meth:`~pianobot.music.pedal.Pedal.sounding`); None where neither uses the pedal."""
+    pedal_f1: float | None = None
+    """Presses and releases of the pedal matched one to one within the onset tolerance (:func:`pedal_f1`);
+    None where neither uses the pedal."""
+    pedal_error_mean: float | None = None
+    """Mean timing error (s) of the matched presses and releases; None where none matched."""
 
     def summary(self) -> dict:
         """The summary figures (everything but the per-note rows)."""
@@ -189,8 +199,10 @@ def compare(
     played: Piece,
     onset_tolerance: float = DEFAULT_ONSET_TOLERANCE,
     control_hz: float = ScoreSpec.control_hz,
+    pedals: tuple[Pedal, Pedal] | None = None,
 ) -> Report:
-    """Score ``played`` against ``reference``."""
+    """Score ``played`` against ``reference``; with ``pedals`` (the reference's sustain pedal, the
+    performance's), where either is pressed, also the pedal's figures."""
     _, transcription, transcription_velocity = _mir_eval()
     ref_int, ref_hz, ref_vel = _arrays(reference)
     out_int, out_hz, out_vel = _arrays(played)
@@ -249,7 +261,28 @@ def compare(
         ),
         onset_tolerance=onset_tolerance,
         rows=tuple(rows),
+        **_pedal_figures(reference, played, pedals, onset_tolerance),
     )
+
+
+def _pedal_figures(reference: Piece, played: Piece, pedals: tuple[Pedal, Pedal] | None, tolerance: float) -> dict:
+    """The Report's pedal fields (empty where neither piece uses the pedal)."""
+    if pedals is None or not any(pedals):
+        return {}
+    _, transcription, _ = _mir_eval()
+    ref_int, ref_hz, _ = _arrays(pedals[0].sounding(reference))
+    out_int, out_hz, _ = _arrays(pedals[1].sounding(played))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        _, _, sounding, _ = transcription.precision_recall_f1_overlap(
+            ref_int, ref_hz, out_int, out_hz, onset_tolerance=tolerance
+        )
+    f1, error = pedal_f1(*pedals, tolerance)
+    return {
+        "sounding_f1_with_offsets": float(sounding),
+        "pedal_f1": f1,
+        "pedal_error_mean": None if math.isnan(error) else round(error, 6),
+    }
 
 
 def plot_report(reference: Piece, played: Piece, report: Report, path) -> None:
@@ -299,3 +332,22 @@ def plot_report(reference: Piece, played: Piece, report: Report, path) -> None:
     fig.savefig(buffer, format="png", dpi=100)
     plt.close(fig)
     atomic_write(path, buffer.getvalue())
+
+
+def pedal_f1(reference: Pedal, played: Pedal, tolerance: float = DEFAULT_ONSET_TOLERANCE) -> tuple[float, float]:
+    """How closely ``played`` works the pedal as ``reference`` does: F1 of its presses and releases
+    matched one to one with the reference's of the same kind within ``tolerance`` seconds
+    (mir_eval's event matching), and the mean timing error (s) of the matched ones (nan where none is
+    matched). Both without pedal: 1.0, nan."""
+    util, _, _ = _mir_eval()
+    if not reference and not played:
+        return 1.0, math.nan
+    hits, errors = 0, []
+    for kind in (True, False):
+        ref = np.array([t for t, down in reference.changes() if down is kind])
+        out = np.array([t for t, down in played.changes() if down is kind])
+        for i, j in util.match_events(ref, out, tolerance):
+            hits += 1
+            errors.append(abs(ref[i] - out[j]))
+    changes = 2 * (len(reference) + len(played))
+    return 2 * hits / changes, float(np.mean(errors)) if errors else math.nan

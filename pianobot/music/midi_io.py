@@ -35,6 +35,7 @@ from pianobot.music.midi_file import (  # noqa: F401 (by their old address too)
     opened,
     source_path,
 )
+from pianobot.music.pedal import DOWN_AT, Pedal
 from pianobot.music.piece import HANDS, MAX_SECONDS, Note, Piece, pitch_name
 
 _FINGER_TOKEN = r"(?:[0-9](?:_[0-9])?|-)"
@@ -146,6 +147,8 @@ class _TempoMap:
         return seconds + mido.tick2second(tick - tick0, self.tpb, tempo)
 
 
+SUSTAIN = 64
+"""The sustain pedal's MIDI control change number."""
 PERCUSSION = 9
 """MIDI channel 10 (9 counted from 0): General MIDI's drums, whose notes are no piano keys."""
 
@@ -156,7 +159,7 @@ def list_tracks(midi: mido.MidiFile) -> list[TrackInfo]:
     for i, track in enumerate(midi.tracks):
         name = _text(next((m.name for m in track if m.type == "track_name"), ""))
         ons = [m for m in track if m.type == "note_on" and m.velocity > 0 and m.channel != PERCUSSION]
-        pedal = sum(1 for m in track if m.type == "control_change" and m.control == 64 and m.value >= 64)
+        pedal = sum(1 for m in track if m.type == "control_change" and m.control == SUSTAIN and m.value >= DOWN_AT)
         pitches = [m.note for m in ons]
         infos.append(
             TrackInfo(
@@ -278,19 +281,10 @@ def read_midi(
     tracks merged). ``bpm`` re-times the piece at a constant tempo, ignoring the file's tempo
     map. ``grid`` (a fraction of a whole note, e.g. 1/16) moves every onset and offset to the
     nearest grid line, in the file's beats, for recordings of human players; a note lasts at
-    least one grid step. Sustain-pedal events are ignored: a note sounds while its key is down.
+    least one grid step. A note lasts while its key is down; the sustain pedal is :func:`read_pedal`'s.
     """
     path, midi = opened(path)
-    if bpm is not None:
-        if not 10 <= bpm <= 1000:
-            raise SettingError(f"load.tempo {bpm}: choose a tempo between 10 and 1000 bpm", "load.tempo")
-        tpb = midi.ticks_per_beat
-        seconds = lambda tick: tick / tpb * 60.0 / bpm  # noqa: E731
-        nominal = bpm
-    else:
-        tempo_map = _TempoMap(midi, path)
-        seconds = tempo_map.seconds
-        nominal = max(10.0, min(1000.0, mido.tempo2bpm(tempo_map.first_tempo)))
+    seconds, nominal = _clock(midi, path, bpm)
 
     if grid is not None:
         step = max(1, round(midi.ticks_per_beat * 4 * grid))
@@ -355,6 +349,39 @@ def read_midi(
                 continue
             notes.append(Note(onset=onset, pitch=pitch, offset=offset, velocity=vel, finger=finger, hand=hand))
     return Piece(tuple(_resolve_overlaps(notes)), bpm=nominal)
+
+
+def _clock(midi: mido.MidiFile, path: Path, bpm: float | None):
+    """(ticks -> seconds, the nominal tempo): through the file's tempo map, or at ``bpm`` throughout."""
+    if bpm is not None:
+        if not 10 <= bpm <= 1000:
+            raise SettingError(f"load.tempo {bpm}: choose a tempo between 10 and 1000 bpm", "load.tempo")
+        tpb = midi.ticks_per_beat
+        return (lambda tick: tick / tpb * 60.0 / bpm), bpm
+    tempo_map = _TempoMap(midi, path)
+    return tempo_map.seconds, max(10.0, min(1000.0, mido.tempo2bpm(tempo_map.first_tempo)))
+
+
+def read_pedal(path: str | Path | MidiSource, *, bpm: float | None = None) -> Pedal:
+    """The sustain pedal of a .mid file: control change 64 on any track and channel (a value of
+    :data:`~pianobot.music.pedal.DOWN_AT` or more is down), timed as :func:`read_midi` times notes
+    (``bpm`` as there). A pedal still down at the file's end comes up with its last event."""
+    path, midi = opened(path)
+    seconds, _ = _clock(midi, path, bpm)
+    changes, end = [], 0
+    for track in midi.tracks:
+        for tick, msg in _absolute(track):
+            end = max(end, tick)
+            if msg.type == "control_change" and msg.control == SUSTAIN:
+                changes.append((tick, msg.value >= DOWN_AT))
+    changes.sort(key=lambda change: change[0])  # (one tick's events in their track's order)
+    if changes and seconds(changes[-1][0]) > MAX_SECONDS:
+        raise SettingError(
+            f"{path} presses the pedal at {seconds(changes[-1][0]) / 60:,.0f} minutes: pianobot reads at most "
+            f"{MAX_SECONDS / 60:.0f} minutes of music; cut the file or choose a faster load.tempo",
+            "load.tempo",
+        )
+    return Pedal.from_changes(((seconds(t), down) for t, down in changes), end=min(seconds(end), MAX_SECONDS))
 
 
 def _parts(midi: mido.MidiFile, chosen: list[int], seconds, path: Path) -> list[tuple[int | None, list, dict]]:

@@ -9,7 +9,8 @@ from pathlib import Path
 import mido
 
 from pianobot.files import atomic_write
-from pianobot.music.midi_io import TRACK_NAMES, UNASSIGNED_TRACK, finger_text
+from pianobot.music.midi_io import SUSTAIN, TRACK_NAMES, UNASSIGNED_TRACK, finger_text
+from pianobot.music.pedal import Pedal
 from pianobot.music.piece import Piece
 
 
@@ -19,9 +20,13 @@ def _write_resolution(bpm: float) -> tuple[int, int]:
     return tempo, tempo // 1000
 
 
-def _track(part: Piece, name: str, tempo: int | None) -> mido.MidiTrack:
-    """One track of ``part``'s notes with fingering lyrics, named ``name``, with the tempo if given."""
+def _track(part: Piece, name: str, tempo: int | None, pedal: Pedal = Pedal()) -> mido.MidiTrack:
+    """One track of ``part``'s notes with fingering lyrics, named ``name``, with the tempo if given
+    and the sustain pedal (control change 64: 127 down, 0 up)."""
     events: list[tuple[int, int, mido.Message | mido.MetaMessage]] = []
+    for time, down in pedal.changes():  # (a release sorts before the note-offs at its tick, a press after them)
+        message = mido.Message("control_change", control=SUSTAIN, value=127 if down else 0)
+        events.append((round(time * 1000), 3 if down else 0, message))
     for chord in part.chords():
         tick = round(chord[0].onset * 1000)
         if any(n.finger is not None for n in chord):
@@ -44,10 +49,10 @@ def _track(part: Piece, name: str, tempo: int | None) -> mido.MidiTrack:
     return track
 
 
-def midi_bytes(piece: Piece, *, name: str = "pianobot") -> bytes:
+def midi_bytes(piece: Piece, *, name: str = "pianobot", pedal: Pedal = Pedal()) -> bytes:
     """The piece as a MIDI file with 1 ms ticks and fingering lyrics: type 0 (one track named
     ``name``) when no note has a hand, else type 1 with one track per hand ("Right Hand", "Left
-    Hand", then "Unassigned" for notes without a hand), the first carrying the tempo."""
+    Hand", then "Unassigned" for notes without a hand), the first carrying the tempo and ``pedal``."""
     tempo, tpb = _write_resolution(piece.bpm)
     if piece.hands:
         parts = [(TRACK_NAMES[hand], piece.part(hand)) for hand in piece.hands]
@@ -57,12 +62,12 @@ def midi_bytes(piece: Piece, *, name: str = "pianobot") -> bytes:
     # any name: a file name may be '音.mid'
     midi = mido.MidiFile(type=1 if piece.hands else 0, ticks_per_beat=tpb, charset="utf-8")
     for i, (track_name, part) in enumerate(parts):
-        midi.tracks.append(_track(part, track_name, tempo if i == 0 else None))
+        midi.tracks.append(_track(part, track_name, tempo if i == 0 else None, pedal if i == 0 else Pedal()))
     buffer = io.BytesIO()
     midi.save(file=buffer)
     return buffer.getvalue()
 
 
-def write_midi(piece: Piece, path: str | Path, *, name: str = "pianobot") -> Path:
-    """Write ``piece`` to ``path`` atomically (see :func:`midi_bytes`)."""
-    return atomic_write(path, midi_bytes(piece, name=name))
+def write_midi(piece: Piece, path: str | Path, *, name: str = "pianobot", pedal: Pedal = Pedal()) -> Path:
+    """Write ``piece`` (and its sustain ``pedal``) to ``path`` atomically (see :func:`midi_bytes`)."""
+    return atomic_write(path, midi_bytes(piece, name=name, pedal=pedal))

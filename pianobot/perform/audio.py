@@ -12,6 +12,7 @@ import numpy as np
 from pianobot.errors import PianobotError
 from pianobot.files import atomic_write
 from pianobot.music.midi_io import midi_bytes
+from pianobot.music.pedal import Pedal
 from pianobot.music.piece import Piece
 
 SAMPLE_RATE = 22_050
@@ -59,12 +60,16 @@ def check_soundfont(path: Path) -> Path:
 
 
 def synthesize(
-    piece: Piece, sample_rate: int = SAMPLE_RATE, font: Path | None = None, delay: float = 0.0
+    piece: Piece, sample_rate: int = SAMPLE_RATE, font: Path | None = None, delay: float = 0.0, pedal: Pedal = Pedal()
 ) -> tuple[np.ndarray, str]:
     """(audio samples in [-1, 1], how they were made): with the soundfont ``font`` (checked with
     :func:`check_soundfont`), else an installed one, else sine waves; ``delay`` seconds of
-    silence before the piece's time 0 (a video's lead-in)."""
+    silence before the piece's time 0 (a video's lead-in). With the sustain ``pedal`` each note
+    sounds as long as the pedal holds it (:meth:`~pianobot.music.pedal.Pedal.sounding`), with
+    the soundfont and the sine waves alike."""
     import pretty_midi  # (imported when sound is made: it and scipy take most of a second)
+
+    piece = pedal.sounding(piece)
 
     midi = pretty_midi.PrettyMIDI(io.BytesIO(midi_bytes(piece.shift(delay) if delay else piece)))
     font = font or soundfont()
@@ -74,10 +79,16 @@ def synthesize(
 
 
 def write_wav(
-    piece: Piece, path: str | Path, sample_rate: int = SAMPLE_RATE, font: Path | None = None, delay: float = 0.0
+    piece: Piece,
+    path: str | Path,
+    sample_rate: int = SAMPLE_RATE,
+    font: Path | None = None,
+    delay: float = 0.0,
+    pedal: Pedal = Pedal(),
 ) -> str:
-    """Write the piece as 16-bit mono WAV, atomically; returns how it was synthesised."""
-    audio, method = synthesize(piece, sample_rate, font, delay)
+    """Write the piece (sounding with its sustain ``pedal``, as :func:`synthesize`) as 16-bit mono
+    WAV, atomically; returns how it was synthesised."""
+    audio, method = synthesize(piece, sample_rate, font, delay, pedal)
     peak = float(np.abs(audio).max()) if audio.size else 0.0
     samples = (audio / peak * 0.9 * 32767).astype(np.int16) if peak > 0 else audio.astype(np.int16)
     buffer = io.BytesIO()

@@ -32,6 +32,8 @@ class Figure:
     meaning: str
     first: bool = False
     """Among the figures a newcomer needs first (the rest: `--all`, and the HTML report)."""
+    applies: Callable[[Report], bool] = lambda r: True
+    """Whether the report has it (the pedal's figures: where either piece uses the pedal)."""
 
 
 FIGURES = (
@@ -98,6 +100,21 @@ FIGURES = (
         "how long notes were held against their written length: 1 as written, 0.5 half as long",
     ),
     Figure(
+        "note F1 with offsets, sounding (pedal)",
+        lambda r: _opt(r.sounding_f1_with_offsets, ".3f"),
+        "note F1 with offsets, each note lasting as long as it sounds: until its key rises and the sustain pedal "
+        "is up (each file's own pedal)",
+        first=True,
+        applies=lambda r: r.pedal_f1 is not None,
+    ),
+    Figure(
+        "sustain pedal",
+        lambda r: f"F1 {_opt(r.pedal_f1, '.3f')}, timing error {_opt(_ms(r.pedal_error_mean), '.0f', ' ms')} mean",
+        "presses and releases matched one to one within the onset tolerance; how far off the matched ones were",
+        first=True,
+        applies=lambda r: r.pedal_f1 is not None,
+    ),
+    Figure(
         "onset tolerance",
         lambda r: f"{r.onset_tolerance * 1000:.0f} ms",
         "how far from its time a note may start and still count",
@@ -106,3 +123,8 @@ FIGURES = (
 
 
 # -- the HTML report -------------------------------------------------------------------------------
+
+
+def figures_for(report: Report, every: bool = False) -> list[Figure]:
+    """The figures ``report`` has, the first few (``every``: all of them)."""
+    return [f for f in FIGURES if (every or f.first) and f.applies(report)]

@@ -83,7 +83,8 @@ class HoldGuard:
             )
         self.policy = policy
         self.teacher = ScriptedPianist(config, tuning)
-        joints = actuated_indices(config)[:-1]  # (the last action is the wrist's)
+        joints = actuated_indices(config)[:-1]  # (then the wrist's, then with the pedal an action the foot's)
+        self.wrist_at = len(joints)
         counts, _ = finger_counts(config)
         slot_of = np.repeat(np.arange(len(counts)), counts)  # every joint's finger slot, in command order
         self.joints_of = [np.flatnonzero(slot_of[joints] == i) for i in range(len(counts))]
@@ -126,7 +127,7 @@ class HoldGuard:
             self.held += holding.size
             steps = len(observation["score"])  # (the targets' "how soon": 1 now, falling by 1/steps a step)
             if not np.any(observation["targets"][:, 3] >= 1.0 - QUIET_STEPS / steps):
-                action[-1] = taught[-1]
+                action[self.wrist_at] = taught[self.wrist_at]
                 self.wrist += 1
         return action
 
@@ -145,6 +146,7 @@ class WristGuard:
         self.fingers = len(world.hand.spec.fingers)
         self.limit = tuning.hold_slide * world.control_hz / world.hand.max_wrist_speed
         """The wrist's largest action while a fingertip is low (its action is a share of the top speed)."""
+        self.wrist_at = len(actuated_indices(config)) - 1
         self.capped = 0
         """Control steps in which the guard slowed the wrist, since the guard was made."""
 
@@ -154,8 +156,9 @@ class WristGuard:
     def act(self, observation: dict) -> np.ndarray:
         action = np.array(self.policy.act(observation), dtype=np.float32)  # a copy: the policy's own is left alone
         joints = np.asarray(observation["joints"], dtype=float).reshape(self.fingers, -1)
-        if abs(action[-1]) > self.limit and any(self.motion.low(q) for q in joints):
-            action[-1] = np.sign(action[-1]) * self.limit
+        wrist = self.wrist_at
+        if abs(action[wrist]) > self.limit and any(self.motion.low(q) for q in joints):
+            action[wrist] = np.sign(action[wrist]) * self.limit
             self.capped += 1
         return action
 

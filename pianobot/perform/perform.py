@@ -19,6 +19,7 @@ import numpy as np
 from pianobot.env.piano import EnvConfig, PianoEnv
 from pianobot.errors import one_line
 from pianobot.files import check_writable, move_into_place, not_written, temporary_beside
+from pianobot.music.pedal import Pedal
 from pianobot.music.piece import Piece
 from pianobot.perform.controllers import make_controller
 from pianobot.perform.rollout import Controller, Rollout, rollout
@@ -34,13 +35,16 @@ def perform(
     seed: int = 0,
     video: bool = False,
     on_step: Callable[[int, int], None] | None = None,
+    pedal: Pedal | None = None,
 ) -> Rollout:
     """Play ``piece`` from start to end in one continuous simulation.
 
     ``controller`` is 'scripted', 'random', or a function that makes a controller for the
     environment (compositional execution passes one). ``on_step(done, total)`` reports progress.
+    ``pedal``: the piece's sustain pedal (the environment works it as written where the
+    controller does not: ``EnvConfig.pedal_action``).
     """
-    env = PianoEnv(piece=piece, config=config, render_mode="rgb_array" if video else None)
+    env = PianoEnv(piece=piece, config=config, render_mode="rgb_array" if video else None, pedal=pedal)
     try:
         agent = controller(env) if callable(controller) else make_controller(controller, env, seed)
         return rollout(env, agent, seed=seed, video=video, on_step=on_step)

@@ -39,6 +39,7 @@ from pianobot.env.piano import EnvConfig, PianoEnv
 from pianobot.errors import PianobotError, SettingError
 from pianobot.music.instrument import HandSpec, KeyboardSpec
 from pianobot.music.metrics import Report
+from pianobot.music.pedal import Pedal
 from pianobot.music.phrases import DEFAULT_MAX_NOTES, Phrase, split_phrases
 from pianobot.music.piece import Piece
 from pianobot.perform import compose
@@ -106,6 +107,8 @@ class PerformancePlan:
     pianist moves the fingers that hold a written note (where the policy's environment allows it).
     None: where the general policy was trained on a family of
     :data:`~pianobot.perform.guard.HOLD_GUARD_FAMILIES` (:attr:`holds`)."""
+    pedal: Pedal = Pedal()
+    """The piece's sustain pedal, which the foot plays as written (where the players do not work it)."""
 
     def __post_init__(self) -> None:
         if not self.stretches:
@@ -171,6 +174,11 @@ class Performance:
     @property
     def played(self) -> Piece:
         return self.rollout.played
+
+    @property
+    def pedal(self) -> Pedal:
+        """The sustain pedal as the foot worked it, in the piece's time."""
+        return self.rollout.pedal
 
     @property
     def frames(self) -> list:
@@ -323,6 +331,7 @@ def plan_performance(
     hold_guard: bool | None = PerformancePlan.hold_guard,
     gui: bool = False,
     leave_out: frozenset[str] = frozenset(),
+    pedal: Pedal = Pedal(),
 ) -> PerformancePlan:
     """Who plays each stretch of ``piece`` and in which environment (the module's rule).
 
@@ -346,7 +355,7 @@ def plan_performance(
     if controller in ONE_PLAYER:
         phrases = split_phrases(piece, phrase_notes or DEFAULT_MAX_NOTES)
         stretch = Stretch(tuple(phrases), ONE_PLAYER[controller])
-        return PerformancePlan(piece, replace(PLAY_CONFIG, world=world), (stretch,))
+        return PerformancePlan(piece, replace(PLAY_CONFIG, world=world), (stretch,), pedal=pedal)
 
     phrases = trained_split(models, piece, phrase_notes)
     env = _own_environment(models, phrases, leave_out)
@@ -371,7 +380,7 @@ def plan_performance(
     config = replace(env, world=replace(env.world, gui=gui))
     if config.tactile and not any(_reads_touch(s.policy) for s in stretches if s.policy is not None):
         config = replace(config, tactile=False)  # (no player reads touch: its images would be drawn for nobody)
-    return PerformancePlan(piece, config, stretches, wrist_guard, hold_guard)
+    return PerformancePlan(piece, config, stretches, wrist_guard, hold_guard, pedal)
 
 
 def _reads_touch(policy: Path) -> bool:
@@ -400,6 +409,6 @@ def perform_plan(
         made.append(controller_for(plan, env, seed))
         return made[0]
 
-    played = simulation.perform(plan.piece, controller, plan.config, seed, video, on_step)
+    played = simulation.perform(plan.piece, controller, plan.config, seed, video, on_step, plan.pedal)
     guards = compose.slowed_steps(made[0]), compose.held_steps(made[0]), compose.wrist_steps(made[0])
     return Performance(plan, played, seed, *guards)

@@ -7,7 +7,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from pianobot.music.metrics import Report
-from pianobot.perform.figures import FIGURES, Figure, _opt  # noqa: F401 (FIGURES, Figure: by their old address too)
+from pianobot.perform.figures import FIGURES, Figure, _opt, figures_for  # noqa: F401 (FIGURES, Figure: by their old address too)
 
 FINGER_COLOURS = {1: "#8c564b", 2: "#1f77b4", 3: "#2ca02c", 4: "#ff7f0e", 5: "#9467bd", None: "#7f7f7f"}
 """A played note's colour: the finger that struck it (grey: none recorded)."""
@@ -171,8 +171,7 @@ def _figures_table(report: Report, first: bool) -> str:
     rows = "".join(
         f"<tr><td>{escape(f.label)}</td><td class='value'>{escape(f.value(report))}</td>"
         f"<td class='meaning'>{escape(f.meaning)}</td></tr>"
-        for f in FIGURES
-        if f.first or not first
+        for f in figures_for(report, not first)
     )
     return f"<table class='figures'>{rows}</table>"
 

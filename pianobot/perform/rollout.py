@@ -13,6 +13,7 @@ import numpy as np
 
 from pianobot.env.piano import PianoEnv
 from pianobot.music.metrics import Report, compare
+from pianobot.music.pedal import Pedal
 from pianobot.music.piece import Piece
 from pianobot.sim.recorder import NoteRecorder
 
@@ -39,10 +40,15 @@ class Rollout:
     """Rendered images, first before the first step, when asked for."""
     start: float = 0.0
     """Simulated time (s) of the piece's time 0: the lead-in before it (the video's first frame is at 0)."""
+    pedal: Pedal = Pedal()
+    """The sustain pedal as the foot worked it, in the piece's time."""
+    written_pedal: Pedal = Pedal()
+    """The sustain pedal the piece asked for."""
 
     def report(self) -> Report:
-        """Note F1, velocity and timing errors of ``played`` against ``reference``."""
-        return compare(self.reference, self.played)
+        """Note F1, velocity and timing errors of ``played`` against ``reference`` (and the pedal's figures
+        where either uses it)."""
+        return compare(self.reference, self.played, pedals=(self.written_pedal, self.pedal))
 
 
 def rollout(
@@ -61,8 +67,10 @@ def rollout(
     frames = [env.render()] if video else None
     total, steps = 0.0, 0
     while True:
+        now = env.world.time
         observation, reward, terminated, truncated, step = env.step(controller.act(observation))
         recorder.add(step["events"], step["fingers"])
+        recorder.press(now, step["pedal"])
         total += reward
         steps += 1
         if frames is not None:
@@ -73,4 +81,5 @@ def rollout(
             break
     reference = info["piece"]
     played = recorder.piece(end=env.world.time, start=env.score_start, bpm=reference.bpm)
-    return Rollout(reference, played, total, steps, frames, env.score_start)
+    pedal = recorder.pedal(end=env.world.time, start=env.score_start)
+    return Rollout(reference, played, total, steps, frames, env.score_start, pedal, env.pedal)

@@ -39,6 +39,7 @@ from pianobot.agent.general import parts_policy
 from pianobot.errors import PianobotError, PianobotWarning, SettingError
 from pianobot.music.instrument import THUMB, HandSpec, KeyboardSpec
 from pianobot.music.metrics import Report
+from pianobot.music.pedal import Pedal
 from pianobot.music.per_hand import HandsReport, compare_hands
 from pianobot.music.piece import FINGER_NAMES, HANDS, Piece
 from pianobot.music.window import Window
@@ -139,6 +140,10 @@ class HandsPerformance:
     start: float = 0.0
     """Simulated time (s), from the first frame, at which the piece's time 0 falls (less than 0
     when the piece begins with a rest longer than the lead-in): where the video's sound starts."""
+    pedal: Pedal = Pedal()
+    """The sustain pedal as the foot worked it, in the piece's time."""
+    written_pedal: Pedal = Pedal()
+    """The piece's own sustain pedal."""
     played: Piece = field(init=False)
     """What both keyboards sounded, as one piece at the written pitches, each note with its hand."""
     scores: HandsReport = field(init=False, repr=False, compare=False)
@@ -147,7 +152,7 @@ class HandsPerformance:
     def __post_init__(self) -> None:
         played = Piece(tuple(n for h in self.hands for n in h.played.notes), self.piece.bpm)
         object.__setattr__(self, "played", played)
-        object.__setattr__(self, "scores", compare_hands(self.piece, played))
+        object.__setattr__(self, "scores", compare_hands(self.piece, played, pedals=(self.written_pedal, self.pedal)))
 
     def report(self, hand: str | None = None) -> Report:
         """The figures for the whole piece, or for ``hand``'s part (against its written notes),
@@ -211,9 +216,11 @@ def play_hands(
     together: bool = True,
     on_step: Callable[[int, int], None] | None = None,
     video: bool = False,
+    pedal: Pedal = Pedal(),
     **options,
 ) -> HandsPerformance:
-    """Perform ``piece``, every note of which has a hand (the module's notes): ``controller``
+    """Perform ``piece``, every note of which has a hand (the module's notes), with its sustain
+    ``pedal`` (the foot plays it as written): ``controller``
     'sac' (the general policy, or policies trained for the part) or 'scripted', ``models`` the
     model store, ``seed`` the hand starts, ``hand`` each hand's fingers (default: three, or with
     the thumb too where that keeps more of the notes, :func:`thumbs_keep_more`, said in one
@@ -241,7 +248,7 @@ def play_hands(
     together = together and len(piece.hands) == 2
     parts = prepare_parts(piece, keyboard, fingers, together, grow)
     plans = plan_hands(parts, controller, models, fingers, options)
-    return perform_hands(piece, parts, plans, seed, together, on_step, video)
+    return perform_hands(piece, parts, plans, seed, together, on_step, video, pedal)
 
 
 def prepare_parts(
@@ -317,13 +324,15 @@ def perform_hands(
     together: bool = True,
     on_step: Callable[[int, int], None] | None = None,
     video: bool = False,
+    pedal: Pedal = Pedal(),
 ) -> HandsPerformance:
-    """Play each hand's plan from hand start ``seed``: both in one simulation where ``together``
-    allows it (else, said in one warning line, each in a simulation of its own)."""
+    """Play each hand's plan from hand start ``seed``, the foot playing ``pedal`` as written: both in
+    one simulation where ``together`` allows it (else, said in one warning line, each in a
+    simulation of its own, the pedal with each)."""
     together = together and len(parts) == 2
     if together:
         try:
-            return _play_together(piece, parts, plans, seed, on_step, video)
+            return _play_together(piece, parts, plans, seed, on_step, video, pedal)
         except HandsApart as e:
             if video:
                 raise PianobotError(f"{e}: no video can show both hands; play one hand for it") from None
@@ -332,9 +341,12 @@ def perform_hands(
         raise PianobotError("a video of both hands needs them in one simulation: play one hand for it")
     done = []
     for name, (window, part, start, left_out, changes) in parts.items():
-        performance = plan.perform_plan(plans[name], seed, on_step=on_step)
+        own = replace(plans[name], pedal=pedal.shift(-start))
+        performance = plan.perform_plan(own, seed, on_step=on_step)
         done.append(HandPerformance(name, window, part, start, left_out, performance, changes))
-    return HandsPerformance(piece, tuple(done), seed)
+    first = done[0]  # (each hand's foot played the same pedal: the first's is written)
+    played = first.performance.rollout.pedal.shift(first.start)
+    return HandsPerformance(piece, tuple(done), seed, pedal=played, written_pedal=pedal)
 
 
 def _hand_options(options: dict, hand: str) -> dict:
@@ -366,9 +378,17 @@ class HandsApart(Exception):
 
 
 def _play_together(
-    piece: Piece, parts: dict, plans: dict[str, plan.PerformancePlan], seed: int, on_step: Callable | None, video: bool
+    piece: Piece,
+    parts: dict,
+    plans: dict[str, plan.PerformancePlan],
+    seed: int,
+    on_step: Callable | None,
+    video: bool,
+    pedal: Pedal,
 ) -> HandsPerformance:
-    """Both hands' plans played in one :class:`~pianobot.env.two_hands.HandsEnv` from hand start ``seed``."""
+    """Both hands' plans played in one :class:`~pianobot.env.two_hands.HandsEnv` from hand start
+    ``seed``, the foot playing ``pedal``."""
+    offset = parts["right"][2]  # (the piece's first onset: both parts start from it)
     from pianobot.env.two_hands import HandsEnv  # (the simulator loads only when something plays)
     from pianobot.sim.recorder import NoteRecorder
 
@@ -377,6 +397,7 @@ def _play_together(
             {h: (parts[h][0], parts[h][1]) for h in HANDS},
             {h: plans[h].config for h in HANDS},
             render_mode="rgb_array" if video else None,
+            pedal=pedal.shift(-offset),
         )
     except ValueError as e:  # parts too far apart for 88 keys, players of different physics
         raise HandsApart(str(e)) from None
@@ -388,7 +409,9 @@ def _play_together(
         recorder, rewards, steps = NoteRecorder(), dict.fromkeys(HANDS, 0.0), 0
         frames = [env.render()] if video else None
         while True:
+            now = env.world.time
             observations, _, _, truncated, info = env.step({h: c.act(observations[h]) for h, c in controllers.items()})
+            recorder.press(now, info["pedal"])
             if frames is not None:
                 frames.append(env.render())
             recorder.add(info["events"], info["fingers"], info["struck_by"])
@@ -399,8 +422,8 @@ def _play_together(
                 on_step(steps, env.horizon)
             if truncated:
                 break
-        offset = parts["right"][2]  # (the piece's first onset: both parts start from it)
         sounded = recorder.piece(end=env.world.time, start=env.score_start, bpm=piece.bpm).shift(offset)
+        footed = recorder.pedal(end=env.world.time, start=env.score_start).shift(offset)
     finally:
         env.close()
     done = []
@@ -424,7 +447,9 @@ def _play_together(
         )
         done.append(HandPerformance(h, window, part, start, left_out, performance, changes, own))
     start = env.score_start - offset
-    return HandsPerformance(piece, tuple(done), seed, together=True, frames=frames, start=start)
+    return HandsPerformance(
+        piece, tuple(done), seed, together=True, frames=frames, start=start, pedal=footed, written_pedal=pedal
+    )
 
 
 def play(

@@ -15,13 +15,11 @@ Every command that reads a piece (``play``, ``score``, ``inspect``, ``finger``, 
 5. :func:`finger_part`: one hand's part checked against the keyboard and fingered by the planner
    where it has no fingering.
 
-:func:`read_piece` takes them in order and returns a :class:`ReadPiece`: the tracks read,
-whether it is one hand or two, each hand's part, what was reduced away and why (the lines
-said), the fingering plan, the fingers and the keyboard. What each step says is a
-:class:`~pianobot.errors.PianobotWarning`, or, for a file it refuses, a one-line
-:class:`~pianobot.errors.PianobotError`; the caller words what undoes a choice
-(:class:`Wording`). Each hand's part as its player is given it (:func:`prepare_part`: mirrored,
-moved onto its keys, reduced, fingered) is here too.
+:func:`read_piece` takes them in order into a :class:`ReadPiece` (tracks, one hand or two, each
+hand's part, what was reduced and why, fingering, fingers, keyboard, the sustain pedal). Each step
+says what it did in a :class:`~pianobot.errors.PianobotWarning`, or refuses a file in a one-line
+:class:`~pianobot.errors.PianobotError`; the caller words what undoes a choice (:class:`Wording`).
+Each hand's part as its player is given it (:func:`prepare_part`) is here too.
 """
 
 from __future__ import annotations
@@ -33,8 +31,9 @@ from pathlib import Path
 from pianobot.errors import PianobotError, PianobotWarning
 from pianobot.music import midi_io
 from pianobot.music.instrument import THUMB, HandSpec, KeyboardSpec, check_playable, keys_for, suggest_transpose
-from pianobot.music.load import LoadOptions, end_legato, load_hands, load_part, load_piece, thin_hand
+from pianobot.music.load import LoadOptions, end_legato, load_hands, load_part, load_pedal, load_piece, thin_hand
 from pianobot.music.midi_io import MidiSource, TrackInfo, source_path
+from pianobot.music.pedal import Pedal
 from pianobot.music.piece import HANDS, Note, Piece, pitch_name
 from pianobot.music.window import Window, window_for
 from pianobot.pianist.assign import load_two_hands, reduce_hand
@@ -88,6 +87,8 @@ class ReadPiece:
     """One hand's fingering as the planner made it (None: the file's own, or not fingered here)."""
     reduced: tuple[str, ...] = ()
     """What was reduced away or changed, and why: one line per kind, as said."""
+    pedal: Pedal = Pedal()
+    """The file's sustain pedal, timed as its notes (:func:`~pianobot.music.load.load_pedal`)."""
 
     @property
     def both(self) -> bool:
@@ -213,15 +214,17 @@ def read_piece(
     source = open_song(path)
     name = source_path(source)
     tracks = tracks_of(source)
+    pedal = load_pedal(source, options)
     thumbs = None
     if fingers is None:
         fingers, thumbs = choose_fingers(source, options, quiet, wording, model)
     hands = read_both_hands(source, options, fingers, keyboard or KeyboardSpec()) if both else None
     if hands is not None:
-        return ReadPiece(name, source, tracks, keyboard or KeyboardSpec(), fingers, thumbs, hands, piece=hands.piece)
+        keys = keyboard or KeyboardSpec()
+        return ReadPiece(name, source, tracks, keys, fingers, thumbs, hands, piece=hands.piece, pedal=pedal)
     keys = keyboard or choose_keys(source, options, fingers, quiet, wording)
     part, reduced = read_part(source, options, keys, fingers, fit)
-    read = ReadPiece(name, source, tracks, keys, fingers, thumbs, None, part, reduced=reduced)
+    read = ReadPiece(name, source, tracks, keys, fingers, thumbs, None, part, reduced=reduced, pedal=pedal)
     return finger_read(read, options, wording) if finger else read
 
 

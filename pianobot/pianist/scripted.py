@@ -73,4 +73,7 @@ class ScriptedPianist:
             or not (finger in plans and plans[finger].phase == "hold" and plans[finger].key == key)
         )
         self.previous_row = score[0].copy()
-        return self.motion.command(plans, joints, wrist)[self.actuated]
+        action = self.motion.command(plans, joints, wrist)[self.actuated]
+        if "pedal" in observation:  # (the pedal is an action: the foot follows the score)
+            action = np.append(action, 1.0 if observation["pedal"][0] > 0.5 else -1.0)
+        return action

@@ -150,7 +150,7 @@ def _show_tracks(console, song: Path, source, options) -> tuple[list, bool, list
             f"{len(with_notes)} track(s) with notes"
             + (f"; {_hand_parts(tracks)}" if hands else "")
             + (
-                f"; sustain pedal pressed {pedal} times (ignored: a note sounds while its key is down)"
+                f"; sustain pedal pressed {pedal} times (play presses it as written; --no-pedal leaves it up)"
                 if pedal
                 else "; no sustain pedal"
             )

@@ -160,6 +160,7 @@ def play(
                 phrase_notes=phrase_notes,
                 wrist_guard=wrist_guard,
                 hold_guard=hold_guard,
+                pedal=read.pedal,
             ),
             files=files,
             shown=shown,
@@ -167,6 +168,7 @@ def play(
         return
     options = dict(general=use_general, general_policy=general_policy, fallback=fallback is not None)
     options |= dict(phrase_notes=phrase_notes, wrist_guard=wrist_guard, hold_guard=hold_guard, gui=gui)
+    options |= dict(pedal=read.pedal)
     play_one(song, output, finger_file(read, reading), controller, models, seed, options, files, shown)
 
 
@@ -284,7 +286,7 @@ def play_one(
         )
     plan = performance.plan
     report = performance.report()
-    write_midi(performance.played, output, name=f"pianobot ({plan.performer}): {song.stem}")
+    write_midi(performance.played, output, name=f"pianobot ({plan.performer}): {song.stem}", pedal=performance.pedal)
     atomic_write(report_path, json.dumps(performance.to_dict(), indent=2) + "\n")
     if json_path is not None:
         write_json(json_path, performance.to_dict())
@@ -304,11 +306,14 @@ def play_one(
         import tempfile
 
         with tempfile.TemporaryDirectory() as scratch:  # the sound, starting with the first frame
-            method = write_wav(performance.played, Path(scratch) / "sound.wav", font=soundfont, delay=performance.start)
-            write_video(performance.frames, video, fps=plan.config.world.control_hz, audio=Path(scratch) / "sound.wav")
+            sound = Path(scratch) / "sound.wav"
+            method = write_wav(
+                performance.played, sound, font=soundfont, delay=performance.start, pedal=performance.pedal
+            )
+            write_video(performance.frames, video, fps=plan.config.world.control_hz, audio=sound)
         console.print(f"video written to {said(video)}, with sound ({method})")
     if wav is not None:
-        method = write_wav(performance.played, wav, font=soundfont)
+        method = write_wav(performance.played, wav, font=soundfont, pedal=performance.pedal)
         console.print(f"audio written to {said(wav)} ({method})")
     if html is not None:
         from pianobot.perform.report import write_html
@@ -358,7 +363,7 @@ def play_both(
     for warning in caught:  # what each hand was given is on the first screen; the rest are warnings
         if quiet or str(warning.message) not in changes:
             warnings.warn(warning.message)
-    write_midi(performance.played, output)
+    write_midi(performance.played, output, pedal=performance.pedal)
     report = performance.to_dict(reading)
     atomic_write(files["report"], json.dumps(report, indent=2) + "\n")
     if files["json"] is not None:
@@ -378,13 +383,13 @@ def play_both(
         start = performance.start  # (the sound starts with the first frame)
         with tempfile.TemporaryDirectory() as scratch:
             sound = Path(scratch) / "sound.wav"
-            method = write_wav(
-                performance.played.shift(min(start, 0.0)), sound, font=files["soundfont"], delay=max(start, 0.0)
-            )
+            early = min(start, 0.0)  # (a lead-in shorter than the piece's first rest: the sound starts later)
+            played, pedal = performance.played.shift(early), performance.pedal.shift(early)
+            method = write_wav(played, sound, font=files["soundfont"], delay=max(start, 0.0), pedal=pedal)
             write_video(performance.frames, files["video"], fps=performance.fps, audio=sound)
         console.print(f"video written to {said(files['video'])}, with sound ({method})")
     if files["wav"] is not None:
-        method = write_wav(performance.played, files["wav"], font=files["soundfont"])
+        method = write_wav(performance.played, files["wav"], font=files["soundfont"], pedal=performance.pedal)
         console.print(f"audio written to {said(files['wav'])} ({method})")
     if files["html"] is not None:
         from pianobot.perform.report import write_html

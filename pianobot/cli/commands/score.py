@@ -68,7 +68,8 @@ def score(
     read = read_file(reference, reading, finger=False, quiet=True, fit=False)
     reference_piece = read.hands.piece if read.both else read.part  # as play scored it (with --hand, reduced)
     played_piece = midi_io.read_midi(played)
-    scores = compare_hands(reference_piece, played_piece, onset_tolerance=onset_tolerance)
+    pedals = (read.pedal, midi_io.read_pedal(played) if reading.options.pedal else read.pedal)
+    scores = compare_hands(reference_piece, played_piece, onset_tolerance=onset_tolerance, pedals=pedals)
     report = scores.whole
     if scores.hands:
         console.print(display.hands_scores_table(scores))
