@@ -132,23 +132,42 @@ def _unpitched(m21, element) -> bool:
 def _part_events(m21, part, said: dict[str, int]) -> list[tuple[int, int, int, int | None]]:
     """(on tick, off tick, pitch, finger) of every pitched note of ``part``, ties merged (grace,
     unpitched and doubled notes left out, counted in ``said``)."""
-    notes: dict[tuple[int, int], tuple[int, int | None]] = {}
-    for element in part.stripTies(inPlace=False).flatten().notes:
+    written = []  # (on, off, pitch, finger, tie type)
+    for element in part.flatten().notes:
         if _unpitched(m21, element):
             said["unpitched"] += 1
-            continue
-        if element.duration.isGrace:
+        elif element.duration.isGrace:
             said["grace"] += len(element.pitches)
+        else:
+            on, off = _tick(element.offset), _tick(element.offset + element.quarterLength)
+            ties = (
+                [n.tie for n in sorted(element.notes, key=lambda n: n.pitch.midi)] if element.isChord else [element.tie]
+            )
+            for (pitch, finger), tie in zip(_fingered(m21, element, said), ties):
+                if off > on:
+                    written.append((on, off, pitch, finger, tie.type if tie is not None else None))
+    return _merge_ties(written, said)
+
+
+def _merge_ties(written: list, said: dict[str, int]) -> list[tuple[int, int, int, int | None]]:
+    """Notes tied to the next note of their pitch starting where they end made one note (with the
+    first one's finger); two notes on one key at once (two voices) made one, the longer."""
+    notes: dict[tuple[int, int], list] = {}
+    tied: dict[int, list] = {}  # pitch: the note its next note of that pitch is tied to
+    for on, off, pitch, finger, tie in sorted(written, key=lambda w: (w[0], w[2])):
+        held = tied.pop(pitch, None)
+        if held is not None and held[0] == on and tie in ("stop", "continue"):
+            held[0] = off
+            if tie == "continue":
+                tied[pitch] = held
             continue
-        on = _tick(element.offset)
-        off = _tick(element.offset + element.quarterLength)
-        for pitch, finger in _fingered(m21, element, said):
-            if off <= on:
-                continue
-            if (on, pitch) in notes:  # (two voices on one key: one note, the longer)
-                said["doubled"] += 1
-                off = max(off, notes[(on, pitch)][0])
-            notes[(on, pitch)] = (off, finger)
+        if (on, pitch) in notes:
+            said["doubled"] += 1
+            notes[(on, pitch)][0] = max(off, notes[(on, pitch)][0])
+            continue
+        notes[(on, pitch)] = [off, finger]
+        if tie in ("start", "continue"):
+            tied[pitch] = notes[(on, pitch)]
     return [(on, off, pitch, finger) for (on, pitch), (off, finger) in sorted(notes.items())]
 
 
