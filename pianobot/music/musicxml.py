@@ -84,15 +84,16 @@ def _render(score, tree: Score, path: Path) -> mido.MidiFile:
     said: dict[str, int] = defaultdict(int)
     tracks: list[mido.MidiTrack] = []
     for name, part in _staves(score):
+        unpitched = said["unpitched"]
         events = _part_events(m21, part, said)
         if events:
             tracks.append(_track(name, events))
-        elif any(_unpitched(m21, n) for n in part.recurse().notes):
-            said["percussion"] += 1
-    _say(path, said, tree)
+        elif said["unpitched"] > unpitched:
+            said["unpitched"], said["percussion"] = unpitched, said["percussion"] + 1
     if not tracks:
         what = " (only percussion)" if said["percussion"] else ""
         raise PianobotError(f"{path} holds no pitched notes{what}: give a score with notes for the piano")
+    _say(path, said, tree)
     midi = mido.MidiFile(type=1, ticks_per_beat=TICKS_PER_BEAT)
     midi.tracks.append(_tempo_track(score))
     pedal_track = next((t for t in tracks if t.name == TRACK_NAMES["right"]), tracks[0])
@@ -232,12 +233,14 @@ def _timed(track: mido.MidiTrack, timed: list[tuple[int, int, object]]) -> mido.
 
 
 def _tempo_track(score) -> mido.MidiTrack:
-    """The tempo marks of ``score`` as set_tempo events (120 bpm where it has none)."""
-    timed = []
+    """The tempo marks of ``score`` as set_tempo events (120 bpm where it has none; a mark that
+    each staff repeats, once)."""
+    timed, now = [], None
     for start, _, mark in score.metronomeMarkBoundaries():
         bpm = mark.getQuarterBPM()
-        if bpm and bpm > 0:
-            timed.append((_tick(start), 0, mido.MetaMessage("set_tempo", tempo=mido.bpm2tempo(bpm))))
+        if bpm and bpm > 0 and (tempo := mido.bpm2tempo(bpm)) != now:
+            timed.append((_tick(start), 0, mido.MetaMessage("set_tempo", tempo=tempo)))
+            now = tempo
     return _timed(mido.MidiTrack([mido.MetaMessage("track_name", name="Tempo")]), timed)
 
 

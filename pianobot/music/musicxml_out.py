@@ -1,8 +1,9 @@
 """A piece written as a MusicXML score (``pianobot finger -o song.musicxml``), with music21.
 
 Both hands: one piano part of two staves, the right hand's on the upper, the left hand's on the
-lower (notes without a hand on a third); one hand: one staff. Each note's finger is a fingering
-mark (a chord's notes each their own); the piece's tempo is a metronome mark. Onsets and lengths
+lower (notes without a hand on a third); one hand: one staff. Notes that start and end together are a
+chord, others their own voices. Each note's finger is a fingering mark (a chord's notes each
+their own); the piece's tempo is a metronome mark (shown in whole beats a minute, sounding exactly). Onsets and lengths
 are counted in beats at that tempo and moved to the nearest sixteenth or eighth-note triplet
 (:data:`GRID`), so that a notation program shows them as notes; a piece played by a person (not
 on a grid) is written as the nearest such notes. Reading the score back
@@ -67,7 +68,8 @@ def _staff(m21, staff, part: Piece, bpm: float, name: str, bass: bool, tempo: bo
     staff.partName = name
     staff.insert(0, m21.clef.BassClef() if bass else m21.clef.TrebleClef())
     if tempo:
-        staff.insert(0, m21.tempo.MetronomeMark(number=round(bpm, 2)))
+        shown = round(bpm)  # (the mark a notation program shows; the tempo sounds exactly)
+        staff.insert(0, m21.tempo.MetronomeMark(number=shown, numberSounding=None if shown == bpm else round(bpm, 4)))
     voices: list[tuple[float, object]] = []  # (where the voice's last note ends, the voice)
     for onset, length, element in _elements(m21, part, bpm / 60.0):
         free = next((i for i, (end, _) in enumerate(voices) if end <= onset), None)
@@ -88,14 +90,15 @@ def _staff(m21, staff, part: Piece, bpm: float, name: str, bass: bool, tempo: bo
 
 def _elements(m21, part: Piece, beat: float) -> list[tuple[float, float, object]]:
     """(onset, length, music21 note or chord) for ``part``'s notes, in beats (``beat`` a second's),
-    the notes that start together a chord (as long as the longest), each note with its fingering mark."""
-    by_onset: dict[float, list[Note]] = {}
+    the notes that start and end together a chord, each note with its fingering mark."""
+    together: dict[tuple[float, float], list[Note]] = {}
     for note in part.notes:
-        by_onset.setdefault(_beats(note.onset * beat), []).append(note)
+        onset = _beats(note.onset * beat)
+        length = max(_beats(note.offset * beat) - onset, 1 / max(GRID))
+        together.setdefault((onset, length), []).append(note)
     elements = []
-    for onset, notes in sorted(by_onset.items()):
+    for (onset, length), notes in sorted(together.items()):
         notes = sorted(notes, key=lambda n: n.pitch)
-        length = max(max(_beats(n.offset * beat) - onset for n in notes), 1 / max(GRID))
         element = m21.note.Note(notes[0].pitch) if len(notes) == 1 else m21.chord.Chord([n.pitch for n in notes])
         element.quarterLength = length
         for n in notes:
