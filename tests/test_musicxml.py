@@ -289,3 +289,10 @@ def test_a_fingered_score_plays_with_its_own_fingering(tmp_path):
     result = run("score", played, midi, "--json", tmp_path / "s.json")
     assert result.exit_code == 0, result.output
     assert json.loads((tmp_path / "s.json").read_text())["f1"] >= 0.95
+
+
+def test_a_finger_the_hand_lacks_is_said_in_one_line(tmp_path):
+    melody = "<attributes><divisions>1</divisions></attributes>" + note("C4", 1, finger=2) + note("D4", 1, finger=5)
+    path = write(tmp_path / "five.musicxml", score([melody], names=["Right Hand"]))
+    result = run("play", path, "-o", tmp_path / "out.mid", "--controller", "scripted")
+    assert_one_line_error(result, "fingered 5", "--hand-model pianist")
