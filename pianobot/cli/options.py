@@ -212,10 +212,12 @@ def reads(*, without: tuple[str, ...] = ()):
     return decorate
 
 
-def check_midi_output(output: Path, song: Path, what: str) -> None:
-    """-o must name a .mid file other than the input."""
-    if output.suffix.lower() not in (".mid", ".midi"):
-        raise PianobotError(f"-o {output}: {what} is a MIDI file, name it *.mid")
+def check_midi_output(output: Path, song: Path, what: str, score: bool = False) -> None:
+    """-o must name a .mid file other than the input (``score``: or a MusicXML score, .musicxml/.xml/.mxl)."""
+    suffixes = (".mid", ".midi") + ((".musicxml", ".xml", ".mxl") if score else ())
+    if output.suffix.lower() not in suffixes:
+        also = " or a MusicXML score, name it *.mid or *.musicxml (*.mxl compressed)" if score else ", name it *.mid"
+        raise PianobotError(f"-o {output}: {what} is a MIDI file{also}")
     if os.path.realpath(output) == os.path.realpath(song):  # (realpath: a symbolic-link loop is no crash)
         raise PianobotError(f"-o {output} would overwrite the input {song.name}: choose another file name")
 

@@ -1,5 +1,6 @@
 """A .mid file read once: its bytes checked and parsed (mido) into a :class:`MidiSource`, which
-every reader of :mod:`pianobot.music.midi_io` takes in place of a path."""
+every reader of :mod:`pianobot.music.midi_io` takes in place of a path (a MusicXML score is read
+into one too: :mod:`pianobot.music.musicxml`)."""
 
 from __future__ import annotations
 
@@ -90,11 +91,16 @@ class MidiSource:
 
 
 def open_midi(path: str | Path | MidiSource) -> MidiSource:
-    """The .mid file at ``path``, read and parsed (a bad file refused in one line); a
+    """The .mid file at ``path``, read and parsed (a bad file refused in one line); a MusicXML
+    score (.musicxml, .xml, .mxl) read and rendered as one (:mod:`pianobot.music.musicxml`); a
     :class:`MidiSource` is returned as it is."""
     if isinstance(path, MidiSource):
         return path
     path = Path(path)
+    if path.suffix.lower() in (".musicxml", ".xml", ".mxl"):
+        from pianobot.music.musicxml import open_musicxml  # (music21 only where a score is read)
+
+        return open_musicxml(path)
     return MidiSource(path, _load(path))
 
 

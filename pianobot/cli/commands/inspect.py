@@ -34,7 +34,9 @@ JSON_PATH_OPTION = typer.Option(
 
 @reads()
 def inspect(
-    song: Path = typer.Argument(..., help="A .mid file (or a PIG fingering .txt file)."),
+    song: Path = typer.Argument(
+        ..., help="A .mid file, a MusicXML score (.musicxml, .xml, .mxl) or a PIG fingering .txt file."
+    ),
     phrase_notes: Optional[int] = PlayPhraseNotes,
     models: Path = MODELS_OPTION,
     all_rows: bool = AllRows,

@@ -48,7 +48,7 @@ def progress(what: str):
 
 SONG_OPTION = typer.Argument(
     ...,
-    help="The piece: a .mid file or a PIG .txt file (unfingered notes are fingered by the planner).",
+    help="The piece: a .mid file, a MusicXML score (.musicxml, .xml, .mxl) or a PIG .txt file (unfingered notes are fingered by the planner).",
 )
 OUTPUT_OPTION = typer.Option(..., "--output", "-o", help="The .mid file of what was played.")
 CONTROLLER_OPTION = typer.Option(

@@ -25,7 +25,7 @@ from pianobot.music.metrics import DEFAULT_ONSET_TOLERANCE
 @reads(without=("refinger", "lowest_note", "keys"))
 def score(
     played: Path = typer.Argument(..., help="The performance, a .mid file (e.g. written by `pianobot play`)."),
-    reference: Path = typer.Argument(..., help="The reference score, a .mid file."),
+    reference: Path = typer.Argument(..., help="The reference score, a .mid file or a MusicXML score."),
     onset_tolerance: float = typer.Option(
         DEFAULT_ONSET_TOLERANCE, "--onset-tolerance", help="Seconds within which a played onset matches the reference."
     ),

@@ -45,7 +45,7 @@ from pianobot.sim.world import WorldConfig
 
 SONG_OPTION = typer.Argument(
     None,
-    help="A .mid file with fingering (a two-hand file, as play plays it: each hand's part); leave out with --task.",
+    help="A .mid file or MusicXML score with fingering (a two-hand file, as play plays it: each hand's part); leave out with --task.",
 )
 TASK_OPTION = typer.Option(
     None,

@@ -1,0 +1,296 @@
+"""MusicXML scores (.musicxml, .xml, .mxl) in, as a :class:`~pianobot.music.midi_file.MidiSource`.
+
+A score is read with music21 (the ``musicxml`` extra, imported only here and only when a score is
+read or written) and rendered into an in-memory type 1 MIDI file, so that every later step
+(:mod:`pianobot.music.midi_io`) reads it as it reads a .mid file:
+
+- a tempo track with every tempo mark (``<metronome>``, ``<sound tempo>``), 120 bpm where none;
+- one track per staff of a pitched part: a two-staff part's staff 1 is named "Right Hand", its
+  staff 2 "Left Hand"; a one-staff part keeps its part's name (a hand where the name says one, as
+  for a MIDI track); other staves are named for their part and staff;
+- notes with their ties merged; grace notes and unpitched (percussion) notes left out, each said in
+  one line; tuplets at their true length; repeats played once as written, said in one line;
+- each ``<fingering>`` 1-5 as the note's finger, written as lyric events in midi_io's convention
+  (a chord's notes each their own); a mark such as "1-2" or "3_1" counts as its first finger, one
+  that is no finger is dropped, each kind said in one line;
+- the sustain pedal (``<pedal>`` start, change, stop) as control change 64 (127 down, 0 up) on the
+  right hand's track (the first track where there is none), at the marks' own times.
+
+music21 gives a chord's fingering marks to its notes in pitch order and loses which note a mark
+was written on; so before music21 reads the XML, each unfingered note of a chord that has marks is
+given a placeholder mark ("-", no finger), and a note's alternate marks are removed (its first
+mark is the one that strikes). The pedal's times are read from the XML itself
+(:mod:`pianobot.music.musicxml_tree`), since music21 keeps only the notes a pedal mark spans.
+"""
+
+from __future__ import annotations
+
+import warnings
+from collections import defaultdict
+from fractions import Fraction
+from pathlib import Path
+
+import mido
+
+from pianobot.errors import PianobotError, PianobotWarning, quote
+from pianobot.music.midi_file import MidiSource
+from pianobot.music.midi_io import TRACK_NAMES, finger_text
+from pianobot.music.musicxml_tree import Score, read_tree
+
+SUFFIXES = (".musicxml", ".xml", ".mxl")
+"""The file names read (and written by ``pianobot finger -o``) as MusicXML."""
+EXTRA = "pip install 'pianobot[musicxml]'"
+"""How to install the library MusicXML needs."""
+TICKS_PER_BEAT = 960
+"""Ticks per quarter note of the rendering: triplets and quintuplets of any note fall on a tick."""
+VELOCITY = 80
+"""The loudness of every note of a score (its dynamics are not read)."""
+
+
+def is_musicxml(path: str | Path) -> bool:
+    """Whether ``path`` names a MusicXML file (by its suffix)."""
+    return Path(path).suffix.lower() in SUFFIXES
+
+
+def music21():
+    """The music21 package, or a one-line error that names the extra to install."""
+    try:
+        import music21 as m21
+    except ImportError:
+        raise PianobotError(f"reading and writing MusicXML needs music21, which is not installed: {EXTRA}") from None
+    return m21
+
+
+def open_musicxml(path: str | Path) -> MidiSource:
+    """The score at ``path`` read and rendered as a type 1 MIDI file (see the module's text), kept
+    with the score's own path so that messages name the user's file; refused in one line where it
+    is no readable score."""
+    path = Path(path)
+    m21 = music21()
+    tree = read_tree(path)
+    try:
+        importer = m21.musicxml.xmlToM21.MusicXMLImporter()
+        importer.xmlRootToScore(tree.root, importer.stream)
+        score = importer.stream
+    except Exception as e:  # music21 raises many types on odd scores
+        reason = quote(str(e).strip().splitlines()[0] if str(e).strip() else type(e).__name__)
+        raise PianobotError(f"{path} is not a score pianobot can read ({reason}): re-export it as MusicXML") from None
+    return MidiSource(path, _render(score, tree, path))
+
+
+def _render(score, tree: Score, path: Path) -> mido.MidiFile:
+    """The MIDI file of a music21 ``score`` (its pedal marks from ``tree``)."""
+    m21 = music21()
+    said: dict[str, int] = defaultdict(int)
+    tracks: list[mido.MidiTrack] = []
+    for name, part in _staves(score):
+        unpitched = said["unpitched"]
+        events = _part_events(m21, part, said)
+        if events:
+            tracks.append(_track(name, events))
+        elif said["unpitched"] > unpitched:
+            said["unpitched"], said["percussion"] = unpitched, said["percussion"] + 1
+    if not tracks:
+        what = " (only percussion)" if said["percussion"] else ""
+        raise PianobotError(f"{path} holds no pitched notes{what}: give a score with notes for the piano")
+    _say(path, said, tree)
+    midi = mido.MidiFile(type=1, ticks_per_beat=TICKS_PER_BEAT)
+    midi.tracks.append(_tempo_track(score))
+    pedal_track = next((t for t in tracks if t.name == TRACK_NAMES["right"]), tracks[0])
+    _add_pedal(pedal_track, _pedal_times(score, tree))
+    midi.tracks.extend(tracks)
+    return midi
+
+
+def _staves(score) -> list[tuple[str, object]]:
+    """(track name, music21 part) for each staff of the score: see the module's text."""
+    parts = list(score.parts)
+    staves: dict[str, list] = defaultdict(list)
+    for part in parts:
+        staves[_group(part)].append(part)
+    named = []
+    for part in parts:
+        group = staves[_group(part)]
+        title = (part.partName or "").strip() or f"Part {parts.index(part) + 1}"
+        if len(group) == 1:
+            named.append((title, part))
+        elif group.index(part) < 2:
+            named.append((TRACK_NAMES["right" if group.index(part) == 0 else "left"], part))
+        else:
+            named.append((f"{title} staff {group.index(part) + 1}", part))
+    return named
+
+
+def _group(part) -> str:
+    """The score part a music21 part (a staff of it) comes from: its id without music21's '-Staff2'."""
+    return str(part.id).rsplit("-Staff", 1)[0]
+
+
+def _unpitched(m21, element) -> bool:
+    return isinstance(element, (m21.note.Unpitched, m21.percussion.PercussionChord))
+
+
+def _part_events(m21, part, said: dict[str, int]) -> list[tuple[int, int, int, int | None]]:
+    """(on tick, off tick, pitch, finger) of every pitched note of ``part``, ties merged (grace,
+    unpitched and doubled notes left out, counted in ``said``)."""
+    written = []  # (on, off, pitch, finger, tie type)
+    for element in part.flatten().notes:
+        if _unpitched(m21, element):
+            said["unpitched"] += 1
+        elif element.duration.isGrace:
+            said["grace"] += len(element.pitches)
+        else:
+            on, off = _tick(element.offset), _tick(element.offset + element.quarterLength)
+            ties = (
+                [n.tie for n in sorted(element.notes, key=lambda n: n.pitch.midi)] if element.isChord else [element.tie]
+            )
+            for (pitch, finger), tie in zip(_fingered(m21, element, said), ties):
+                if off > on:
+                    written.append((on, off, pitch, finger, tie.type if tie is not None else None))
+    return _merge_ties(written, said)
+
+
+def _merge_ties(written: list, said: dict[str, int]) -> list[tuple[int, int, int, int | None]]:
+    """Notes tied to the next note of their pitch starting where they end made one note (with the
+    first one's finger); two notes on one key at once (two voices) made one, the longer."""
+    notes: dict[tuple[int, int], list] = {}
+    tied: dict[int, list] = {}  # pitch: the note its next note of that pitch is tied to
+    for on, off, pitch, finger, tie in sorted(written, key=lambda w: (w[0], w[2])):
+        held = tied.pop(pitch, None)
+        if held is not None and held[0] == on and tie in ("stop", "continue"):
+            held[0] = off
+            if tie == "continue":
+                tied[pitch] = held
+            continue
+        if (on, pitch) in notes:
+            said["doubled"] += 1
+            notes[(on, pitch)][0] = max(off, notes[(on, pitch)][0])
+            continue
+        notes[(on, pitch)] = [off, finger]
+        if tie in ("start", "continue"):
+            tied[pitch] = notes[(on, pitch)]
+    return [(on, off, pitch, finger) for (on, pitch), (off, finger) in sorted(notes.items())]
+
+
+def _tick(offset) -> int:
+    return round(Fraction(offset) * TICKS_PER_BEAT)
+
+
+def _fingered(m21, element, said: dict[str, int]) -> list[tuple[int, int | None]]:
+    """(MIDI pitch, finger) of each note of a note or chord: a chord's marks go to its notes in pitch order."""
+    marks = [a for a in element.articulations if isinstance(a, m21.articulations.Fingering)]
+    if isinstance(element, m21.chord.Chord):
+        pitches = sorted(p.midi for p in element.pitches)
+    else:
+        pitches = [element.pitch.midi]
+    if len(marks) != len(pitches):
+        if marks:
+            said["ambiguous"] += 1
+        marks = [None] * len(pitches)
+    return [(pitch, _finger(mark, said)) for pitch, mark in zip(pitches, marks)]
+
+
+def _finger(mark, said: dict[str, int]) -> int | None:
+    """A fingering mark's finger: '3' is 3; '3-1', '3_1' or '3/1' its first finger; else none."""
+    if mark is None:
+        return None
+    text = str(mark.fingerNumber if mark.fingerNumber is not None else "").strip()
+    if text in ("", "-"):
+        return None
+    head = text[0]
+    if head in "12345" and (len(text) == 1 or not text[1].isdigit()):
+        if len(text) > 1:
+            said["substitution"] += 1
+        return int(head)
+    said["not a finger"] += 1
+    said.setdefault("example", text)  # type: ignore[arg-type]
+    return None
+
+
+def _track(name: str, events: list[tuple[int, int, int, int | None]]) -> mido.MidiTrack:
+    """A track named ``name`` with ``events``' notes, and their fingers as lyric events at each onset."""
+    timed: list[tuple[int, int, mido.Message]] = []  # (tick, order, message): offs, lyrics, ons
+    by_onset: dict[int, list[tuple[int, int | None]]] = defaultdict(list)
+    for on, off, pitch, finger in events:
+        by_onset[on].append((pitch, finger))
+        timed.append((on, 2, mido.Message("note_on", note=pitch, velocity=VELOCITY, channel=0)))
+        timed.append((off, 0, mido.Message("note_off", note=pitch, velocity=0, channel=0)))
+    for on, starting in by_onset.items():
+        fingers = [finger for _, finger in sorted(starting)]
+        if any(f is not None for f in fingers):
+            timed.append((on, 1, mido.MetaMessage("lyrics", text=finger_text(fingers))))
+    track = mido.MidiTrack([mido.MetaMessage("track_name", name=name)])
+    return _timed(track, timed)
+
+
+def _timed(track: mido.MidiTrack, timed: list[tuple[int, int, object]]) -> mido.MidiTrack:
+    """``track`` with ``timed`` (tick, order at that tick, message) appended in time order, as delta times."""
+    now = 0
+    for tick, _, message in sorted(timed, key=lambda item: (item[0], item[1])):
+        track.append(message.copy(time=tick - now))
+        now = tick
+    return track
+
+
+def _tempo_track(score) -> mido.MidiTrack:
+    """The tempo marks of ``score`` as set_tempo events (120 bpm where it has none; a mark that
+    each staff repeats, once)."""
+    timed, now = [], None
+    for start, _, mark in score.metronomeMarkBoundaries():
+        bpm = mark.getQuarterBPM()
+        if bpm and bpm > 0 and (tempo := mido.bpm2tempo(bpm)) != now:
+            timed.append((_tick(start), 0, mido.MetaMessage("set_tempo", tempo=tempo)))
+            now = tempo
+    return _timed(mido.MidiTrack([mido.MetaMessage("track_name", name="Tempo")]), timed)
+
+
+def _pedal_times(score, tree: Score) -> list[tuple[Fraction, bool]]:
+    """The score's sustain pedal changes as (quarter notes from the start, down), placed by music21's measures."""
+    starts: dict[str, list] = {}
+    for part in score.parts:
+        starts.setdefault(_group(part), [m.offset for m in part.getElementsByClass("Measure")])
+    times = []
+    for mark in tree.pedal:
+        measures = starts.get(mark.part, [])
+        if mark.measure < len(measures):
+            times.append((Fraction(measures[mark.measure]) + mark.beats, mark.down))
+    return times
+
+
+def _add_pedal(track: mido.MidiTrack, pedal: list[tuple[Fraction, bool]]) -> None:
+    """Sustain pedal changes ((quarter notes, down)) added to ``track`` as control change 64."""
+    if not pedal:
+        return
+    timed, now = [], 0
+    for message in track:
+        now += message.time
+        order = 0 if message.type == "note_off" else 3 if message.type == "note_on" else 2
+        timed.append((now, order, message))
+    for when, down in pedal:  # (at one tick: up before down, both after the notes' ends, before their starts)
+        value = 127 if down else 0
+        timed.append((_tick(when), 1, mido.Message("control_change", control=64, value=value, channel=0)))
+    first = timed[0] if timed and timed[0][2].type == "track_name" else None
+    track.clear()
+    if first:
+        track.append(first[2].copy(time=0))
+        timed = timed[1:]
+    _timed(track, timed)
+
+
+def _say(path: Path, said: dict[str, int], tree: Score) -> None:
+    """One warning line for each kind of thing the reading left out or changed."""
+    lines = {
+        "grace": "left out {n} grace note(s) (ornaments without a time of their own)",
+        "unpitched": "left out {n} unpitched (percussion) note(s): they are no piano keys",
+        "percussion": "left out {n} percussion part(s): they are no piano keys",
+        "doubled": "{n} note(s) written twice on one key at once (two voices) played once",
+        "substitution": "{n} fingering mark(s) naming two fingers (a substitution) read as their first finger",
+        "not a finger": "dropped {n} fingering mark(s) that name no finger 1-5 (such as '{example}')",
+        "ambiguous": "dropped the fingering of {n} chord(s) whose marks cannot be matched to their notes",
+    }
+    for kind, line in lines.items():
+        if said.get(kind):
+            text = line.format(n=said[kind], example=quote(str(said.get("example", "")), 20))
+            warnings.warn(PianobotWarning(f"{path.name}: {text}"))
+    if tree.repeats:
+        warnings.warn(PianobotWarning(f"{path.name}: its repeats are not expanded: it is played once, as written"))
