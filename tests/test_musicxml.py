@@ -14,7 +14,8 @@ from conftest import assert_one_line_error, run
 
 from pianobot.errors import PianobotError, PianobotWarning
 from pianobot.music.midi_file import open_midi
-from pianobot.music.midi_io import describe_tracks, read_midi
+from pianobot.music.midi_io import describe_tracks, read_midi, read_pedal
+from pianobot.music.pedal import Pedal
 from pianobot.music.piece import Note, Piece
 
 music21 = pytest.importorskip("music21")
@@ -138,6 +139,8 @@ def test_the_sustain_pedal_marks_are_control_change_64_on_the_right_hands_track(
     # down at beat 0, a change at beat 2 (up, then down), up at the end of measure 2 (beat 8)
     assert pedal == [(0, 127), (2, 0), (2, 127), (8, 0)]
     assert {t.name: t.pedal for t in describe_tracks(source)}["Right Hand"] == 2
+    # read as the pedal the foot plays: down from 0 s, changed at 1 s (120 bpm), up at 6 s (60 bpm from 2 s)
+    assert read_pedal(source) == Pedal(((0.0, 1.0), (1.0, 6.0)))
 
 
 def test_tempo_changes_are_set_tempo_events(tmp_path):
@@ -289,6 +292,25 @@ def test_a_fingered_score_plays_with_its_own_fingering(tmp_path):
     result = run("score", played, midi, "--json", tmp_path / "s.json")
     assert result.exit_code == 0, result.output
     assert json.loads((tmp_path / "s.json").read_text())["f1"] >= 0.95
+
+
+def test_a_two_staff_score_with_a_few_marks_plays_both_hands_with_them(tmp_path):
+    """Both hands of a score that marks some notes only, as pianists mark them: the pianist's hand
+    plays every mark (fingering accuracy over the marked notes 1.0), the planner fingering the rest."""
+    from pianobot.music.musicxml_out import write_musicxml
+
+    # (not the planner's own choice: index first, the thumb under at F, the left hand from its ring finger)
+    right = [(72, 2), (74, None), (76, 4), (77, 1), (79, None), (77, 1), (76, None), (74, None), (72, 2)]
+    left = [(48, 4), (52, None), (55, 1), (53, 2), (52, None), (48, 4)]
+    notes = [Note(0.4 * i, p, 0.4 * i + 0.4, 80, f, "right") for i, (p, f) in enumerate(right)]
+    notes += [Note(0.6 * i, p, 0.6 * i + 0.6, 70, f, "left") for i, (p, f) in enumerate(left)]
+    path = write_musicxml(Piece.of(notes, bpm=150), tmp_path / "marked.musicxml", name="marked")
+    played = tmp_path / "played.mid"
+    args = ["--hand-model", "pianist", "--controller", "scripted", "--json", tmp_path / "r.json"]
+    result = run("play", path, "-o", played, *args)
+    assert result.exit_code == 0, result.output
+    report = json.loads((tmp_path / "r.json").read_text())
+    assert report["f1"] >= 0.95 and report["fingering_accuracy"] == 1.0
 
 
 def test_a_finger_the_hand_lacks_is_said_in_one_line(tmp_path):

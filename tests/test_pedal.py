@@ -35,12 +35,13 @@ def test_pedal_spans_are_validated_and_merged():
     with pytest.raises(PianobotError, match="come up after"):
         Pedal(((1.0, 1.0),))
     pedal = Pedal.from_changes([(0.5, True), (0.7, True), (1.0, False), (1.0, True), (2.0, False), (3.0, True)], end=4)
-    assert pedal.spans == ((0.5, 2.0), (3.0, 4.0))  # a press while down changes nothing; up and down at once: one
+    assert pedal.spans == ((0.5, 1.0), (1.0, 2.0), (3.0, 4.0))  # a press while down changes nothing
     assert Pedal.from_changes([(3.0, True)]).spans == ()  # never released, no end: nothing held
     assert pedal.down_at(0.5) and pedal.down_at(1.99) and not pedal.down_at(2.0) and not pedal.down_at(0.49)
-    assert list(pedal.steps(5, 1.0)) == [False, True, False, True, False]
+    # a change (up and down at once) lifts the foot for the step it falls in
+    assert list(pedal.steps(10, 2.0)) == [False, True, False, True, False, False, True, True, False, False]
     assert pedal.shift(-1.0).spans == ((0.0, 1.0), (2.0, 3.0))  # cut at 0
-    assert pedal.until(3.5).spans == ((0.5, 2.0), (3.0, 3.5))
+    assert pedal.until(3.5).spans == ((0.5, 1.0), (1.0, 2.0), (3.0, 3.5))
 
 
 def test_sounding_holds_a_released_note_until_the_pedal_rises_or_its_key_is_struck_again():
@@ -73,7 +74,7 @@ def test_the_pedal_goes_out_as_cc64_and_comes_back_the_same(tmp_path):
     path.write_bytes(data)
     values = [m.value for t in mido.MidiFile(path).tracks for m in t if m.type == "control_change"]
     assert values == [127, 0, 127, 0]
-    assert read_pedal(path) == Pedal(((0.1, 1.2),))  # (touching spans read as one: no time for the dampers)
+    assert read_pedal(path) == pedal
     assert read_midi(path) == piece
 
 

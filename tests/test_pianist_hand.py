@@ -123,3 +123,35 @@ def test_under_position_control_each_finger_is_commanded_within_its_own_limits()
     index_at_limit = np.array([0.349, 0.5, 0.5, 0.5])
     command = motion._finger_command(2, None, index_at_limit, wrist_next=0.1)
     assert command[0] <= 1.0 and command[0] > 0.5  # near its own upper limit (+1), not mid-range on the thumb's
+
+
+def test_a_partly_fingered_part_keeps_its_marks_on_the_pianist_s_hand_and_not_on_the_allegro_s():
+    """Pianists mark a few fingers (the thumb under at F); the planner fills the rest around them.
+    The Allegro-like hand's fingers are no human's: it plans anew, as it always has."""
+    from pianobot.pianist.fingering import ensure_fingering
+
+    marks = {0: 1, 3: 1, 7: 5, 9: 3}  # C thumb, F thumb (under), top C little finger, A on the way down middle
+    scale = _scale(0.3)
+    marked = scale.with_fingers([marks.get(i) for i in range(len(scale))])
+    fingered, plan = ensure_fingering(marked, KeyboardSpec(), FIVE)
+    assert plan is not None and all(fingered.notes[i].finger == f for i, f in marks.items())
+    assert (
+        ensure_fingering(marked, KeyboardSpec(), FIVE, refinger=True)[0]
+        == ensure_fingering(scale, KeyboardSpec(), FIVE)[0]
+    )
+    allegro = HandSpec()
+    assert ensure_fingering(marked, KeyboardSpec(), allegro)[0] == ensure_fingering(scale, KeyboardSpec(), allegro)[0]
+
+
+def test_both_hands_play_the_file_s_own_marks_on_the_pianist_s_hand():
+    from pianobot.perform.together import play_hands
+
+    right = [Note(0.3 * i, p, 0.3 * i + 0.28, 80, f, "right") for i, (p, f) in
+             enumerate(zip([60, 62, 64, 65, 67, 69, 71, 72], [1, None, None, 1, None, None, None, 5]))]  # fmt: skip
+    left = [Note(0.6 * i, p, 0.6 * i + 0.55, 70, f, "left") for i, (p, f) in
+            enumerate(zip([48, 52, 55, 48], [5, 3, 1, None]))]  # fmt: skip
+    played = play_hands(Piece.of(right + left), "scripted", hand=FIVE, seed=0)
+    report = played.report()
+    assert report.f1 == 1.0 and report.fingering_accuracy == 1.0  # over the marked notes
+    parts = {h.hand: [n.finger for n in h.part.notes] for h in played.hands}
+    assert parts["right"][:4] == [1, 2, 3, 1] and parts["left"][:3] == [5, 3, 1]

@@ -30,8 +30,9 @@ DOWN_AT = 64
 
 @dataclass(frozen=True)
 class Pedal:
-    """The spans (down, up) in seconds during which the sustain pedal is held; sorted, apart, each
-    at least 1 ms long. ``Pedal()`` is a piece played without the pedal."""
+    """The spans (down, up) in seconds during which the sustain pedal is held; sorted, each at
+    least 1 ms long, apart or touching (a pedal change: up and down again at once, the dampers
+    falling for a moment). ``Pedal()`` is a piece played without the pedal."""
 
     spans: tuple[tuple[float, float], ...] = ()
 
@@ -71,13 +72,7 @@ class Pedal:
                 pressed = None
         if pressed is not None and end is not None and _ms(end) > pressed:
             spans.append((pressed, _ms(end)))
-        merged: list[tuple[float, float]] = []
-        for down, up in spans:  # a release and a press in the same millisecond: one span
-            if merged and down <= merged[-1][1]:
-                merged[-1] = (merged[-1][0], max(up, merged[-1][1]))
-            else:
-                merged.append((down, up))
-        return Pedal(tuple(merged))
+        return Pedal(tuple(spans))
 
     def __bool__(self) -> bool:
         return bool(self.spans)
@@ -102,11 +97,18 @@ class Pedal:
         return [change for down, up in self.spans for change in ((down, True), (up, False))]
 
     def steps(self, count: int, hz: float, start: float = 0.0) -> np.ndarray:
-        """Whether the pedal is down at each of ``count`` control steps ``start + i / hz`` (bool array)."""
+        """Whether the pedal is down at each of ``count`` control steps ``start + i / hz`` (bool array).
+        A pedal change (a release and a press at one time, as a score marks it) lifts the pedal for
+        the step it falls in, so that the dampers fall for a moment, as a pianist's foot lets them."""
         times = start + np.arange(count) / hz
         down = np.zeros(count, bool)
+        previous = None
         for press, release in self.spans:
-            down |= (times >= press - 1e-9) & (times < release - 1e-9)
+            now = (times >= press - 1e-9) & (times < release - 1e-9)
+            if press == previous and now.any():
+                now[np.argmax(now)] = False
+            down |= now
+            previous = release
         return down
 
     # -- transforms (all return new pedals) ----------------------------------------------

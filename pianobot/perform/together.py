@@ -61,6 +61,7 @@ from pianobot.pianist.reading import (  # noqa: F401 (the reading, pianist/readi
     thumbs_keep_more,
     two_hands,
 )
+from pianobot.sim.hand import hand_model
 
 APART = "each hand in a simulation of its own"
 """How both hands play with ``together=False``: said wherever such a performance is reported."""
@@ -260,7 +261,8 @@ def prepare_parts(
     piece's first note (else each from its own); ``grow``: as :func:`prepare_part`'s."""
     offset = piece.notes[0].onset if together else None
     fingered = sum(n.finger is not None for n in piece.notes)
-    if fingered:
+    written = hand_model(fingers.model).written_fingering  # (the file's marks kept: prepare_part)
+    if fingered and not written:
         warnings.warn(
             PianobotWarning(
                 f"the piece's fingering ({fingered} of {len(piece)} notes) is not used with both hands: the fingering "
@@ -277,8 +279,9 @@ def prepare_parts(
         _warn_again(caught)
         parts[name] = (*prepared, changes)
     if together and len(parts) == 2:  # fingerings that keep the wrists apart, where they can
-        apart = finger_apart({h: (window, part) for h, (window, part, *_) in parts.items()}, fingers)
-        parts = {h: (window, apart[h].piece, *rest) for h, (window, _, *rest) in parts.items()}
+        marked = tuple(h for h in parts if written and any(n.finger is not None for n in piece.part(h).notes))
+        apart = finger_apart({h: (window, part) for h, (window, part, *_) in parts.items()}, fingers, marked)
+        parts = {h: (window, apart[h].piece if apart[h] else part, *rest) for h, (window, part, *rest) in parts.items()}
     return parts
 
 

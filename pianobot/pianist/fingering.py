@@ -51,7 +51,7 @@ from pianobot.music.piece import Note, Piece, pitch_name
 from pianobot.pianist.layout import KeyLayout
 from pianobot.pianist.strikes import Run, StrikePlanner
 from pianobot.pianist.tuning import PianistTuning, tuning_for
-from pianobot.sim.hand import HandConfig, hand_config
+from pianobot.sim.hand import HandConfig, hand_config, hand_model
 from pianobot.sim.keyboard import KeyboardConfig, key_boxes, keyboard_width, strike_points
 from pianobot.sim.world import WorldConfig
 
@@ -80,6 +80,10 @@ SETTLE_TIME = 0.2
 ROOM_COST = 5.0
 """Cost of each white key the wrist stands outside its room (:meth:`Planner.plan`'s ``room``: where
 the other hand leaves this one space)."""
+MARK_COST = 50.0
+"""Cost of each note given another finger than the file marks it with (a partly fingered part's
+marks, :meth:`Planner.plan`): far above any move, stretch or legato cost, so a mark is kept
+wherever the hand can play it, and given up only where it cannot reach or is too slow."""
 _INFEASIBLE = 1e9
 _TOO_FAST = 1e3
 
@@ -313,9 +317,18 @@ class Planner:
         own = np.maximum(np.maximum(low - pianist, pianist - high), 0.0)
         return ROOM_COST * np.maximum(grid[None, :], own[:, None]) / self.pitch
 
+    def _off_marks(self, chord: Sequence[Note]) -> np.ndarray:
+        """:data:`MARK_COST` per note of ``chord`` that each state (assignment x wrist position) fingers
+        otherwise than its mark (a note without a finger has no mark)."""
+        marks = [n.finger for n in sorted(chord, key=lambda n: n.pitch)]
+        assignments, _, _ = self._states(chord)
+        off = [sum(m is not None and m != f for m, f in zip(marks, a)) for a in assignments]
+        return np.repeat(MARK_COST * np.array(off, float)[:, None], len(self.grid), axis=1)
+
     # -- the whole piece ---------------------------------------------------------------------
     def plan(self, piece: Piece, room: Sequence[tuple[float, float]] | None = None) -> FingeringPlan:
-        """The lowest-cost fingering of ``piece`` (the module's notes). ``room``: for each chord
+        """The lowest-cost fingering of ``piece`` (the module's notes), keeping the fingers its notes
+        have where the hand can (:data:`MARK_COST`). ``room``: for each chord
         (as :meth:`~pianobot.music.piece.Piece.chords` gives them) the lowest and highest wrist
         position (m, ``-inf``/``inf`` for none) that keeps this hand clear of the other; a state
         whose wrist, or where its fingers put the scripted pianist's wrist (straight over their
@@ -348,6 +361,8 @@ class Planner:
                 back.append(best)
             if room is not None:
                 reach = Reach(reach.chord, reach.cost + self._outside(chord, *room[i]).ravel())
+            if any(n.finger is not None for n in chord):
+                reach = Reach(reach.chord, reach.cost + self._off_marks(chord).ravel())
             reaches.append(reach)
 
         index = int(np.argmin(reaches[-1].cost))
@@ -400,11 +415,15 @@ def ensure_fingering(
     piece: Piece, keyboard: KeyboardSpec, hand: HandSpec, refinger: bool = False
 ) -> tuple[Piece, FingeringPlan | None]:
     """``piece`` as it is when every note has a finger (and not ``refinger``), else fingered by
-    the planner; the plan is returned too, or None when the piece kept its fingering."""
+    the planner; the plan is returned too, or None when the piece kept its fingering. A hand
+    model that plays written fingering (:attr:`~pianobot.sim.hand.HandModel.written_fingering`)
+    keeps a partly fingered piece's marks where it can; otherwise, and with ``refinger``, the
+    planner fingers every note anew."""
     if piece.has_fingering and not refinger:
         return piece, None
     check_playable(piece.without_fingering(), keyboard, hand)  # on the keyboard, not too many notes at once
-    plan = _plan(piece, piece.bpm, keyboard, hand)
+    marked = not refinger and hand_model(hand.model).written_fingering
+    plan = _plan(piece if marked else piece.without_fingering(), piece.bpm, keyboard, hand)
     return plan.piece, plan
 
 

@@ -34,7 +34,7 @@ from pianobot.music.instrument import THUMB, HandSpec, KeyboardSpec, check_playa
 from pianobot.music.load import LoadOptions, end_legato, load_hands, load_part, load_pedal, load_piece, thin_hand
 from pianobot.music.midi_io import MidiSource, TrackInfo, source_path
 from pianobot.music.pedal import Pedal
-from pianobot.music.piece import HANDS, Note, Piece, pitch_name
+from pianobot.music.piece import HANDS, Piece, pitch_name
 from pianobot.music.window import Window, window_for
 from pianobot.pianist.assign import load_two_hands, reduce_hand
 from pianobot.pianist.fingering import FingeringPlan, ensure_fingering
@@ -47,8 +47,7 @@ Source = Path | MidiSource
 
 @dataclass(frozen=True)
 class Wording:
-    """How the caller says what undoes a choice the reading made for it (the command line names
-    its options; the library's defaults name the settings)."""
+    """How the caller says what undoes a choice the reading made (options on the command line, else settings)."""
 
     three: str = "hand=HandSpec() plays with three"
     """After the line that gives both hands their thumbs."""
@@ -102,8 +101,8 @@ class ReadPiece:
 
 
 def open_song(path: str | Path | MidiSource) -> Source:
-    """The file at ``path`` read once: a .mid file parsed (refused in one line where it is no
-    readable MIDI file); a PIG .txt file's path (its text read by each step that needs it)."""
+    """The file at ``path`` read once: a .mid file (or a MusicXML score) parsed, refused in one line where
+    it is none; a PIG .txt file's path (its text read by each step that needs it)."""
     if isinstance(path, MidiSource) or Path(path).suffix.lower() == ".txt":
         return path if isinstance(path, MidiSource) else Path(path)
     return midi_io.open_midi(path)
@@ -181,6 +180,9 @@ def finger_part(
     piece, plan = ensure_fingering(part, keyboard, fingers, options.refinger)
     if plan is not None:
         why = wording.refinger if options.refinger else "it has notes without fingering"
+        marks = [(n.finger, p.finger) for n, p in zip(part.notes, piece.notes) if n.finger is not None]
+        if marks and not options.refinger and hand_model(fingers.model).written_fingering:
+            why += f"; kept {sum(a == b for a, b in marks)} of its {len(marks)} fingering marks"
         warnings.warn(
             PianobotWarning(
                 f"{name}: fingering planned for fingers {', '.join(map(str, fingers.fingers))} ({why}): "
@@ -239,9 +241,8 @@ def finger_read(read: ReadPiece, options: LoadOptions, wording: Wording = Wordin
 
 @dataclass(frozen=True)
 class HandsReading:
-    """A two-hand file as read for both hands: every note with its hand, and how many of each
-    hand's notes the file named (its tracks' names, or a PIG file's channels) rather than the
-    fingering planner (:func:`~pianobot.pianist.assign.assign_hands`)."""
+    """A two-hand file read for both hands: every note with its hand, and how many of each hand's the file
+    named (tracks' names, a PIG file's channels), not the planner (:func:`~pianobot.pianist.assign.assign_hands`)."""
 
     piece: Piece
     named: dict[str, int]
@@ -276,8 +277,7 @@ class HandsReading:
 def read_hands(
     path: str | Path | MidiSource, options: LoadOptions = LoadOptions(), spec: HandSpec = HandSpec()
 ) -> HandsReading:
-    """Both hands of the file at ``path``: :func:`~pianobot.pianist.assign.load_two_hands` (its
-    warnings and its one-line refusals), with what the file named."""
+    """Both hands of the file at ``path`` (:func:`~pianobot.pianist.assign.load_two_hands`), with what the file named."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", PianobotWarning)  # said by load_two_hands
         given = load_hands(source := open_song(path), options)
@@ -305,19 +305,16 @@ def two_hands(
     spec: HandSpec = HandSpec(),
     keyboard: KeyboardSpec = KeyboardSpec(),
 ) -> HandsReading | None:
-    """Both hands of the file at ``path`` where ``pianobot play`` plays both, else None: read it
-    as one hand, as before two hands.
+    """Both hands of the file at ``path`` where ``pianobot play`` plays both, else None (one hand).
 
-    Both hands: without ``options.hand``, and with ``options.track`` naming two or more tracks of
-    notes or none (then only those tracks are read), a file whose tracks are named for
-    hands (the notes of others given hands by the fingering planner), or a PIG file, with notes
-    for both hands; or a file that cannot be one hand's, whose notes the fingering planner gives
-    to both hands: its notes span more keys than one hand's ``keyboard`` has, or, unfingered,
-    one hand's reading refuses it (notes off ``keyboard``, more at once than the hand's fingers,
-    a chord or a move it cannot reach). Where the planner gives every note to one hand, or both
-    hands' reading refuses a file that one hand's refuses too, one hand's reading says why. The
-    reading's warnings are said only where both hands play (or where it refuses the file: notes
-    beyond the piano)."""
+    Both hands, without ``options.hand`` and with ``options.track`` naming none or two or more
+    tracks of notes (only those read): a file with tracks named for hands (the others' notes
+    given hands by the fingering planner) or a PIG file, with notes for both; or a file one hand
+    cannot play, whose notes the planner gives to both: wider than one hand's ``keyboard``, or,
+    unfingered, refused by one hand's reading (notes off the keys, more at once than the fingers,
+    a chord or move out of reach). Where the planner gives every note to one hand, or both hands'
+    reading refuses it too, one hand's reading says why. Warnings are said only where both hands
+    play (or where the file is refused: notes beyond the piano)."""
     if options.hand is not None:
         return None
     path, source = source_path(path), open_song(path)
@@ -400,7 +397,8 @@ def prepare_part(
     part wider than ``keyboard`` is given its own range instead (:func:`~pianobot.music.window.window_for`).
     Each kind of change is one :class:`PianobotWarning`, worded for the written part."""
     window, reduced, start, left_out = _reduced_part(piece, hand, keyboard, fingers, start, grow)
-    fingered, _ = ensure_fingering(reduced, window.keyboard, fingers, refinger=True)
+    written = hand_model(fingers.model).written_fingering  # (the file's marks kept where the hand can)
+    fingered, _ = ensure_fingering(reduced, window.keyboard, fingers, refinger=not written)
     return window, fingered, start, left_out
 
 
@@ -421,7 +419,9 @@ def _reduced_part(
         )
     if not inside:
         raise PianobotError(f"none of the {hand} hand's notes fits the keyboard its player knows")
-    moved = Piece(tuple(Note(n.onset, window.inward(n.pitch), n.offset, n.velocity) for n in inside), bpm=piece.bpm)
+    marks = hand_model(fingers.model).written_fingering and all(n.finger in (None, *fingers.fingers) for n in inside)
+    moved = Piece(tuple(replace(n, pitch=window.inward(n.pitch), hand=None) for n in inside), bpm=piece.bpm)
+    moved = moved if marks else moved.without_fingering()
     start = moved.notes[0].onset if start is None else start
     # (the simulated hand is a right hand: its top notes are a left hand's lowest)
     thinned = thin_hand(moved.shift(-start), hand, fingers, "lowest" if hand == "left" else "highest")
@@ -429,9 +429,8 @@ def _reduced_part(
 
 
 def given_notes(piece: Piece, fingers: HandSpec, keyboard: KeyboardSpec | None = None) -> int | None:
-    """How many of ``piece``'s notes (each with its hand) both hands are given with ``fingers``,
-    each part as :func:`prepare_part` gives it: on ``keyboard``, default the general policy's 24
-    keys or a wider part's own octaves. None where a hand's part is refused. Nothing is said."""
+    """How many of ``piece``'s notes both hands are given with ``fingers`` (:func:`prepare_part`), on
+    ``keyboard`` (default: 24 keys or a wider part's own octaves); None where a part is refused."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", PianobotWarning)
         try:
@@ -446,10 +445,10 @@ def given_notes(piece: Piece, fingers: HandSpec, keyboard: KeyboardSpec | None =
 def keeps_more(
     readings: list[tuple[HandSpec, Piece]], keyboard: KeyboardSpec | None = None
 ) -> tuple[int, tuple[int, int] | None]:
-    """Which finger set both hands play with where none are named, of ``readings``: each of a hand
-    model's sets with the piece as read for it, in its order of preference. The first, unless a later
-    one gives the hands more notes (:func:`given_notes`): then the one that gives the most. Returns
-    (its index, (notes given with the first set, with it)), the counts None for the first."""
+    """Which of ``readings`` (a hand model's finger sets, each with the piece as read for it, in its
+    order of preference) both hands play with where none are named: the first, unless a later one
+    gives more notes (:func:`given_notes`), then the one giving most: (its index, (notes given with
+    the first, with it)), the counts None for the first."""
     (_, first), *others = readings
     given = given_notes(first, readings[0][0], keyboard)
     if given is None:
@@ -467,19 +466,17 @@ def keeps_more(
 def thumbs_keep_more(
     three: Piece, thumbs: Piece | None = None, keyboard: KeyboardSpec | None = None
 ) -> tuple[int, int] | None:
-    """(notes both hands are given with three fingers, with their thumbs too) where the thumbs keep
-    more of them, else None: :func:`keeps_more` of the Allegro-like hand's sets, ``three`` and
-    ``thumbs`` (default the same) the piece as read for each."""
+    """(notes both hands are given with three fingers, with thumbs) where the thumbs keep more, else None:
+    :func:`keeps_more` of the Allegro-like hand's sets, ``three``/``thumbs`` (default: the same) as read for each."""
     return keeps_more([(HandSpec(), three), (THUMB, three if thumbs is None else thumbs)], keyboard)[1]
 
 
 def fingers_for_file(
     path: str | Path | MidiSource, options: LoadOptions, model: str = HandSpec.model
 ) -> tuple[HandSpec, tuple[int, int] | None]:
-    """Both hands' fingers for the file at ``path`` where none are named, as ``pianobot play`` chooses
-    them among ``model``'s finger sets (:func:`keeps_more`, with its counts), where the file plays
-    both hands read with each (:func:`two_hands`), else the first set. On the default keys whatever
-    keys a command names, so that ``pianobot score`` reads the hands as ``play`` did. Nothing is said."""
+    """Both hands' fingers for the file at ``path`` where none are named, as ``play`` chooses among
+    ``model``'s finger sets (:func:`keeps_more` of the file's both hands read with each, :func:`two_hands`),
+    else the first set; on the default keys whatever keys are named (``score`` reads as ``play`` did)."""
     sets = [HandSpec(fingers=fingers, model=model) for fingers in hand_model(model).finger_sets]
     readings = []
     with warnings.catch_warnings():

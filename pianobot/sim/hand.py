@@ -92,6 +92,10 @@ class HandModel:
     settings: tuple[tuple[str, float], ...] = ()
     """(name, value): the :class:`HandConfig` settings this body has other than their defaults
     (the palm's pose over the keys, its motors), as :func:`hand_config` applies them."""
+    written_fingering: bool = False
+    """Whether a file's 1-5 fingering, written for a human hand, is this hand's: its marks are kept
+    where the hand can play them, in a partly fingered part and in both hands' parts (else a part
+    not wholly fingered, and both hands' parts, are fingered anew for this hand)."""
 
     def __post_init__(self) -> None:
         numbers = [f for f, _, _ in self.bases]

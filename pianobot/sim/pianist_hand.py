@@ -33,6 +33,7 @@ PIANIST = HandModel(
         ("max_strike_speed", 0.2),
     ),
     passes=frozenset({(1, 2), (1, 3), (1, 4)}),
+    written_fingering=True,
     settings=(
         ("palm_height", 0.0575),
         ("palm_y", 0.1575),
