@@ -166,3 +166,45 @@ def test_play_writes_the_files_pedal_and_score_reports_it(tmp_path):
     assert run("play", song, "-o", dry, "--controller", "scripted", "--quiet", "--no-pedal").exit_code == 0
     assert read_pedal(dry) == Pedal()
     assert read_midi(dry) == read_midi(out)
+
+
+def test_two_hands_have_one_foot_beside_them():
+    from pianobot.env.two_hands import HandsEnv
+    from pianobot.music.instrument import KeyboardSpec
+    from pianobot.music.window import Window
+
+    keys, config = KeyboardSpec(), EnvConfig(tactile=False)
+    parts = {"right": (Window("right", keys, -1), PHRASE), "left": (Window("left", keys, -1), PHRASE)}
+    with pytest.raises(ValueError, match="one foot"):
+        HandsEnv(parts, {"right": EnvConfig(tactile=False, pedal_action=True), "left": config})
+    env = HandsEnv(parts, {"right": config, "left": config}, pedal=WRITTEN, pedal_action=True)
+    assert env.action_space["pedal"].shape == (1,) and "pedal" in env.observation_space.spaces
+    observations, _ = env.reset(seed=0)
+    assert observations["pedal"].shape == (config.lookahead + 1,)
+    idle = {h: np.zeros(env.action_space[h].shape, np.float32) for h in ("right", "left")}
+    _, _, _, _, info = env.step({**idle, "pedal": np.ones(1, np.float32)})
+    assert info["pedal"] is True and all(i["pedal"] is True for i in info["hands"].values())
+    env.close()
+    written = HandsEnv(parts, {"right": config, "left": config}, pedal=WRITTEN)  # the foot as written
+    written.reset(seed=0)
+    downs = [written.step(idle)[4]["pedal"] for _ in range(written.horizon)]
+    written.close()
+    lead = written.hands["right"].lead_steps
+    assert downs == [False] * lead + WRITTEN.steps(written.horizon - lead, 20.0).tolist()
+
+
+def test_a_policy_of_the_default_actor_reads_the_score_s_pedal_and_moves_the_foot():
+    from pianobot.agent.config import SACConfig
+    from pianobot.agent.policy import make_agent
+    from pianobot.agent.sac import split_observation
+
+    env = PianoEnv(piece=PHRASE, config=EnvConfig(tactile=False, pedal_action=True), pedal=WRITTEN)
+    observation, _ = env.reset(seed=0)
+    agent = make_agent(env, SACConfig(hidden=16, batch_size=4))
+    plain = PianoEnv(piece=PHRASE, config=EnvConfig(tactile=False))
+    assert len(split_observation(observation)[0]) == len(split_observation(plain.reset(seed=0)[0])[0]) + 11
+    assert agent.act(observation).shape == env.action_space.shape
+    with pytest.raises(ValueError, match="no foot"):
+        make_agent(env, SACConfig(hidden=16, actor="fingers"))
+    env.close()
+    plain.close()

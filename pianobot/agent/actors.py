@@ -17,6 +17,10 @@ from torch.nn import functional as F
 
 from pianobot.agent.config import SACConfig
 
+NO_FOOT = (
+    " (the finger-shared actor has no foot: a policy that works the pedal, env.pedal_action, takes the 'mlp' actor)"
+)
+
 
 class GaussianActor(nn.Module):
     """A tanh-squashed Gaussian policy; a subclass's :meth:`heads` gives the mean and (unbounded)
@@ -119,12 +123,14 @@ class FingerActor(GaussianActor):
         if layout.counts is None:
             self.per_finger = (action_dim - 1) // layout.fingers
             if self.per_finger * layout.fingers + 1 != action_dim:
-                raise ValueError(f"{action_dim} actions are not {layout.fingers} fingers' alike plus the wrist")
+                raise ValueError(
+                    f"{action_dim} actions are not {layout.fingers} fingers' alike plus the wrist{NO_FOOT}"
+                )
         else:  # fingers that differ: each one's joints padded to the most (zeros), its actions the first of the most
             joints, moved = layout.counts
             self.per_finger = max(moved)
             if sum(moved) + 1 != action_dim:
-                raise ValueError(f"{action_dim} actions are not the fingers' {sum(moved)} plus the wrist")
+                raise ValueError(f"{action_dim} actions are not the fingers' {sum(moved)} plus the wrist{NO_FOOT}")
             total = sum(joints)
             pad = [
                 [sum(joints[:f]) + j if j < n else total for j in range(layout.joints)] for f, n in enumerate(joints)

@@ -29,7 +29,8 @@ from pianobot.agent.config import DEVICES, SACConfig
 from pianobot.errors import SettingError, quote
 
 # -- observation layout -----------------------------------------------------------------------
-VECTOR_KEYS = ("score", "wrist", "joints", "joint_velocities", "targets", "keys", "key_velocities")
+VECTOR_KEYS = ("score", "wrist", "joints", "joint_velocities", "targets", "keys", "key_velocities", "pedal")
+"""What the flat vector holds, in order (each where the environment observes it)."""
 
 
 def _keys(score: bool) -> tuple[str, ...]:
