@@ -10,7 +10,8 @@ stays quick (it registers the gymnasium ids ``pianobot/Piano-v1``, ``pianobot/On
 - :func:`play` -- a whole piece performed as ``pianobot play`` performs it (:func:`plan_performance`
   says who plays each stretch, :func:`perform_plan` plays a plan); a piece with both hands plays
   both, in one simulation (:func:`load_two_hands` reads a two-hand file);
-- :func:`compare` -- note F1, velocity and timing errors of a performance against its score.
+- :func:`compare` -- note F1, velocity and timing errors of a performance against its score;
+- :class:`Pedal`, :func:`read_pedal` -- the sustain pedal, and a file's (control change 64).
 """
 
 from __future__ import annotations
@@ -26,6 +27,8 @@ _API = {
     "Piece": "pianobot.music.piece",
     "LoadOptions": "pianobot.music.load",
     "load_piece": "pianobot.music.load",
+    "Pedal": "pianobot.music.pedal",
+    "read_pedal": "pianobot.music.midi_io",
     "split_phrases": "pianobot.music.phrases",
     "compare": "pianobot.music.metrics",
     "PianoEnv": "pianobot.env.piano",
