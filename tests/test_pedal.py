@@ -40,6 +40,8 @@ def test_pedal_spans_are_validated_and_merged():
     assert pedal.down_at(0.5) and pedal.down_at(1.99) and not pedal.down_at(2.0) and not pedal.down_at(0.49)
     # a change (up and down at once) lifts the foot for the step it falls in
     assert list(pedal.steps(10, 2.0)) == [False, True, False, True, False, False, True, True, False, False]
+    assert list(Pedal(((0.0, 0.9), (1.3, 2.0))).steps(4, 2.0)) == [True, True, False, True]  # up at a step
+    assert list(Pedal(((0.0, 1.1), (1.3, 2.0))).steps(4, 2.0)) == [True, True, True, False]  # up between steps
     assert pedal.shift(-1.0).spans == ((0.0, 1.0), (2.0, 3.0))  # cut at 0
     assert pedal.until(3.5).spans == ((0.5, 1.0), (1.0, 2.0), (3.0, 3.5))
 

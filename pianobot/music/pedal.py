@@ -98,14 +98,15 @@ class Pedal:
 
     def steps(self, count: int, hz: float, start: float = 0.0) -> np.ndarray:
         """Whether the pedal is down at each of ``count`` control steps ``start + i / hz`` (bool array).
-        A pedal change (a release and a press at one time, as a score marks it) lifts the pedal for
-        the step it falls in, so that the dampers fall for a moment, as a pianist's foot lets them."""
+        A pedal up between two steps (a change, up and down at once as a score marks it) is up for
+        the step it comes down in, so that the dampers fall for a moment, as a pianist's foot lets them."""
         times = start + np.arange(count) / hz
         down = np.zeros(count, bool)
         previous = None
         for press, release in self.spans:
             now = (times >= press - 1e-9) & (times < release - 1e-9)
-            if press == previous and now.any():
+            lifted = previous is not None and np.any((times >= previous - 1e-9) & (times < press - 1e-9))
+            if previous is not None and not lifted and now.any():  # (up between two steps: up for one)
                 now[np.argmax(now)] = False
             down |= now
             previous = release
