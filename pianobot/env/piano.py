@@ -223,8 +223,8 @@ class PianoEnv(gym.Env):
     """The hand plays ``piece`` (a phrase), or a fresh instance from ``sampler`` (or of the
     paper's task ``task``) at each reset.
 
-    ``length``: seconds the episode's score lasts at least (the piece's duration by default; the
-    rest silent). ``view``: one hand of a two-hand world, seen through its window
+    ``length``: seconds the episode's score lasts at least (the piece's duration by default, or
+    until its written ``pedal`` rises; the rest silent). ``view``: one hand of a two-hand world, seen through its window
     (:class:`~pianobot.sim.frame.HandView`), instead of a world of its own; the world's owner
     (:class:`~pianobot.env.two_hands.HandsEnv`) resets it between :meth:`draw_start` and
     :meth:`begin`, and steps it before :meth:`absorb`."""
@@ -263,8 +263,8 @@ class PianoEnv(gym.Env):
         if view is not None and (view.config.keyboard.spec != config.world.keyboard.spec or render_mode is not None):
             raise ValueError("a hand's view needs the environment's keyboard to be the view's, and no render mode")
         self.piece = piece
-        self.length = length
         self.pedal = pedal or Pedal()  # (the written sustain pedal, in the piece's time; none for a task)
+        self.length = max(length or 0.0, self.pedal.spans[-1][1]) if self.pedal else length  # (until it rises)
         self.world = view if view is not None else PianoWorld(config.world)
         self.owns_world = view is None
         """False for one hand of a world of two (:class:`pianobot.env.two_hands.HandsEnv` steps and resets it)."""
