@@ -4,7 +4,10 @@ under the fingers, chosen on the command line and recorded in every report."""
 from __future__ import annotations
 
 import json
+import math
+from dataclasses import replace
 
+import numpy as np
 import pytest
 from conftest import assert_one_line_error, run
 
@@ -12,7 +15,8 @@ from pianobot.music.instrument import HandSpec, KeyboardSpec
 from pianobot.music.piece import Note, Piece
 from pianobot.perform.plan import perform_plan, plan_performance
 from pianobot.pianist.fingering import Planner, plan_fingering
-from pianobot.sim.hand import ALLEGRO, HandModel, default_fingers, hand_config, joint_limits
+from pianobot.pianist.tuning import tuning_for
+from pianobot.sim.hand import ALLEGRO, HandConfig, HandModel, default_fingers, hand_config, joint_limits
 from pianobot.sim.keyboard import KeyboardConfig
 from pianobot.sim.pianist_hand import PIANIST
 from pianobot.sim.world import PianoWorld, WorldConfig
@@ -67,6 +71,35 @@ def test_the_scripted_pianist_plays_the_scale_with_the_thumb_under():
     performance = perform_plan(plan_performance(piece, "scripted", hand=FIVE))
     report = performance.report()
     assert report.f1 == 1.0 and report.fingering_accuracy == 1.0
+
+
+def test_the_planner_uses_95_percent_of_the_pianist_s_reach_and_75_of_the_allegro_s():
+    forward = {
+        hand: config.palm_y - 0.110 for hand, config in (("allegro", HandConfig()), ("pianist", hand_config(FIVE)))
+    }
+    allegro, pianist = Planner(), Planner(KeyboardConfig(), hand_config(FIVE))
+    white = int(np.flatnonzero(~allegro.black)[0])
+    assert allegro.reach[2][white] == pytest.approx(0.75 * forward["allegro"] * math.tan(0.47), abs=1e-12)
+    assert pianist.reach[5][white] == pytest.approx(0.95 * forward["pianist"] * math.tan(0.349), abs=1e-12)
+    assert pianist.reach[1][white] == pytest.approx(0.95 * forward["pianist"] * math.tan(0.6), abs=1e-12)
+
+
+def _fifth() -> list[Note]:
+    return [Note(0.0, 60, 0.5, 80), Note(0.0, 67, 0.5, 80)]  # C4 and G4: a fifth, four white keys apart
+
+
+def test_a_fifth_with_fingers_2_and_5_is_in_the_pianist_s_reach_and_played():
+    hand = hand_config(HandSpec((2, 3, 4, 5), model="pianist"))  # without the thumb: only 2 and 5 span a fifth
+    assert Planner(KeyboardConfig(), hand).place(_fifth()).possible
+    narrow = replace(tuning_for(hand), reach_fraction=0.75)  # the margin before: a fifth 2-5 out of reach
+    assert not Planner(KeyboardConfig(), hand, narrow).place(_fifth()).possible
+    chords = [
+        replace(n, onset=n.onset + 0.8 * i, offset=n.offset + 0.8 * i, finger=f)
+        for i in range(3)
+        for n, f in zip(_fifth(), (2, 5))
+    ]
+    report = perform_plan(plan_performance(Piece(tuple(chords), bpm=100), "scripted", hand=FIVE)).report()
+    assert report.f1 == 1.0
 
 
 def test_hand_model_pianist_plays_with_five_fingers_and_the_report_says_so(tmp_path):

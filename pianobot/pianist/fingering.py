@@ -55,8 +55,9 @@ from pianobot.sim.hand import HandConfig, hand_config, hand_model
 from pianobot.sim.keyboard import KeyboardConfig, key_boxes, keyboard_width, strike_points
 from pianobot.sim.world import WorldConfig
 
-REACH_FRACTION = 0.75
-"""Share of the abduction limit's sideways reach the planner uses (the rest is margin for aim)."""
+REACH_FRACTION = PianistTuning.reach_fraction
+"""Share of the abduction limit's sideways reach the planner uses (the rest is margin for aim); a hand
+model may set its own (``PianistTuning.reach_fraction``)."""
 BLACK_REACH = 0.6
 """Share of that reach used on black keys: a slanted fingertip easily slips off their narrow tops."""
 GRID = 4
@@ -138,7 +139,7 @@ class Planner:
         # slanted fingertip easily slips off their narrow tops
         forward = hand.palm_y - strike_points(keyboard)[:, 1].max()
         self.black = np.array([b.black for b in key_boxes(keyboard)])
-        share = REACH_FRACTION * forward * np.where(self.black, BLACK_REACH, 1.0)
+        share = tuning.reach_fraction * forward * np.where(self.black, BLACK_REACH, 1.0)
         self.reach = {f: share * math.tan(hand.model.abduction_limit(f)) for f in self.fingers}
         """Each finger's sideways reach (m) at each key."""
         self.passes = {(a, b) for a in self.fingers for b in self.fingers if hand.model.passes_by(a, b)}

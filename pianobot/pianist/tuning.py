@@ -60,6 +60,9 @@ class PianistTuning:
     same key again from the ready height (control steps): no move across, so less than ``prepare_steps``."""
 
     # -- fingering (pianobot/pianist/fingering.py) ---------------------------------------------------
+    reach_fraction: float = 0.75
+    """Share of what a finger's abduction limit reaches sideways that the fingering planner uses (the
+    rest is margin for aim)."""
     legato_cost: float = 2.0
     """The fingering planner's cost of a note let go before its written end, per share of its written
     length lost (in white keys of wrist travel: a whole note lost costs as much as a move of this many)."""

@@ -31,6 +31,7 @@ PIANIST = HandModel(
         ("black_strike_reach", 0.009),
         ("hold_slide", 0.004),
         ("max_strike_speed", 0.2),
+        ("reach_fraction", 0.95),
     ),
     passes=frozenset({(1, 2), (1, 3), (1, 4)}),
     written_fingering=True,
@@ -54,6 +55,10 @@ in a scale rather than the hand jumping. Its fingers turn sideways less far than
 Allegro-like hand's longer ones, so the wrist strays less from straight over a held or struck
 key (``hold_reach``, ``strike_reach``; the thumb's as far farther as it turns) and slides more
 slowly while a finger holds one (``hold_slide``); and its joints, at the Shadow hand's speed,
-strike no faster than 0.2 m/s (``max_strike_speed``: about MIDI velocity 97 on a white key)."""
+strike no faster than 0.2 m/s (``max_strike_speed``: about MIDI velocity 97 on a white key). Its
+planner uses 95 % of each finger's sideways reach (``reach_fraction``; the Allegro-like hand's
+75 %): the scripted pianist strikes a key only once the fingertip is over it, and its fingers
+land there turned to their limit, so the wider margin only forbade spans the hand plays (a fifth
+with fingers 2 and 5)."""
 
 register_hand_model(PIANIST)
