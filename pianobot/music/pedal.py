@@ -14,6 +14,7 @@ on sounding until the pedal comes up, or until its own key is struck again.
 
 from __future__ import annotations
 
+import bisect
 import math
 import numbers
 from dataclasses import dataclass, replace
@@ -54,6 +55,7 @@ class Pedal:
                 )
             spans.append((down, up))
         object.__setattr__(self, "spans", tuple(spans))
+        object.__setattr__(self, "_presses", [down for down, _ in spans])  # (for bisect)
 
     @staticmethod
     def from_changes(changes: Iterable[tuple[float, bool]], end: float | None = None) -> "Pedal":
@@ -83,14 +85,12 @@ class Pedal:
 
     def down_at(self, time: float) -> bool:
         """Whether the pedal is down at ``time`` (down from its press, up from its release)."""
-        return any(down <= time < up for down, up in self.spans)
+        return self.release_after(time) is not None
 
     def release_after(self, time: float) -> float | None:
         """When the pedal comes up, if it is down at ``time``; else None."""
-        for down, up in self.spans:
-            if down <= time < up:
-                return up
-        return None
+        i = bisect.bisect_right(self._presses, time) - 1  # (the last press at or before it)
+        return self.spans[i][1] if i >= 0 and time < self.spans[i][1] else None
 
     def changes(self) -> list[tuple[float, bool]]:
         """(time, down) for every press and release, in time order."""
@@ -101,15 +101,16 @@ class Pedal:
         A pedal up between two steps (a change, up and down at once as a score marks it) is up for
         the step it comes down in, so that the dampers fall for a moment, as a pianist's foot lets them."""
         times = start + np.arange(count) / hz
-        down = np.zeros(count, bool)
-        previous = None
-        for press, release in self.spans:
-            now = (times >= press - 1e-9) & (times < release - 1e-9)
-            lifted = previous is not None and np.any((times >= previous - 1e-9) & (times < press - 1e-9))
-            if previous is not None and not lifted and now.any():  # (up between two steps: up for one)
-                now[np.argmax(now)] = False
-            down |= now
-            previous = release
+        if not self.spans:
+            return np.zeros(count, bool)
+        presses, releases = np.array(self.spans).T
+        last = np.searchsorted(presses, times + 1e-9, side="right") - 1  # (each step's last press)
+        down = (last >= 0) & (times < releases[np.maximum(last, 0)] - 1e-9)
+        firsts = np.searchsorted(times, presses - 1e-9)  # (each span's first step)
+        for i in range(1, len(self.spans)):  # up between two steps: up for the step it comes down in
+            first = firsts[i]
+            if np.searchsorted(times, releases[i - 1] - 1e-9) == first and first < count and down[first]:
+                down[first] = False
         return down
 
     # -- transforms (all return new pedals) ----------------------------------------------
@@ -133,16 +134,17 @@ class Pedal:
         down sounds on until the pedal comes up, or until its pitch is struck again, whichever is first."""
         if not self.spans:
             return piece
-        next_strike: dict[int, list[float]] = {}
-        for note in piece.notes:
-            next_strike.setdefault(note.pitch, []).append(note.onset)
+        strikes: dict[int, list[float]] = {}
+        for note in piece.notes:  # (in onset order)
+            strikes.setdefault(note.pitch, []).append(note.onset)
         out = []
         for note in piece.notes:
             release = self.release_after(note.offset)
             if release is None:
                 out.append(note)
                 continue
-            later = [t for t in next_strike[note.pitch] if t > note.onset]
-            end = min([release, *later]) if later else release
+            onsets = strikes[note.pitch]
+            later = bisect.bisect_right(onsets, note.onset)  # (its pitch's next strike, if any)
+            end = min(release, onsets[later]) if later < len(onsets) else release
             out.append(replace(note, offset=max(note.offset, end)))
         return Piece(tuple(out), bpm=piece.bpm)
