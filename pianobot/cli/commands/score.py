@@ -67,8 +67,9 @@ def score(
     # the fingers and keys play chose (they may read the hands otherwise), nothing said again
     read = read_file(reference, reading, finger=False, quiet=True, fit=False)
     reference_piece = read.hands.piece if read.both else read.part  # as play scored it (with --hand, reduced)
-    played_piece = midi_io.read_midi(played)
-    pedals = (read.pedal, midi_io.read_pedal(played) if reading.options.pedal else read.pedal)
+    performance = midi_io.open_midi(played)  # (read once: its notes, then its pedal)
+    played_piece = midi_io.read_midi(performance)
+    pedals = (read.pedal, midi_io.read_pedal(performance) if reading.options.pedal else read.pedal)
     scores = compare_hands(reference_piece, played_piece, onset_tolerance=onset_tolerance, pedals=pedals)
     report = scores.whole
     if scores.hands:
