@@ -210,3 +210,14 @@ def test_a_policy_of_the_default_actor_reads_the_score_s_pedal_and_moves_the_foo
         make_agent(env, SACConfig(hidden=16, actor="fingers"))
     env.close()
     plain.close()
+
+
+def test_a_pedal_long_after_the_last_note_is_not_read(tmp_path):
+    """What the pedal holds has died away RING seconds after the last note: a stray press an hour on
+    neither refuses the file nor lengthens the simulation."""
+    from pianobot.music.pedal import RING
+
+    hour = 480 * 2 * 3600  # ticks at 120 bpm
+    events = [(0, on(60)), (480, off(60)), (240, cc(127)), (hour, cc(127)), (hour + 480, cc(0))]
+    path = midi_file(tmp_path / "stray.mid", [("Piano", events)])
+    assert read_pedal(path).spans == ((0.25, 0.5 + RING),)  # (down from 0.25 s, never up before the stray one)

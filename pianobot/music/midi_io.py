@@ -35,7 +35,7 @@ from pianobot.music.midi_file import (  # noqa: F401 (by their old address too)
     opened,
     source_path,
 )
-from pianobot.music.pedal import DOWN_AT, Pedal
+from pianobot.music.pedal import DOWN_AT, RING, Pedal
 from pianobot.music.piece import HANDS, MAX_SECONDS, Note, Piece, pitch_name
 
 _FINGER_TOKEN = r"(?:[0-9](?:_[0-9])?|-)"
@@ -365,23 +365,22 @@ def _clock(midi: mido.MidiFile, path: Path, bpm: float | None):
 def read_pedal(path: str | Path | MidiSource, *, bpm: float | None = None) -> Pedal:
     """The sustain pedal of a .mid file: control change 64 on any track and channel (a value of
     :data:`~pianobot.music.pedal.DOWN_AT` or more is down), timed as :func:`read_midi` times notes
-    (``bpm`` as there). A pedal still down at the file's end comes up with its last event."""
+    (``bpm`` as there), up to :data:`~pianobot.music.pedal.RING` seconds after the last note ends
+    (what it holds has died away by then); a pedal still down there, or at the file's last event,
+    comes up there."""
     path, midi = opened(path)
     seconds, _ = _clock(midi, path, bpm)
-    changes, end = [], 0
+    changes, last_event, last_note = [], 0, 0
     for track in midi.tracks:
         for tick, msg in _absolute(track):
-            end = max(end, tick)
-            if msg.type == "control_change" and msg.control == SUSTAIN:
+            last_event = max(last_event, tick)
+            if msg.type in ("note_on", "note_off"):
+                last_note = max(last_note, tick)
+            elif msg.type == "control_change" and msg.control == SUSTAIN:
                 changes.append((tick, msg.value >= DOWN_AT))
     changes.sort(key=lambda change: change[0])  # (one tick's events in their track's order)
-    if changes and seconds(changes[-1][0]) > MAX_SECONDS:
-        raise SettingError(
-            f"{path} presses the pedal at {seconds(changes[-1][0]) / 60:,.0f} minutes: pianobot reads at most "
-            f"{MAX_SECONDS / 60:.0f} minutes of music; cut the file or choose a faster load.tempo",
-            "load.tempo",
-        )
-    return Pedal.from_changes(((seconds(t), down) for t, down in changes), end=min(seconds(end), MAX_SECONDS))
+    end = min(seconds(last_event), seconds(last_note) + RING, MAX_SECONDS)
+    return Pedal.from_changes(((seconds(t), down) for t, down in changes if seconds(t) < end), end=end)
 
 
 def _parts(midi: mido.MidiFile, chosen: list[int], seconds, path: Path) -> list[tuple[int | None, list, dict]]:

@@ -27,6 +27,10 @@ from pianobot.music.piece import MAX_SECONDS, Piece, _ms
 
 DOWN_AT = 64
 """A control change 64 value at or above this presses the pedal; below it lets the pedal up."""
+RING = 10.0
+"""Seconds after a piece's last note ends that its pedal is still read: a piano's note has died
+away by then, so the pedal holds nothing, and a stray pedal event far after the music (an hour on)
+neither lengthens the simulation nor refuses the file."""
 
 
 @dataclass(frozen=True)
