@@ -164,6 +164,8 @@ def test_play_writes_the_files_pedal_and_score_reports_it(tmp_path):
         assert a[1] == b[1] and abs(a[0] - b[0]) <= STEP
     scored = run("score", out, song, "--all")
     assert scored.exit_code == 0 and "sustain pedal" in scored.output and "F1 1.000" in scored.output
+    unpedalled = run("score", out, song, "--all", "--no-pedal")
+    assert unpedalled.exit_code == 0 and "sustain pedal" not in unpedalled.output
     dry = tmp_path / "dry.mid"
     assert run("play", song, "-o", dry, "--controller", "scripted", "--quiet", "--no-pedal").exit_code == 0
     assert read_pedal(dry) == Pedal()
