@@ -337,21 +337,22 @@ def test_train_a_task_family_evaluates_on_many_instances(tmp_path):
 def test_play_sac_without_policies_names_the_phrase_and_the_train_command(tmp_path):
     """The trained policies play by default: without them (and without the general policy), one
     line says where it looked and how to get them or what else to do."""
-    result = run("play", EXAMPLES / "three-note.mid", "-o", tmp_path / "x.mid", "--models", tmp_path, "--no-general")
+    result = run("play", EXAMPLES / "three-note.mid", "-o", tmp_path / "x.mid", "--models", tmp_path, "--policy", "none")
     assert_one_line_error(
         result,
         "phrase 0 (C4 D4 E4)",
         str(tmp_path),
         "pianobot train",
         "--models",
-        "--fallback scripted",
+        "--policy scripted",
         "--controller scripted",
     )
     assert not (tmp_path / "x.mid").exists()
 
 
 def test_play_sac_composes_trained_and_fallback_phrases(tmp_path):
-    """Phrase 0 has a (barely) trained policy, phrase 1 none: --fallback scripted plays it and says so."""
+    """Phrase 0 has a (barely) trained policy, phrase 1 none, and no general policy
+    fits its environment: --policy scripted plays it and says so."""
     one = EXAMPLES / "one-note.mid"
     trained = run(
         "train", one, "--steps", "60", "--exploration-steps", "30", "--no-tactile", "--models", tmp_path / "models"
@@ -372,7 +373,7 @@ def test_play_sac_composes_trained_and_fallback_phrases(tmp_path):
         "1",
     )
     assert_one_line_error(run(*args), "phrase 1 (G4)")
-    result = run(*args, "--fallback", "scripted")
+    result = run(*args, "--policy", "scripted")
     assert result.exit_code == 0, result.output
     assert "phrase 1: scripted pianist" in result.output
     report = json.loads((tmp_path / "out.report.json").read_text())

@@ -26,7 +26,7 @@ runner = CliRunner()
     "args, option, bad",
     [
         (("play", SONG, "-o", "x.mid", "--controller", "robot"), "--controller", "robot"),
-        (("play", SONG, "-o", "x.mid", "--fallback", "general"), "--fallback", "general"),
+        (("play", SONG, "-o", "x.mid", "--guard", "always"), "--guard", "always"),
         (("train", SONG, "--learner", "ppo"), "--learner", "ppo"),
         (("train", SONG, "--cluster", "slurm"), "--cluster", "slurm"),
         (("train", SONG, "--device", "gpu"), "--device", "gpu"),

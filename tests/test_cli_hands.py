@@ -362,10 +362,11 @@ def test_finger_writes_each_hands_fingering_one_track_each(tmp_path):
     assert "left hand, fingers 2 (index), 3 (middle), 4 (ring): wrist travel" in text and "one track per hand" in text
 
 
-def test_both_hands_play_the_packaged_parts_policy_unless_left_policy_names_another(tmp_path):
+def test_both_hands_play_the_packaged_parts_policy_unless_policy_names_another(tmp_path):
     """Both hands with the general policies: by default each hand has the packaged left hand's
-    policy (`task-parts`), a melody as a right hand in two voices; --left-policy names the left's;
-    it is refused, in one line, where no general policy plays a left hand."""
+    policy (`task-parts`), a melody as a right hand in two voices; --policy left=DIR names the left's
+    (and right=DIR the right's); a hand named where there is none, a folder without a policy and
+    a controller that plays every phrase itself are refused in one line."""
     from pianobot.agent.general import PACKAGED
 
     song, models = _duet(tmp_path / "duet.mid"), tmp_path / "models"
@@ -381,42 +382,52 @@ def test_both_hands_play_the_packaged_parts_policy_unless_left_policy_names_anot
     hands = json.loads((tmp_path / "v.json").read_text())["hands"]
     assert "task-parts-" in hands["right"]["performer"] and "task-parts-" in hands["left"]["performer"]
     melody = next(PACKAGED.glob("task-melody-*"))
-    named = ("--left-policy", melody, "--json", tmp_path / "two.json", "-q")
+    named = ("--policy", f"left={melody}", "--json", tmp_path / "two.json", "-q")
     result = run("play", song, "-o", tmp_path / "two.mid", "--models", models, *named)
     assert result.exit_code == 0, result.output
     hands = json.loads((tmp_path / "two.json").read_text())["hands"]
     assert "task-melody-" in hands["left"]["performer"] and "task-parts-" not in hands["left"]["performer"]
     assert "task-parts-" in hands["right"]["performer"]
     one_hand = midi_file(tmp_path / "one.mid", [("Right Hand", RIGHT)])
-    refused = run("play", one_hand, "-o", tmp_path / "x.mid", "--left-policy", melody)
+    named = ("--policy", f"right={melody}", "--json", tmp_path / "right.json", "-q")
+    result = run("play", song, "-o", tmp_path / "right.mid", "--models", models, *named)
+    assert result.exit_code == 0, result.output
+    hands = json.loads((tmp_path / "right.json").read_text())["hands"]
+    assert "task-melody-" in hands["right"]["performer"] and "task-parts-" in hands["left"]["performer"]
+    one_hand = midi_file(tmp_path / "one.mid", [("Right Hand", RIGHT)])
+    refused = run("play", one_hand, "-o", tmp_path / "x.mid", "--policy", f"left={melody}")
     assert_one_line_error(refused, "plays one hand")
-    refused = run("play", song, "-o", tmp_path / "x.mid", "--controller", "scripted", "--left-policy", melody)
+    refused = run("play", song, "-o", tmp_path / "x.mid", "--controller", "scripted", "--policy", str(melody))
     assert_one_line_error(refused, "--controller scripted")
-    refused = run("play", song, "-o", tmp_path / "x.mid", "--left-policy", models)  # a folder without a policy
-    assert_one_line_error(refused, "--left-policy", "not a trained policy folder")
+    refused = run("play", song, "-o", tmp_path / "x.mid", "--policy", f"left={models}")  # a folder without a policy
+    assert_one_line_error(refused, "--policy", "not a trained policy folder")
+    refused = run("play", song, "-o", tmp_path / "x.mid", "--policy", f"middle={melody}")
+    assert_one_line_error(refused, "--policy", "right=DIR,left=DIR")
+    refused = run("play", song, "-o", tmp_path / "x.mid", "--policy", f"left={melody},left={melody}")
+    assert_one_line_error(refused, "--policy", "once")
 
 
 def test_the_parts_policy_plays_through_the_hold_guard_unless_told(tmp_path):
     """By default the packaged parts policy (a `--task parts` one) plays through the hold guard, a
-    melody policy named for the left hand alone; --hold-guard guards both, --no-hold-guard neither.
+    melody policy named for the left hand alone; --guard hold guards both, --guard none neither.
     The left hand holds C3 and G3 for two beats each: the guard's teacher held them."""
     from pianobot.agent.general import PACKAGED
 
     song = _duet(tmp_path / "duet.mid")
     (tmp_path / "empty").mkdir()  # an empty model store
-    melody = ("--left-policy", next(PACKAGED.glob("task-melody-*")))
+    melody = ("--policy", f"left={next(PACKAGED.glob('task-melody-*'))}")
     expected = {
         (): (True, True),
         melody: (True, False),
-        (*melody, "--hold-guard"): (True, True),
-        ("--no-hold-guard",): (False, False),
+        (*melody, "--guard", "hold"): (True, True),
+        ("--guard", "none"): (False, False),
     }
     for flags, (right, left) in expected.items():
         result = run("play", song, "-o", tmp_path / "out.mid", "--models", tmp_path / "empty", *flags)
         assert result.exit_code == 0, result.output
         hands = json.loads((tmp_path / "out.report.json").read_text())["hands"]
         assert hands["right"]["performer"].startswith("general policy task-parts")
-        family = "task-melody" if melody[0] in flags else "task-parts"
+        family = "task-melody" if melody[1] in flags else "task-parts"
         assert hands["left"]["performer"].startswith(f"general policy {family}")
         assert [hands[h]["hold_guard"]["on"] for h in ("right", "left")] == [right, left]
         assert [hands[h]["performer"].endswith("through the hold guard") for h in ("right", "left")] == [right, left]

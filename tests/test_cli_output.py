@@ -35,6 +35,16 @@ def test_help_is_whole_at_80_columns(command):
             assert " ".join(param.help.split()) in words.replace("- ", "-"), param.help
 
 
+def test_play_help_fits_on_one_screen():
+    """`play --help` fits a terminal of 62 rows at 80 columns: who plays is one --policy and how
+    the scripted pianist helps one --guard, not six options explained by each other's special cases."""
+    lines = CliRunner().invoke(app, ["play", "--help"], env={"COLUMNS": "80"}).output.splitlines()
+    assert len(lines) <= 62, "\n".join(lines)
+    options = " ".join(lines)
+    assert "--policy" in options and "--guard <auto|hold|wrist|both|none>" in options
+    assert not any(old in options for old in ("--general-policy", "--left-policy", "--fallback", "-guard /"))
+
+
 def test_boolean_options_are_shown_and_parsed_as_flags(tmp_path):
     help_text = CliRunner().invoke(app, ["play", "--help"], env={"COLUMNS": "80"}).output
     assert "<bool>" not in help_text

@@ -3,6 +3,7 @@ their own, and `train` starts every phrase from it (fine-tuning). A tiny policy 
 `melody` family stands in for the real one, which a long run trains."""
 
 import csv
+import inspect
 import json
 import shutil
 from dataclasses import replace
@@ -198,17 +199,16 @@ def test_play_uses_a_phrases_own_policy_then_the_general_policy_and_says_so(tmp_
 
     # own policy > general policy > scripted fallback: without the general policy, as before
     assert_one_line_error(
-        run(*args, "--no-general"), "phrase 1 (G4)", "--fallback scripted", "pianobot train --task parts"
+        run(*args, "--policy", "none"), "phrase 1 (G4)", "--policy scripted", "pianobot train --task parts"
     )
-    fallback = run(*args, "--no-general", "--fallback", "scripted")
+    fallback = run(*args, "--policy", "scripted")
     assert fallback.exit_code == 0, fallback.output
     report = json.loads((tmp_path / "out.report.json").read_text())
     assert report["phrases"]["1"] == "scripted pianist" and "general_policy" not in report
-    assert_one_line_error(run(*args, "--no-general", "--general-policy", general), "--general-policy", "--no-general")
 
     # a general policy trained in another environment than the phrase policies is refused
-    other = run(*args, "--general-policy", ONE_NOTE_POLICY)
-    assert_one_line_error(other, f"the general policy {ONE_NOTE_POLICY} was trained with env.", "--no-general")
+    other = run(*args, "--policy", ONE_NOTE_POLICY)
+    assert_one_line_error(other, f"the general policy {ONE_NOTE_POLICY} was trained with env.", "--policy scripted")
 
 
 def test_train_a_two_hand_file_trains_each_hands_part_and_play_plays_what_was_judged(tmp_path, models):
@@ -307,20 +307,21 @@ def test_the_general_policy_plays_its_consecutive_phrases_as_one_section(tmp_pat
 
     song = write_midi(piece, tmp_path / "song.mid")
     args = ("play", song, "-o", tmp_path / "out.mid", "--models", models, "--phrase-notes", "1")
-    for wrist, hold in (("--wrist-guard", "--no-hold-guard"), ("--no-wrist-guard", "--hold-guard")):
-        result = run(*args, wrist, hold)
+    for guards in ("wrist", "hold"):
+        wrist, hold = guards == "wrist", guards == "hold"
+        result = run(*args, "--guard", guards)
         assert result.exit_code == 0, result.output
         report = json.loads((tmp_path / "out.report.json").read_text())
         assert [report["phrases"][k].split()[0] for k in "01234"] == ["general"] * 2 + ["own"] + ["general"] * 2
         guard = report["wrist_guard"]
-        assert guard == {"on": False, "slowed_steps": 0} if wrist == "--no-wrist-guard" else guard["on"] is True
+        assert guard == {"on": False, "slowed_steps": 0} if not wrist else guard["on"] is True
         held = report["hold_guard"]
         assert (
             held == {"on": False, "held_finger_steps": 0, "wrist_steps": 0}
-            if hold == "--no-hold-guard"
+            if not hold
             else held["on"] is True
         )
-        if hold == "--hold-guard":  # C4 and G4 are held for a second and more: the guard held them
+        if hold:  # C4 and G4 are held for a second and more: the guard held them
             assert held["held_finger_steps"] > 20
 
 
@@ -335,10 +336,15 @@ def test_the_options_default_to_the_training_configuration_and_say_what_they_do(
     assert train["until_f1"].default is TrainConfig.until_f1 is None and TrainConfig.finetune_until_f1 == 1.0
     assert "evaluate it before any training step" in train["from_general"].help
     play = {p.name: p.default for p in commands["play"].params}
-    assert play["use_general"] is True and play["general_policy"] is None and play["wrist_guard"] is False
-    from pianobot.perform.plan import PerformancePlan
+    from pianobot.cli.commands.play import GUARDS, _players
+    from pianobot.perform.plan import PerformancePlan, plan_performance
 
-    assert play["hold_guard"] is PerformancePlan.hold_guard is None
+    defaults = inspect.signature(plan_performance).parameters
+    assert play["policy"] == "general" and play["guard"] == "auto"
+    assert _players("general", EXAMPLES / "mary.mid", False, "sac") == {
+        name: defaults[name].default for name in ("general", "general_policy", "fallback")
+    }
+    assert GUARDS["auto"] == (PerformancePlan.wrist_guard, PerformancePlan.hold_guard) == (False, None)
 
 
 def test_a_phrase_trained_from_the_general_policy_takes_its_actor(tmp_path):

@@ -136,7 +136,7 @@ def test_the_library_names_settings_and_the_command_line_their_options(tmp_path)
     with pytest.raises(SettingError) as refused:
         plan_performance(piece, models=tmp_path, general=False)
     assert refused.value.field == "store.models" and "play.fallback scripted" in str(refused.value)
-    assert "--models DIR" in phrase(refused.value) and "--fallback scripted" in phrase(refused.value)
+    assert "--models DIR" in phrase(refused.value) and "--policy scripted" in phrase(refused.value)
     (tmp_path / "bad").mkdir()
     (tmp_path / "bad" / store.MANIFEST_FILE).write_text("{")
     with pytest.raises(SettingError) as unreadable:
@@ -147,10 +147,10 @@ def test_the_library_names_settings_and_the_command_line_their_options(tmp_path)
 
 
 def test_a_phrase_nobody_plays_with_the_general_policy_left_out_says_so(tmp_path):
-    """--no-general's refusal read as if no general policy had been found."""
+    """--policy none's refusal not read as if no general policy had been found."""
     piece = pianobot.load_piece(EXAMPLES / "mary.mid")
     with pytest.raises(PianobotError, match=r"the general policy is left out \(play.general\)") as e:
         plan_performance(piece, models=tmp_path, general=False)
     assert "no general policy plays it" not in str(e.value)
-    result = run("play", EXAMPLES / "mary.mid", "-o", tmp_path / "out.mid", "--no-general", "--models", tmp_path)
-    assert "left out (--no-general)" in " ".join(result.stderr.split())
+    result = run("play", EXAMPLES / "mary.mid", "-o", tmp_path / "out.mid", "--policy", "none", "--models", tmp_path)
+    assert "left out (--policy none)" in " ".join(result.stderr.split())

@@ -60,6 +60,10 @@ class OneLineUsageGroup(TyperGroup):
             return super().invoke(ctx)
 
 
+COLUMN = 24
+"""Widest option name beside its help in ``--help`` (a longer one puts its help on the next line)."""
+
+
 class PanelledCommand(TyperCommand):
     """A command whose ``--help`` is click's plain text, wrapped to the terminal (at most 80
     columns), each option with its full names (a flag as ``--thumb / --no-thumb``, no value), and
@@ -74,7 +78,7 @@ class PanelledCommand(TyperCommand):
                 sections.setdefault(title, []).append(record)
         for title, records in sections.items():
             with formatter.section(title):
-                formatter.write_dl(records)
+                formatter.write_dl(records, col_max=COLUMN)
 
 
 app = typer.Typer(

@@ -78,15 +78,16 @@ GeneralPolicy = typer.Option(
 PlayPhraseNotes = typer.Option(
     None,
     "--phrase-notes",
-    help=f"Most notes in one phrase (default: the longest, up to {DEFAULT_MAX_NOTES}, whose policies are trained).",
+    help=f"Most notes in a phrase (default: the longest, up to {DEFAULT_MAX_NOTES}, with trained policies).",
     min=1,
+    metavar="N",
 )
 HtmlReport = typer.Option(
     None,
     "--html",
-    help="Also write a report to open in a browser, offline.",
+    help="Also write a report for a browser (offline).",
 )
-AllFigures = typer.Option(False, "--all", help="Print every figure (by default the few to read first).")
+AllFigures = typer.Option(False, "--all", help="Print every figure, not the few to read first.")
 AllRows = typer.Option(False, "--all", help="List every note and phrase (by default the tables stop after 100 rows).")
 
 # -- reading a piece, once for every command that reads one ---------------------------------------
@@ -101,19 +102,19 @@ def _reading(kind, default, flag: str, text: str, panel: str = PIECE) -> tuple:
 
 # fmt: off
 READING = {  # parameter name: (type, option); the commands' --help shows them in two panels of their own
-    "track": _reading(Optional[str], None, "--track", "Read only these tracks (indices or names, e.g. 2,3; default: all)."),
-    "tempo": _reading(Optional[float], None, "--tempo", "Re-time the piece at this tempo (bpm)."),
-    "transpose": _reading(int, LoadOptions.transpose, "--transpose", "Shift every note by this many semitones."),
-    "fingering": _reading(Optional[Path], None, "--fingering", "A PIG fingering file (default: <song>_fingering.txt, if any)."),
+    "track": _reading(Optional[str], None, "--track", "Only these tracks (indices or names: 2,3)."),
+    "tempo": _reading(Optional[float], None, "--tempo", "Play at this tempo (bpm)."),
+    "transpose": _reading(int, LoadOptions.transpose, "--transpose", "Shift every note by N semitones."),
+    "fingering": _reading(Optional[Path], None, "--fingering", "A PIG fingering file (default: <song>_fingering.txt)."),
     "hand_part": _reading(Optional[HandPart], None, "--hand", "Only this hand's part of a two-hand piece."),
-    "split": _reading(str, pitch_name(LoadOptions.split), "--split", "Lowest note of the right hand's part, where no track names it."),
-    "quantize": _reading(Optional[str], None, "--quantize", "Move notes to a grid, e.g. 1/16 (for recordings)."),
-    "refinger": _reading(bool, LoadOptions.refinger, "--refinger/--no-refinger", "Replace the file's fingering with the planner's."),
-    "pedal": _reading(bool, LoadOptions.pedal, "--pedal/--no-pedal", "Play and score the file's sustain pedal (CC64 at 64 or more is down)."),
-    "lowest_note": _reading(Optional[str], None, "--lowest-note", f"Lowest key (C4, or a MIDI number; default {pitch_name(KeyboardSpec.lowest)} or the piece's own octaves).", INSTRUMENT),
-    "keys": _reading(Optional[int], None, "--keys", f"Number of keys (default {KeyboardSpec.count} or the piece's own octaves).", INSTRUMENT),
-    "hand_model": _reading(HandModelName, HandSpec.model, "--hand-model", "The hand: allegro (the paper's Allegro-like hand) or pianist (five fingers of human size).", INSTRUMENT),
-    "thumb": _reading(Optional[bool], None, "--thumb/--no-thumb", "The Allegro-like hand with its thumb too (default: where it keeps more notes).", INSTRUMENT),
+    "split": _reading(str, pitch_name(LoadOptions.split), "--split", "Lowest note of the right hand, where no track says."),
+    "quantize": _reading(Optional[str], None, "--quantize", "Move notes to a grid, e.g. 1/16 (recordings)."),
+    "refinger": _reading(bool, LoadOptions.refinger, "--refinger/--no-refinger", "Plan fingers even where the file has them."),
+    "pedal": _reading(bool, LoadOptions.pedal, "--pedal/--no-pedal", "Play and score the file's sustain pedal (CC64)."),
+    "lowest_note": _reading(Optional[str], None, "--lowest-note", f"Lowest key (default {pitch_name(KeyboardSpec.lowest)} or the piece's octaves).", INSTRUMENT),
+    "keys": _reading(Optional[int], None, "--keys", f"Number of keys (default {KeyboardSpec.count} or the piece's).", INSTRUMENT),
+    "hand_model": _reading(HandModelName, HandSpec.model, "--hand-model", "allegro (the paper's) or pianist (five fingers).", INSTRUMENT),
+    "thumb": _reading(Optional[bool], None, "--thumb/--no-thumb", "The Allegro hand's thumb (default: if more notes).", INSTRUMENT),
 }
 # fmt: on
 

@@ -246,7 +246,7 @@ def assign(
                 f"phrase {phrase.index} ({notes}) has no policy of its own in the model store {where} "
                 f"{general_said}: "
                 "train it with `pianobot train` (same reading options), train a general policy with "
-                "`pianobot train --task parts`, name another store with store.models DIR, add play.fallback scripted, "
+                "`pianobot train --task parts`, name another store with store.models DIR, play with play.fallback scripted, "
                 "or play with play.controller scripted",
                 "store.models",
             )
@@ -293,7 +293,7 @@ def _general_for(
             env,
             path=path,
             ours="the phrase policies of this piece",
-            remedy="play with --no-general (and --fallback scripted), or train the general policy or the phrases "
+            remedy="play with play.fallback scripted, or train the general policy or the phrases "
             "with the same options",
         )
     candidates = [Path(path)] if path is not None else general_candidates(models)
@@ -348,7 +348,10 @@ def plan_performance(
     if controller not in CONTROLLERS:
         raise SettingError(f"play.controller {controller!r}: choose one of {', '.join(CONTROLLERS)}", "play.controller")
     if general_policy is not None and not general:
-        raise PianobotError(f"--general-policy {general_policy} and --no-general ask for opposite things: give one")
+        raise SettingError(
+            f"general.path {general_policy} names a general policy and play.general leaves it out: give one",
+            "general.path",
+        )
     keyboard, hand = keyboard or KeyboardSpec(), hand or HandSpec()
     models = Path(models) if models is not None else DEFAULT_MODELS
     world = WorldConfig(keyboard=KeyboardConfig(spec=keyboard), hand=hand_config(hand), gui=gui)

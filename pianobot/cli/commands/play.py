@@ -14,12 +14,11 @@ from pianobot.cli.options import (
     DEFAULT_STORE,
     AllFigures,
     Controller,
-    Fallback,
-    GeneralPolicy,
     HtmlReport,
     PlayPhraseNotes,
     Reading,
     check_files,
+    choices,
     check_html,
     check_midi_output,
     check_models,
@@ -46,59 +45,54 @@ def progress(what: str):
         yield lambda done, total: bar.update(task, completed=done, total=total)
 
 
+GUARDS = {"auto": (False, None), "hold": (False, True), "wrist": (True, False), "both": (True, True)}
+GUARDS |= {"none": (False, False)}
+"""--guard -> (wrist_guard, hold_guard) of :class:`~pianobot.perform.plan.PerformancePlan`; 'auto'
+is the plan's defaults (a test holds them equal: the plan module is slow to import)."""
+Guard = choices("Guard", tuple(GUARDS))
+NAMED = ("general", "scripted", "none")
+"""The --policy values that name no folder."""
+
 SONG_OPTION = typer.Argument(
     ...,
-    help="The piece: a .mid file, a MusicXML score (.musicxml, .xml, .mxl) or a PIG .txt file (unfingered notes are fingered by the planner).",
+    help="A .mid file, a MusicXML score (.musicxml, .xml, .mxl) or a PIG .txt file.",
 )
 OUTPUT_OPTION = typer.Option(..., "--output", "-o", help="The .mid file of what was played.")
 CONTROLLER_OPTION = typer.Option(
     CONTROLLERS[0],
     "--controller",
-    help="Who plays: 'sac' (the trained policies), 'scripted' (the hand-written pianist) or 'random'.",
+    help="sac (trained policies), scripted (the hand-written pianist) or random.",
 )
-FALLBACK_OPTION = typer.Option(
-    None,
-    "--fallback",
-    help="Who plays a phrase no policy plays.",
+POLICY_OPTION = typer.Option(
+    "general",
+    "--policy",
+    help="Who plays phrases with no policy of their own: general, a general policy's folder "
+    "(or right=DIR,left=DIR), scripted or none (docs/play.md).",
 )
-USE_GENERAL_OPTION = typer.Option(
-    True,
-    "--general/--no-general",
-    help="Let the general policy play phrases without a policy of their own.",
-)
-LEFT_POLICY_OPTION = typer.Option(
-    None,
-    "--left-policy",
-    help="The left hand's general policy (default: the right hand's).",
-)
-WRIST_GUARD_OPTION = typer.Option(
-    False,
-    "--wrist-guard/--no-wrist-guard",
-    help="Slow the general policy's wrist while a fingertip is low (docs/play.md).",
-)
-HOLD_GUARD_OPTION = typer.Option(
-    None,  # PerformancePlan.hold_guard (a test holds them equal; the plan module is slow to import)
-    "--hold-guard/--no-hold-guard",
-    help="The scripted pianist holds written notes for the general policy (default: for `--task parts` policies; docs/play.md).",
+GUARD_OPTION = typer.Option(
+    "auto",
+    "--guard",
+    help="The scripted pianist's help to the general policy (docs/play.md).",
 )
 SEED_OPTION = typer.Option(
     0,
     "--seed",
-    help="Seed of the hand's start position (and of 'random').",
+    help="Seed of the hand's start (and of random).",
     min=0,
+    metavar="N",
 )
 SOUNDFONT_OPTION = typer.Option(
     None,
     "--soundfont",
-    help="A .sf2 soundfont for the sound (default: an installed one, else sine waves).",
+    help="A .sf2 soundfont (default: one installed).",
 )
 JSON_PATH_OPTION = typer.Option(
     None,
     "--json",
-    help="Also write the report to this JSON file ('-': standard output).",
+    help="Also write the report as JSON ('-': stdout).",
 )
-NOTES_OPTION = typer.Option(0, "--notes", min=0, help="Print the first N rows of the per-note table.")
-QUIET_OPTION = typer.Option(False, "--quiet", "-q", help="Print only where the files went, warnings and errors.")
+NOTES_OPTION = typer.Option(0, "--notes", min=0, metavar="N", help="Print N rows of the per-note table.")
+QUIET_OPTION = typer.Option(False, "--quiet", "-q", help="Print only the files written, warnings and errors.")
 
 
 @reads()
@@ -107,12 +101,8 @@ def play(
     output: Path = OUTPUT_OPTION,
     controller: Controller = CONTROLLER_OPTION,
     models: Path = typer.Option(DEFAULT_STORE, "--models", help="The model store's folder."),
-    fallback: Optional[Fallback] = FALLBACK_OPTION,
-    use_general: bool = USE_GENERAL_OPTION,
-    general_policy: Optional[Path] = GeneralPolicy,
-    left_policy: Optional[Path] = LEFT_POLICY_OPTION,
-    wrist_guard: bool = WRIST_GUARD_OPTION,
-    hold_guard: Optional[bool] = HOLD_GUARD_OPTION,
+    policy: str = POLICY_OPTION,
+    guard: Guard = GUARD_OPTION,
     phrase_notes: Optional[int] = PlayPhraseNotes,
     seed: int = SEED_OPTION,
     video: Optional[Path] = typer.Option(None, "--video", help="Also record a video (.mp4)."),
@@ -126,16 +116,17 @@ def play(
     quiet: bool = QUIET_OPTION,
     reading: Reading = None,
 ):
-    """Perform a piece (both hands of a two-hand file) in the simulator; write the played notes (velocities, fingers, hands) and a report."""
+    """Perform a piece in the simulator (both hands of a two-hand one); write what was played."""
     files = dict(report=output.with_suffix(".report.json"), json=json_path, wav=wav, soundfont=soundfont, html=html)
     files |= dict(video=video)
     shown = dict(notes=notes, every=every, quiet=quiet)
     report_path, shown["console"] = _check_files(
         song, output, reading, controller, models, json_path, html, wav, video, soundfont, gui
     )
-    read = read_file(song, reading, finger=False)  # (one hand's part fingered once --left-policy is checked)
+    read = read_file(song, reading, finger=False)
     hands = read.hands
-    _check_left_policy(left_policy, song, hands, controller, use_general, models)
+    players = _players(policy, song, hands is not None, controller)
+    wrist_guard, hold_guard = GUARDS[guard.value]
     if hands is not None:  # a two-hand file: both hands, in one simulation
         if gui:
             raise PianobotError(
@@ -152,11 +143,7 @@ def play(
             keyboard=reading.keyboard if reading.keyboard_named else None,  # (none named: each player's own keys)
             hand=read.fingers,
             options=dict(
-                general=use_general,
-                general_policy=general_policy
-                if left_policy is None
-                else {"right": general_policy, "left": left_policy},
-                fallback=fallback is not None,
+                **players,
                 phrase_notes=phrase_notes,
                 wrist_guard=wrist_guard,
                 hold_guard=hold_guard,
@@ -166,8 +153,7 @@ def play(
             shown=shown,
         )
         return
-    options = dict(general=use_general, general_policy=general_policy, fallback=fallback is not None)
-    options |= dict(phrase_notes=phrase_notes, wrist_guard=wrist_guard, hold_guard=hold_guard, gui=gui)
+    options = dict(**players, phrase_notes=phrase_notes, wrist_guard=wrist_guard, hold_guard=hold_guard, gui=gui)
     options |= dict(pedal=read.pedal)
     play_one(song, output, finger_file(read, reading), controller, models, seed, options, files, shown)
 
@@ -213,30 +199,36 @@ def _check_files(song, output, reading, controller, models, json_path, html, wav
     return report_path, console
 
 
-def _check_left_policy(left_policy, song, hands, controller, use_general, models) -> None:
-    """--left-policy only where a general policy plays a two-hand file's left hand, and only a trained policy."""
+def _players(policy: str, song: Path, two_hands: bool, controller) -> dict:
+    """--policy as the plan's options: whether the general policy plays (``general``), which one
+    (``general_policy``: a folder, or each hand's), and whether the scripted pianist plays what
+    no policy plays (``fallback``). Each folder named must hold a trained policy."""
     from pianobot.agent import store
 
-    if left_policy is None:
-        return
-    why = (
-        "plays one hand"
-        if hands is None
-        else f"is played by --controller {controller.value}"
-        if controller != "sac"
-        else "is played with --no-general"
-        if not use_general
-        else None
-    )
-    if why is not None:
+    if policy != "general" and controller != "sac":
         raise PianobotError(
-            f"--left-policy {left_policy}: {song.name} {why}, so no general policy plays a left hand; drop --left-policy"
+            f"--policy {policy}: --controller {controller.value} plays every phrase itself: drop --policy"
         )
-    if not store.is_trained(left_policy):
+    if policy in NAMED:
+        return dict(general=policy == "general", general_policy=None, fallback=policy == "scripted")
+    by_hand = "=" in policy and not Path(policy).is_dir()
+    folders = dict(part.split("=", 1) for part in policy.split(",")) if by_hand else {"": policy}
+    if by_hand and (set(folders) - {"right", "left"} or len(folders) != policy.count("=")):
         raise PianobotError(
-            f"--left-policy {left_policy}: not a trained policy folder (one holding {store.POLICY_FILE} and "
-            f"{store.MANIFEST_FILE}, e.g. a `pianobot train --task parts` folder in {models})"
+            f"--policy {policy}: name each hand's general policy once, as right=DIR,left=DIR (or one of them)"
         )
+    if by_hand and not two_hands:
+        raise PianobotError(
+            f"--policy {policy}: {song.name} plays one hand: name the general policy's folder alone"
+        )
+    for folder in folders.values():
+        if not store.is_trained(Path(folder)):
+            raise PianobotError(
+                f"--policy {policy}: {folder} is not a trained policy folder (one holding {store.POLICY_FILE} and "
+                f"{store.MANIFEST_FILE}, e.g. one `pianobot train --task parts` wrote), nor one of {', '.join(NAMED)}"
+            )
+    named = {hand: Path(folder) for hand, folder in folders.items()}
+    return dict(general=True, general_policy=named if by_hand else named[""], fallback=False)
 
 
 def play_one(
