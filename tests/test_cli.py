@@ -337,7 +337,9 @@ def test_train_a_task_family_evaluates_on_many_instances(tmp_path):
 def test_play_sac_without_policies_names_the_phrase_and_the_train_command(tmp_path):
     """The trained policies play by default: without them (and without the general policy), one
     line says where it looked and how to get them or what else to do."""
-    result = run("play", EXAMPLES / "three-note.mid", "-o", tmp_path / "x.mid", "--models", tmp_path, "--policy", "none")
+    result = run(
+        "play", EXAMPLES / "three-note.mid", "-o", tmp_path / "x.mid", "--models", tmp_path, "--policy", "none"
+    )
     assert_one_line_error(
         result,
         "phrase 0 (C4 D4 E4)",

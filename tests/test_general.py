@@ -316,11 +316,7 @@ def test_the_general_policy_plays_its_consecutive_phrases_as_one_section(tmp_pat
         guard = report["wrist_guard"]
         assert guard == {"on": False, "slowed_steps": 0} if not wrist else guard["on"] is True
         held = report["hold_guard"]
-        assert (
-            held == {"on": False, "held_finger_steps": 0, "wrist_steps": 0}
-            if not hold
-            else held["on"] is True
-        )
+        assert held == {"on": False, "held_finger_steps": 0, "wrist_steps": 0} if not hold else held["on"] is True
         if hold:  # C4 and G4 are held for a second and more: the guard held them
             assert held["held_finger_steps"] > 20
 

@@ -293,8 +293,7 @@ def _general_for(
             env,
             path=path,
             ours="the phrase policies of this piece",
-            remedy="play with play.fallback scripted, or train the general policy or the phrases "
-            "with the same options",
+            remedy="play with play.fallback scripted, or train the general policy or the phrases with the same options",
         )
     candidates = [Path(path)] if path is not None else general_candidates(models)
     if path is not None:

@@ -18,10 +18,10 @@ from pianobot.cli.options import (
     PlayPhraseNotes,
     Reading,
     check_files,
-    choices,
     check_html,
     check_midi_output,
     check_models,
+    choices,
     finger_file,
     read_file,
     reads,
@@ -218,9 +218,7 @@ def _players(policy: str, song: Path, two_hands: bool, controller) -> dict:
             f"--policy {policy}: name each hand's general policy once, as right=DIR,left=DIR (or one of them)"
         )
     if by_hand and not two_hands:
-        raise PianobotError(
-            f"--policy {policy}: {song.name} plays one hand: name the general policy's folder alone"
-        )
+        raise PianobotError(f"--policy {policy}: {song.name} plays one hand: name the general policy's folder alone")
     for folder in folders.values():
         if not store.is_trained(Path(folder)):
             raise PianobotError(
