@@ -53,7 +53,10 @@ def test_its_world_builds_five_fingers_and_its_mirror_image_for_the_left_hand():
 
 
 def test_the_planner_passes_the_thumb_under_in_a_scale_where_the_allegro_hand_cannot():
-    fingers = [n.finger for n in plan_fingering(_scale(), KeyboardConfig(), hand_config(FIVE)).piece.notes]
+    """A quick scale (0.15 s a note: no time to shift the whole hand between two notes) is fingered
+    with the thumb under. (At 0.2 s a note and slower the planner shifts the hand after the fifth
+    finger instead: its stretch cost prefers a straight thumb to one turned under the palm.)"""
+    fingers = [n.finger for n in plan_fingering(_scale(0.15), KeyboardConfig(), hand_config(FIVE)).piece.notes]
     assert fingers[:8] == [1, 2, 3, 1, 2, 3, 4, 5]  # the thumb under after E, as pianists finger it
     assert fingers[8:] == [4, 3, 2, 1, 3, 2, 1]  # and the third finger over it on the way down
     planner = Planner(KeyboardConfig(), hand_config(FIVE))
@@ -67,7 +70,8 @@ def test_a_model_refuses_passes_between_fingers_it_lacks():
 
 
 def test_the_scripted_pianist_plays_the_scale_with_the_thumb_under():
-    piece = plan_fingering(_scale(), KeyboardConfig(), hand_config(FIVE)).piece
+    piece = plan_fingering(_scale(0.15), KeyboardConfig(), hand_config(FIVE)).piece
+    assert [n.finger for n in piece.notes][:4] == [1, 2, 3, 1]
     performance = perform_plan(plan_performance(piece, "scripted", hand=FIVE))
     report = performance.report()
     assert report.f1 == 1.0 and report.fingering_accuracy == 1.0
@@ -188,3 +192,17 @@ def test_both_hands_play_the_file_s_own_marks_on_the_pianist_s_hand():
     assert report.f1 == 1.0 and report.fingering_accuracy == 1.0  # over the marked notes
     parts = {h.hand: [n.finger for n in h.part.notes] for h in played.hands}
     assert parts["right"][:4] == [1, 2, 3, 1] and parts["left"][:3] == [5, 3, 1]
+
+
+def test_the_pianist_s_planner_leaves_one_control_step_around_a_wrist_move_and_the_allegro_s_four():
+    """A C major scale in semiquavers at 120 bpm (0.125 s a note) needs its wrist moves between two
+    notes: the pianist's planner fingers it whole, where with the Allegro-like hand's 0.2 s of
+    settling every move would be too fast (and the reduction would drop notes)."""
+    from pianobot.pianist.tuning import PianistTuning
+
+    assert tuning_for(hand_config(FIVE)).settle_time == 0.05 and tuning_for(HandConfig()).settle_time == 0.2
+    assert PianistTuning().settle_time == 0.2
+    quick = Planner(KeyboardConfig(), hand_config(FIVE)).plan(_scale(0.125))
+    assert quick.problems == () and quick.moves >= 2
+    slow = replace(tuning_for(hand_config(FIVE)), settle_time=0.2)
+    assert Planner(KeyboardConfig(), hand_config(FIVE), slow).plan(_scale(0.125)).problems

@@ -53,8 +53,9 @@ from pianobot.music import window as windows
 from pianobot.music.instrument import HandSpec, KeyboardSpec, keyboard_for
 from pianobot.music.load import CHORD_SPREAD, LEGATO_OVERLAP, LoadOptions, load_hands, thin_hand
 from pianobot.music.piece import Note, Piece, mirror_pitch
-from pianobot.pianist.fingering import SETTLE_TIME, FingeringPlan, Planner, ensure_fingering
+from pianobot.pianist.fingering import FingeringPlan, Planner, ensure_fingering
 from pianobot.pianist.reduce import reduce_part
+from pianobot.pianist.tuning import tuning_for
 from pianobot.sim.hand import hand_config, hand_model, thumb_side_reach
 from pianobot.sim.keyboard import KeyboardConfig, key_boxes
 
@@ -392,8 +393,8 @@ def finger_apart(
     planner's ``room``, :meth:`~pianobot.pianist.fingering.Planner.plan`); the hands in ``fixed``
     keep their fingering (their plan: None). A hand stands where its fingers put the scripted
     pianist's wrist (straight over their keys, on average; the pianist may stand elsewhere where
-    held keys or the keyboard's end keep it) from :data:`~pianobot.pianist.fingering.SETTLE_TIME`
-    before each chord until the next, or, idle (:data:`IDLE`), until :data:`LINGER` after its
+    held keys or the keyboard's end keep it) from its planner's settle time
+    (:attr:`~pianobot.pianist.tuning.PianistTuning.settle_time`) before each chord until the next, or, idle (:data:`IDLE`), until :data:`LINGER` after its
     notes end. Where no fingering keeps clear, the least crowding one is taken (the world then
     pushes the hands apart as they play)."""
     if set(parts) != {"right", "left"}:
@@ -455,11 +456,12 @@ def stands(window: windows.Window, part: Piece, spec: HandSpec = HandSpec()) -> 
     chords = part.chords()
     sign = -1.0 if window.hand == "left" else 1.0  # (the left hand's finger bases lie mirrored)
     model = hand_model(spec.model)
+    settle = tuning_for(hand_config(spec)).settle_time
     stands = []
     for i, chord in enumerate(chords):
         wrist = float(np.mean([_world_x(window.outward(n.pitch)) - sign * model.base_x(n.finger) for n in chord]))
         ends = max(n.offset for n in chord)
         following = chords[i + 1][0].onset if i + 1 < len(chords) else ends
         end = following if following - ends < IDLE else ends + LINGER
-        stands.append((chord[0].onset - SETTLE_TIME, max(end, chord[0].onset), wrist))
+        stands.append((chord[0].onset - settle, max(end, chord[0].onset), wrist))
     return stands

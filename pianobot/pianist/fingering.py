@@ -76,8 +76,6 @@ PASS_COST = 0.5
 """Cost of one finger passing another (the thumb under, a finger over it) where the hand lets them."""
 TIP_GAP = 0.015
 """Least sideways distance (m) between two fingertips, in the hand's frame."""
-SETTLE_TIME = 0.2
-"""Seconds a finger needs to lift and settle around a wrist move (the scripted pianist's 4 steps)."""
 ROOM_COST = 5.0
 """Cost of each white key the wrist stands outside its room (:meth:`Planner.plan`'s ``room``: where
 the other hand leaves this one space)."""
@@ -277,14 +275,15 @@ class Planner:
 
     def _wrist_too_fast(self, move: np.ndarray | float, time: float, chord: Sequence[Note]) -> np.ndarray:
         """Whether the wrist cannot move ``move`` (m) in the ``time`` s before ``chord``'s onset:
-        every move leaves :data:`SETTLE_TIME` for the fingers to lift and settle, and a leap (a
+        every move leaves the tuning's ``settle_time`` for the fingers to lift and settle, and a leap (a
         move longer than a finger reaches sideways, so the finger cannot aim at its key before
         the wrist gets there) also leaves the slowest strike of ``chord`` from its ready height:
         the pianist starts that strike only once its finger is over the key."""
         speed = self.hand.max_wrist_speed
         lead = max(self.strikes.ready(Run(self.spec.index(n.pitch), 0, 1, n.velocity))[1] for n in chord)
-        limit = speed * max(0.0, time - SETTLE_TIME)
-        leap_limit = speed * max(0.0, time - SETTLE_TIME - lead * self.strikes.dt)
+        settle = self.strikes.tuning.settle_time
+        limit = speed * max(0.0, time - settle)
+        leap_limit = speed * max(0.0, time - settle - lead * self.strikes.dt)
         move = np.asarray(move)
         farthest = max(r.max() for r in self.reach.values())
         return (move > limit + 1e-9) | ((move > farthest) & (move > leap_limit + 1e-9))

@@ -63,6 +63,10 @@ class PianistTuning:
     reach_fraction: float = 0.75
     """Share of what a finger's abduction limit reaches sideways that the fingering planner uses (the
     rest is margin for aim)."""
+    settle_time: float = 0.2
+    """Seconds the fingering planner leaves around every wrist move for the fingers to lift and
+    settle (the Allegro-like hand's: the scripted pianist's ``prepare_steps``); the reduction drops
+    what the wrist cannot reach in the time left."""
     legato_cost: float = 2.0
     """The fingering planner's cost of a note let go before its written end, per share of its written
     length lost (in white keys of wrist travel: a whole note lost costs as much as a move of this many)."""

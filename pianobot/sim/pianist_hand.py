@@ -32,6 +32,7 @@ PIANIST = HandModel(
         ("hold_slide", 0.004),
         ("max_strike_speed", 0.2),
         ("reach_fraction", 0.95),
+        ("settle_time", 0.05),
     ),
     passes=frozenset({(1, 2), (1, 3), (1, 4)}),
     written_fingering=True,
@@ -59,6 +60,8 @@ strike no faster than 0.2 m/s (``max_strike_speed``: about MIDI velocity 97 on a
 planner uses 95 % of each finger's sideways reach (``reach_fraction``; the Allegro-like hand's
 75 %): the scripted pianist strikes a key only once the fingertip is over it, and its fingers
 land there turned to their limit, so the wider margin only forbade spans the hand plays (a fifth
-with fingers 2 and 5)."""
+with fingers 2 and 5). Its planner leaves one control step (``settle_time`` 0.05 s; the
+Allegro-like hand's 0.2 s) around a wrist move for its light fingers to lift and settle, so the
+reduction gives the hands the quick hand shifts its scripted pianist plays."""
 
 register_hand_model(PIANIST)
