@@ -405,6 +405,10 @@ def test_both_hands_play_the_packaged_parts_policy_unless_policy_names_another(t
     assert_one_line_error(refused, "--policy", "right=DIR,left=DIR")
     refused = run("play", song, "-o", tmp_path / "x.mid", "--policy", f"left={melody},left={melody}")
     assert_one_line_error(refused, "--policy", "once")
+    refused = run(
+        "play", song, "-o", tmp_path / "x.mid", "--policy", f"right={melody},{melody}"
+    )  # a part without a hand
+    assert_one_line_error(refused, "--policy", "right=DIR,left=DIR")
 
 
 def test_the_parts_policy_plays_through_the_hold_guard_unless_told(tmp_path):

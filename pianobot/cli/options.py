@@ -48,7 +48,6 @@ def choices(name: str, values: tuple[str, ...]) -> type[StrEnum]:
 
 
 Controller = choices("Controller", CONTROLLERS)
-Fallback = choices("Fallback", ("scripted",))
 Learner = choices("Learner", LEARNERS)
 Cluster = choices("Cluster", ("local", "ray"))
 Task = choices("Task", FAMILIES)
@@ -103,7 +102,7 @@ def _reading(kind, default, flag: str, text: str, panel: str = PIECE) -> tuple:
 # fmt: off
 READING = {  # parameter name: (type, option); the commands' --help shows them in two panels of their own
     "track": _reading(Optional[str], None, "--track", "Only these tracks (indices or names: 2,3)."),
-    "tempo": _reading(Optional[float], None, "--tempo", "Play at this tempo (bpm)."),
+    "tempo": _reading(Optional[float], None, "--tempo", "Re-time the piece at this tempo (bpm)."),
     "transpose": _reading(int, LoadOptions.transpose, "--transpose", "Shift every note by N semitones."),
     "fingering": _reading(Optional[Path], None, "--fingering", "A PIG fingering file (default: <song>_fingering.txt)."),
     "hand_part": _reading(Optional[HandPart], None, "--hand", "Only this hand's part of a two-hand piece."),
@@ -111,7 +110,7 @@ READING = {  # parameter name: (type, option); the commands' --help shows them i
     "quantize": _reading(Optional[str], None, "--quantize", "Move notes to a grid, e.g. 1/16 (recordings)."),
     "refinger": _reading(bool, LoadOptions.refinger, "--refinger/--no-refinger", "Plan fingers even where the file has them."),
     "pedal": _reading(bool, LoadOptions.pedal, "--pedal/--no-pedal", "Play and score the file's sustain pedal (CC64)."),
-    "lowest_note": _reading(Optional[str], None, "--lowest-note", f"Lowest key (default {pitch_name(KeyboardSpec.lowest)} or the piece's octaves).", INSTRUMENT),
+    "lowest_note": _reading(Optional[str], None, "--lowest-note", f"Lowest key, e.g. C4 or 60 (default {pitch_name(KeyboardSpec.lowest)} or the piece's).", INSTRUMENT),
     "keys": _reading(Optional[int], None, "--keys", f"Number of keys (default {KeyboardSpec.count} or the piece's).", INSTRUMENT),
     "hand_model": _reading(HandModelName, HandSpec.model, "--hand-model", "allegro (the paper's) or pianist (five fingers).", INSTRUMENT),
     "thumb": _reading(Optional[bool], None, "--thumb/--no-thumb", "The Allegro hand's thumb (default: if more notes).", INSTRUMENT),

@@ -212,8 +212,11 @@ def _players(policy: str, song: Path, two_hands: bool, controller) -> dict:
     if policy in NAMED:
         return dict(general=policy == "general", general_policy=None, fallback=policy == "scripted")
     by_hand = "=" in policy and not Path(policy).is_dir()
-    folders = dict(part.split("=", 1) for part in policy.split(",")) if by_hand else {"": policy}
-    if by_hand and (set(folders) - {"right", "left"} or len(folders) != policy.count("=")):
+    parts = [part.partition("=") for part in policy.split(",")] if by_hand else [("", "=", policy)]
+    folders = {hand: folder for hand, _, folder in parts}
+    if by_hand and (
+        set(folders) - {"right", "left"} or len(folders) != len(parts) or not all(eq for _, eq, _ in parts)
+    ):
         raise PianobotError(
             f"--policy {policy}: name each hand's general policy once, as right=DIR,left=DIR (or one of them)"
         )
