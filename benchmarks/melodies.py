@@ -9,7 +9,8 @@ from hand start ``index`` and prints a Markdown table per key: mean and lowest n
 velocity MAE (MIDI units, matched notes), mean absolute onset error (ms), extra notes (played
 notes the score does not ask for), mean note F1 with offsets and per-step key-press F1, and the
 median played/written duration of notes written < 0.35 s, 0.35-0.7 s and longer (articulation,
-docs/metrics.md); then the totals and every melody short of the targets
+docs/metrics.md); then the totals, what ended the notes let go early (:func:`early_causes`: a
+repeated key, a move of the hand, or neither), and every melody short of the targets
 (note F1 >= 0.95, velocity MAE <= 5, no extra notes). ``--hand-model`` plays them with that hand
 and its fingers (default the Allegro-like hand's three).
 """
@@ -25,11 +26,12 @@ import numpy as np
 
 from pianobot.music.instrument import HandSpec, KeyboardSpec
 from pianobot.music.melodies import TONICS, describe, melody_set
-from pianobot.music.metrics import LENGTH_CLASSES, duration_ratios
+from pianobot.music.metrics import LENGTH_CLASSES, NoteRow, duration_ratios
 from pianobot.music.piece import Piece
 from pianobot.perform.perform import PLAY_CONFIG, perform
-from pianobot.pianist.fingering import ensure_fingering
+from pianobot.pianist.fingering import ensure_fingering, plan_fingering
 from pianobot.sim.hand import HAND_MODELS, default_fingers, hand_config
+from pianobot.sim.keyboard import KeyboardConfig
 
 F1_TARGET, VELOCITY_TARGET, MEAN_F1_TARGET = 0.95, 5.0, 0.98
 
@@ -38,6 +40,38 @@ def playable(piece: Piece, hand: HandSpec = HandSpec()) -> Piece | None:
     """The piece fingered by the planner, or None when the planner reports notes too fast for the hand."""
     fingered, plan = ensure_fingering(piece, KeyboardSpec(), hand)
     return None if plan is not None and plan.problems else fingered
+
+
+OFFSET_TOLERANCE, OFFSET_RATIO = 0.05, 0.2
+"""note F1 with offsets' tolerance (mir_eval's): an offset counts within the larger of 50 ms and
+20 % of the written duration."""
+EARLY_CAUSES = ("repeated key", "hand move", "other")
+
+
+def early_causes(piece: Piece, rows: tuple[NoteRow, ...], hand: HandSpec) -> dict[str, int]:
+    """How many matched notes of ``piece`` were let go early (before their written offset by more
+    than note F1 with offsets allows), by what comes next: the same key struck again (it must
+    rise first), the hand moving (the fingering planner's wrist moves between this note's onset
+    and the next: a held key lets go before the wrist slides), or neither."""
+    plan = plan_fingering(piece, KeyboardConfig(), hand_config(hand))
+    onsets = sorted({n.onset for n in plan.piece.notes})
+    wrist = dict(zip(onsets, plan.wrist))
+    counts = dict.fromkeys(EARLY_CAUSES, 0)
+    for row in rows:
+        note, played = row.reference, row.played
+        if note is None or played is None:
+            continue
+        if note.offset - played.offset <= max(OFFSET_TOLERANCE, OFFSET_RATIO * note.duration):
+            continue
+        later = [n for n in piece.notes if n.onset > note.onset]
+        following = min(later, key=lambda n: n.onset) if later else None
+        if following is not None and following.pitch == note.pitch:
+            counts["repeated key"] += 1
+        elif following is not None and abs(wrist[following.onset] - wrist[note.onset]) > 1e-9:
+            counts["hand move"] += 1
+        else:
+            counts["other"] += 1
+    return counts
 
 
 def play_set(per_key: int, hand: HandSpec = HandSpec()) -> tuple[list[dict], int]:
@@ -70,6 +104,8 @@ def play_set(per_key: int, hand: HandSpec = HandSpec()) -> tuple[list[dict], int
                 "extra": sum(r.reference is None for r in report.rows),
                 "missed": sum(r.played is None for r in report.rows),
                 "notes": len(melody.piece),
+                "matched": report.matched_notes,
+                "early": early_causes(melody.piece, report.rows, hand),
             }
         )
     return results, rejected
@@ -108,6 +144,14 @@ def table(results: list[dict], rejected: int) -> str:
     lines.append(row("**all**", results))
     lines.append("")
     lines.append(f"Melodies the planner said this hand cannot play at their tempo, drawn again: {rejected}.")
+    matched = sum(r["matched"] for r in results)
+    early = {cause: sum(r["early"][cause] for r in results) for cause in EARLY_CAUSES}
+    lines.append(
+        f"Notes let go early (before their written end by more than note F1 with offsets allows): "
+        f"{sum(early.values())} of {matched} matched ({sum(early.values()) / max(matched, 1):.1%}); before "
+        + ", ".join(f"{'another cause' if cause == 'other' else 'a ' + cause} {n}" for cause, n in early.items())
+        + "."
+    )
     return "\n".join(lines)
 
 

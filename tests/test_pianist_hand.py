@@ -15,7 +15,7 @@ from pianobot.music.instrument import HandSpec, KeyboardSpec
 from pianobot.music.piece import Note, Piece
 from pianobot.perform.plan import perform_plan, plan_performance
 from pianobot.pianist.fingering import Planner, plan_fingering
-from pianobot.pianist.tuning import tuning_for
+from pianobot.pianist.tuning import PianistTuning, tuning_for
 from pianobot.sim.hand import ALLEGRO, HandConfig, HandModel, default_fingers, hand_config, joint_limits
 from pianobot.sim.keyboard import KeyboardConfig
 from pianobot.sim.pianist_hand import PIANIST
@@ -52,16 +52,23 @@ def test_its_world_builds_five_fingers_and_its_mirror_image_for_the_left_hand():
         world.close()
 
 
-def test_the_planner_passes_the_thumb_under_in_a_scale_where_the_allegro_hand_cannot():
-    """A quick scale (0.15 s a note: no time to shift the whole hand between two notes) is fingered
-    with the thumb under. (At 0.2 s a note and slower the planner shifts the hand after the fifth
-    finger instead: its stretch cost prefers a straight thumb to one turned under the palm.)"""
-    fingers = [n.finger for n in plan_fingering(_scale(0.15), KeyboardConfig(), hand_config(FIVE)).piece.notes]
+@pytest.mark.parametrize("seconds", [0.15, 0.3, 1.0])
+def test_the_planner_passes_the_thumb_under_in_a_scale_where_the_allegro_hand_cannot(seconds):
+    fingers = [n.finger for n in plan_fingering(_scale(seconds), KeyboardConfig(), hand_config(FIVE)).piece.notes]
     assert fingers[:8] == [1, 2, 3, 1, 2, 3, 4, 5]  # the thumb under after E, as pianists finger it
     assert fingers[8:] == [4, 3, 2, 1, 3, 2, 1]  # and the third finger over it on the way down
     planner = Planner(KeyboardConfig(), hand_config(FIVE))
     assert (1, 3) in planner.passes and (3, 1) in planner.passes and (4, 5) not in planner.passes
     assert Planner().passes == set()  # the Allegro-like hand: no finger passes another, as before
+
+
+def test_a_thumb_that_stretches_as_dearly_as_a_finger_shifts_the_hand_in_a_slow_scale_instead():
+    """``thumb_stretch`` is what turns the thumb under: at the fingers' full stretch cost a slow
+    scale is played by shifting the whole hand after the fifth finger (1 2 3 4 5 3 4 5 ...)."""
+    assert tuning_for(hand_config(FIVE)).thumb_stretch == 0.5 and PianistTuning().thumb_stretch == 1.0
+    dear = replace(tuning_for(hand_config(FIVE)), thumb_stretch=1.0)
+    fingers = [n.finger for n in Planner(KeyboardConfig(), hand_config(FIVE), dear).plan(_scale(0.3)).piece.notes]
+    assert fingers[:8] != [1, 2, 3, 1, 2, 3, 4, 5] and fingers[:5] == [1, 2, 3, 4, 5]
 
 
 def test_a_model_refuses_passes_between_fingers_it_lacks():
@@ -70,7 +77,7 @@ def test_a_model_refuses_passes_between_fingers_it_lacks():
 
 
 def test_the_scripted_pianist_plays_the_scale_with_the_thumb_under():
-    piece = plan_fingering(_scale(0.15), KeyboardConfig(), hand_config(FIVE)).piece
+    piece = plan_fingering(_scale(), KeyboardConfig(), hand_config(FIVE)).piece
     assert [n.finger for n in piece.notes][:4] == [1, 2, 3, 1]
     performance = perform_plan(plan_performance(piece, "scripted", hand=FIVE))
     report = performance.report()

@@ -140,6 +140,8 @@ class Planner:
         share = tuning.reach_fraction * forward * np.where(self.black, BLACK_REACH, 1.0)
         self.reach = {f: share * math.tan(hand.model.abduction_limit(f)) for f in self.fingers}
         """Each finger's sideways reach (m) at each key."""
+        self.stretch_cost = {f: STRETCH_COST * (tuning.thumb_stretch if f == 1 else 1.0) for f in self.fingers}
+        """What each finger at the edge of its reach costs (the thumb's: ``tuning.thumb_stretch`` of it)."""
         self.passes = {(a, b) for a in self.fingers for b in self.fingers if hand.model.passes_by(a, b)}
         """The pairs of fingers that may cross (both orders)."""
         self.pitch = keyboard.geometry.white_pitch
@@ -167,7 +169,7 @@ class Planner:
         for a, fingers in enumerate(assignments):
             for key, finger in zip(keys, fingers):
                 offset = (self.key_x[key] - self.grid - self.base_x[finger]) / self.reach[finger][key]
-                cost[a] += np.where(np.abs(offset) <= 1.0, STRETCH_COST * offset**2, _INFEASIBLE)
+                cost[a] += np.where(np.abs(offset) <= 1.0, self.stretch_cost[finger] * offset**2, _INFEASIBLE)
         return assignments, keys, cost
 
     def _transition(

@@ -33,6 +33,8 @@ PIANIST = HandModel(
         ("max_strike_speed", 0.2),
         ("reach_fraction", 0.95),
         ("settle_time", 0.05),
+        ("thumb_stretch", 0.5),
+        ("prepare_steps", 2),
     ),
     passes=frozenset({(1, 2), (1, 3), (1, 4)}),
     written_fingering=True,
@@ -62,6 +64,11 @@ planner uses 95 % of each finger's sideways reach (``reach_fraction``; the Alleg
 land there turned to their limit, so the wider margin only forbade spans the hand plays (a fifth
 with fingers 2 and 5). Its planner leaves one control step (``settle_time`` 0.05 s; the
 Allegro-like hand's 0.2 s) around a wrist move for its light fingers to lift and settle, so the
-reduction gives the hands the quick hand shifts its scripted pianist plays."""
+reduction gives the hands the quick hand shifts its scripted pianist plays; and its fingers take
+two control steps, not the Allegro-like hand's four, to lift, move over and settle before a strike
+(``prepare_steps``), so a key held before a hand move is let go that much nearer its written end. Its thumb pays half a
+finger's stretch cost in the planner (``thumb_stretch``), so a scale passes the thumb under (1 2 3
+1 2 3 4 5) at any tempo, as pianists finger it, rather than shifting the whole hand after the fifth
+finger."""
 
 register_hand_model(PIANIST)
