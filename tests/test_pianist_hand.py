@@ -213,3 +213,15 @@ def test_the_pianist_s_planner_leaves_one_control_step_around_a_wrist_move_and_t
     assert quick.problems == () and quick.moves >= 2
     slow = replace(tuning_for(hand_config(FIVE)), settle_time=0.2)
     assert Planner(KeyboardConfig(), hand_config(FIVE), slow).plan(_scale(0.125)).problems
+
+
+def test_an_alberti_bass_in_semiquavers_plays_whole_because_the_wrist_waits_for_a_striking_thumb():
+    """C3 G3 E3 G3 ... B2 G3 D3 G3 at 0.125 s a note: the thumb strikes B2 turned towards it, the
+    little finger on G3 a sixth above. A wrist sliding straight over B2 while the thumb goes down
+    dragged the thumb off its key (its abduction lags a 29 mm step), so the wrist moves at most
+    ``strike_slide`` a step while a fingertip is on its way into its key (the Allegro-like hand's
+    wrist: unlimited, as before)."""
+    from benchmarks.semiquavers import alberti, line, play
+
+    assert tuning_for(hand_config(FIVE)).strike_slide == 0.004 and tuning_for(HandConfig()).strike_slide == math.inf
+    assert play(line(alberti(), 0.125), FIVE) == (0, 1.0)

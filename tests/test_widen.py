@@ -113,8 +113,35 @@ def test_the_widen_command_says_bad_input_in_one_line_and_exits_2(tmp_path, caps
     for argv, said in (
         ([str(tmp_path), str(tmp_path / "out"), "--fingers", "1,two"], "--fingers 1,two: give finger numbers"),
         ([str(tmp_path / "none"), str(tmp_path / "out")], "holds no manifest.json"),
+        ([str(tmp_path), str(tmp_path / "out"), "--hand-model", "shadow"], "invalid choice: 'shadow'"),
     ):
         with pytest.raises(SystemExit) as exit:
             main(argv)
         assert exit.value.code == 2
         assert said in capsys.readouterr().err.strip().splitlines()[-1]
+
+
+def test_the_packaged_melody_policy_widens_to_the_pianist_s_five_fingers(tmp_path):
+    """``--hand-model`` gives another body the same weights: the Allegro-like hand's three-finger
+    policy starts a five-finger pianist's hand, whose world and joints it then drives."""
+    from pianobot.agent.general import PACKAGED
+    from pianobot.agent.policy import load_policy, policy_configs, policy_target
+    from pianobot.agent.tasks import make_env
+    from pianobot.sim.hand import default_fingers, hand_config
+
+    source = next(PACKAGED.glob("task-melody-*"))
+    folder = widen_policy(source, tmp_path / "pianist", (1, 2, 3, 4, 5), "pianist")
+    env, _ = policy_configs(folder)
+    assert env.world.hand == hand_config(default_fingers("pianist"))  # the pianist's body, not the Allegro's
+    widened = read_manifest(folder)["widened"]
+    assert (widened["hand_model_before"], widened["hand_model"]) == ("allegro", "pianist")
+    instance = make_env(policy_target(folder), env)
+    try:
+        agent = load_policy(folder, instance)
+        observation, _ = instance.reset(seed=0)
+        action = agent.act(observation)
+        assert action.shape == (5 * 4 + 1,) and instance.action_space.contains(action.astype(np.float32))
+    finally:
+        instance.close()
+    with pytest.raises(ValueError, match="choose one of allegro, pianist"):
+        widen_policy(source, tmp_path / "bad", (1, 2, 3, 4), "shadow")

@@ -13,6 +13,11 @@ the fingering planner gives it notes (a thumb takes the lowest), and training on
 widened policy (``pianobot train --task parts --thumb --general-policy DESTINATION``) teaches the
 rest. The critic's encoder, which the actor does not read (DAgger learns no critic), is a fresh
 one for the new hand.
+
+``--hand-model pianist`` gives the weights to another body with the same joints per finger (the
+pianist's five fingers, from the Allegro-like hand's three): nothing there is as the policy
+learnt it (other finger lengths, joint ranges and palm), so it is only a start for training on
+that hand (``pianobot train --task melody --hand-model pianist --general-policy DESTINATION``).
 """
 
 from __future__ import annotations
@@ -31,7 +36,7 @@ from pianobot.agent.tasks import make_env
 from pianobot.config import to_dict
 from pianobot.errors import PianobotError
 from pianobot.music.instrument import HandSpec
-from pianobot.sim.hand import hand_model
+from pianobot.sim.hand import HAND_MODELS, hand_config, hand_model
 
 WIDENED = "widened"
 """A widened policy's manifest says ``"kept": "widened"``: it was not trained as it is."""
@@ -97,10 +102,11 @@ def widen_actor(
     return out
 
 
-def widen_policy(source: Path, destination: Path, fingers: tuple[int, ...]) -> Path:
+def widen_policy(source: Path, destination: Path, fingers: tuple[int, ...], model: str | None = None) -> Path:
     """A policy folder at ``destination`` holding ``source``'s 'fingers' actor widened to a hand
-    with ``fingers`` (a superset of its own), and a manifest that says so (``"kept": "widened"``,
-    no training of its own). Returns ``destination``."""
+    with ``fingers`` (a superset of its own), of hand model ``model`` (None: the policy's own; another
+    model's body gets the same weights, a start for training on it), and a manifest that says so
+    (``"kept": "widened"``, no training of its own). Returns ``destination``."""
     env, sac = policy_configs(source)
     if sac.actor != "fingers" or sac.score_input:
         raise PianobotError(
@@ -108,7 +114,7 @@ def widen_policy(source: Path, destination: Path, fingers: tuple[int, ...]) -> P
             "the 'fingers' actor without it (train.sac.actor fingers) reads every finger alike"
         )
     before = env.world.hand.spec.fingers
-    model = hand_model(env.world.hand.spec.model)
+    model = hand_model(model or env.world.hand.spec.model)
     if not set(fingers) <= set(model.fingers):
         raise PianobotError(
             f"fingers {','.join(map(str, fingers))}: the {model.name} hand has fingers {','.join(map(str, model.fingers))}"
@@ -120,7 +126,9 @@ def widen_policy(source: Path, destination: Path, fingers: tuple[int, ...]) -> P
         )
     if (destination / store.MANIFEST_FILE).exists():
         raise PianobotError(f"{destination} already holds a policy: name a new folder")
-    wide = replace(env, world=replace(env.world, hand=replace(env.world.hand, spec=HandSpec(tuple(sorted(fingers))))))
+    spec = HandSpec(tuple(sorted(fingers)), model=model.name)
+    hand = replace(env.world.hand, spec=spec) if model.name == env.world.hand.spec.model else hand_config(spec)
+    wide = replace(env, world=replace(env.world, hand=hand))
     target = policy_target(source)
     layouts, rests = [], []
     for config in (env, wide):
@@ -149,7 +157,12 @@ def widen_policy(source: Path, destination: Path, fingers: tuple[int, ...]) -> P
         kept=WIDENED,
         evaluation=None,
         evaluations=[],
-        widened={"fingers_before": list(before), "fingers": sorted(fingers)},
+        widened={
+            "fingers_before": list(before),
+            "fingers": sorted(fingers),
+            "hand_model_before": env.world.hand.spec.model,
+            "hand_model": model.name,
+        },
     )
     manifest["config"]["env"] = to_dict(wide)
     for field in ("format", "saved", "versions"):  # (save_policy writes them anew)
@@ -163,6 +176,9 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("source", type=Path, help="a trained policy folder of the 'fingers' actor")
     parser.add_argument("destination", type=Path, help="a new folder for the widened policy")
     parser.add_argument("--fingers", default="1,2,3,4", help="the new hand's fingers (default: 1,2,3,4)")
+    parser.add_argument(
+        "--hand-model", choices=tuple(HAND_MODELS), help="the new hand's model (default: the policy's own)"
+    )
     args = parser.parse_args(argv)
     torch.set_num_threads(1)
     try:
@@ -170,7 +186,7 @@ def main(argv: list[str] | None = None) -> None:
     except ValueError:
         parser.error(f"--fingers {args.fingers}: give finger numbers separated by commas, e.g. 1,2,3,4")
     try:
-        print(widen_policy(args.source, args.destination, fingers))
+        print(widen_policy(args.source, args.destination, fingers, args.hand_model))
     except PianobotError as e:
         parser.error(str(e))
 

@@ -92,6 +92,11 @@ class Motion:
                 high = min(min(at + reach for at, reach in holds), wrist + tuning.hold_slide)
                 target = float(min(max(target, low), high)) if low <= high else wrist
         if any(
+            f in plans and plans[f].phase == "strike" and self.low(joints[slot]) for slot, f in enumerate(self.fingers)
+        ):
+            # a fingertip on its way into its key: a quick slide would drag it off (its abduction lags)
+            target = min(max(target, wrist - tuning.strike_slide), wrist + tuning.strike_slide)
+        if any(
             self.low(joints[slot]) for slot, f in enumerate(self.fingers) if f not in plans or plans[f].phase == "ready"
         ):
             target = wrist  # a finger that lets go of a key rises before the hand moves

@@ -95,6 +95,9 @@ class PianistTuning:
     """Largest change of a flexion joint's angle in one step when positioning (rad per control step)."""
     hold_slide: float = 0.008
     """Farthest the wrist may move in one step while a finger holds a key (m per control step)."""
+    strike_slide: float = math.inf
+    """Farthest the wrist may move in one step while a finger strikes (m per control step; none: it
+    goes where the next strikes want it, a finger mid-strike following it with its abduction)."""
     tilt_step: float = 0.15
     """Most change of the fingertip's tilt the inverse kinematics asks for in one step (rad per control step)."""
 

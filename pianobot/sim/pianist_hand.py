@@ -35,6 +35,7 @@ PIANIST = HandModel(
         ("settle_time", 0.05),
         ("thumb_stretch", 0.5),
         ("prepare_steps", 2),
+        ("strike_slide", 0.004),
     ),
     passes=frozenset({(1, 2), (1, 3), (1, 4)}),
     written_fingering=True,
@@ -69,6 +70,8 @@ two control steps, not the Allegro-like hand's four, to lift, move over and sett
 (``prepare_steps``), so a key held before a hand move is let go that much nearer its written end. Its thumb pays half a
 finger's stretch cost in the planner (``thumb_stretch``), so a scale passes the thumb under (1 2 3
 1 2 3 4 5) at any tempo, as pianists finger it, rather than shifting the whole hand after the fifth
-finger."""
+finger. While a fingertip is on its way into its key the wrist slides at most 4 mm a control step
+(``strike_slide``, as while a finger holds one): a thumb turned towards its key lags a quicker
+slide and was dragged off it."""
 
 register_hand_model(PIANIST)
