@@ -91,7 +91,7 @@ class Motion:
                 low = max(max(at - reach for at, reach in holds), wrist - tuning.hold_slide)
                 high = min(min(at + reach for at, reach in holds), wrist + tuning.hold_slide)
                 target = float(min(max(target, low), high)) if low <= high else wrist
-        if any(
+        if tuning.strike_slide < math.inf and any(
             f in plans and plans[f].phase == "strike" and self.low(joints[slot]) for slot, f in enumerate(self.fingers)
         ):
             # a fingertip on its way into its key: a quick slide would drag it off (its abduction lags)
