@@ -286,14 +286,17 @@ def main() -> None:
         "--hand-model",
         choices=tuple(HAND_MODELS),
         help="each hand this model with its fingers (as play --hand-model); one no general policy is packaged for "
-        "(the pianist's hand) is played by the scripted pianist only, unless --general names one for it",
+        "(the pianist's hand) is played by the scripted pianist only, unless --general or --general-left names one",
     )
     parser.add_argument("--json", help="write every piece's figures here")
     args = parser.parse_args()
     hand = THUMB if args.thumb else HandSpec() if args.no_thumb else None  # (None: as play_hands chooses)
     players = PLAYERS
     if args.hand_model is not None and args.hand_model != HandSpec.model:
-        hand, players = default_fingers(args.hand_model), PLAYERS if args.general is not None else ("scripted",)
+        hand, players = (
+            default_fingers(args.hand_model),
+            PLAYERS if args.general or args.general_left else ("scripted",),
+        )
     if (args.lowest_note is None) != (args.keys is None):
         parser.error("--lowest-note and --keys go together")
     keyboard = KeyboardSpec(args.lowest_note, args.keys) if args.keys is not None else None

@@ -9,8 +9,8 @@ from hand start ``index`` and prints a Markdown table per key: mean and lowest n
 velocity MAE (MIDI units, matched notes), mean absolute onset error (ms), extra notes (played
 notes the score does not ask for), mean note F1 with offsets and per-step key-press F1, and the
 median played/written duration of notes written < 0.35 s, 0.35-0.7 s and longer (articulation,
-docs/metrics.md); then the totals, what ended the notes let go early (:func:`early_causes`: a
-repeated key, a move of the hand, or neither), and every melody short of the targets
+docs/metrics.md); then the totals, what came after the notes let go early (:func:`early_causes`:
+the same key again, a move of the hand, neither, or nothing), and every melody short of the targets
 (note F1 >= 0.95, velocity MAE <= 5, no extra notes). ``--hand-model`` plays them with that hand
 and its fingers (default the Allegro-like hand's three).
 """
@@ -45,14 +45,23 @@ def playable(piece: Piece, hand: HandSpec = HandSpec()) -> Piece | None:
 OFFSET_TOLERANCE, OFFSET_RATIO = 0.05, 0.2
 """note F1 with offsets' tolerance (mir_eval's): an offset counts within the larger of 50 ms and
 20 % of the written duration."""
-EARLY_CAUSES = ("repeated key", "hand move", "other")
+EARLY_CAUSES = ("repeated key", "hand move", "other", "last note")
+
+
+CAUSE_NAMES = {
+    "repeated key": "the same key again",
+    "hand move": "a hand move",
+    "other": "neither",
+    "last note": "nothing (the last note)",
+}
 
 
 def early_causes(piece: Piece, rows: tuple[NoteRow, ...], hand: HandSpec) -> dict[str, int]:
     """How many matched notes of ``piece`` were let go early (before their written offset by more
-    than note F1 with offsets allows), by what comes next: the same key struck again (it must
-    rise first), the hand moving (the fingering planner's wrist moves between this note's onset
-    and the next: a held key lets go before the wrist slides), or neither."""
+    than note F1 with offsets allows), by what comes at the next onset: the same key struck again
+    (it must rise first), the hand moving (the fingering planner's wrist moves between this note's
+    onset and the next: a held key lets go before the wrist slides), neither, or nothing (the
+    piece's last notes)."""
     plan = plan_fingering(piece, KeyboardConfig(), hand_config(hand))
     onsets = sorted({n.onset for n in plan.piece.notes})
     wrist = dict(zip(onsets, plan.wrist))
@@ -63,11 +72,12 @@ def early_causes(piece: Piece, rows: tuple[NoteRow, ...], hand: HandSpec) -> dic
             continue
         if note.offset - played.offset <= max(OFFSET_TOLERANCE, OFFSET_RATIO * note.duration):
             continue
-        later = [n for n in piece.notes if n.onset > note.onset]
-        following = min(later, key=lambda n: n.onset) if later else None
-        if following is not None and following.pitch == note.pitch:
+        later = [n.onset for n in piece.notes if n.onset > note.onset]
+        if not later:
+            counts["last note"] += 1
+        elif any(n.onset == min(later) and n.pitch == note.pitch for n in piece.notes):
             counts["repeated key"] += 1
-        elif following is not None and abs(wrist[following.onset] - wrist[note.onset]) > 1e-9:
+        elif abs(wrist[min(later)] - wrist[note.onset]) > 1e-9:
             counts["hand move"] += 1
         else:
             counts["other"] += 1
@@ -149,7 +159,7 @@ def table(results: list[dict], rejected: int) -> str:
     lines.append(
         f"Notes let go early (before their written end by more than note F1 with offsets allows): "
         f"{sum(early.values())} of {matched} matched ({sum(early.values()) / max(matched, 1):.1%}); before "
-        + ", ".join(f"{'another cause' if cause == 'other' else 'a ' + cause} {n}" for cause, n in early.items())
+        + ", ".join(f"{CAUSE_NAMES[cause]} {n}" for cause, n in early.items())
         + "."
     )
     return "\n".join(lines)

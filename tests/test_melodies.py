@@ -64,29 +64,38 @@ def test_the_scripted_pianist_plays_a_random_melody_in_every_key():
     assert np.mean([r[2] for r in results]) >= 0.98
 
 
-def test_the_benchmark_says_what_ended_each_note_let_go_early():
-    """benchmarks.melodies counts each note let go too early for note F1 with offsets by what came
-    next: the same key again, a move of the hand (the planner's wrist), or neither."""
+def test_the_benchmark_says_what_came_after_each_note_let_go_early():
+    """benchmarks.melodies counts each note let go too early for note F1 with offsets by what comes
+    at the next onset: its key again (in a chord too), a move of the hand (the planner's wrist),
+    neither, or nothing (the last note)."""
     from benchmarks.melodies import early_causes
     from pianobot.music.metrics import NoteRow
     from pianobot.music.piece import Note, Piece
 
     written = Piece(
         (
-            Note(0.0, 60, 0.5, 80, finger=2),  # C4, then C4 again: the key must rise
+            Note(0.0, 62, 0.5, 80, finger=3),  # D4, then a chord with D4 in it (not its lowest): the key must rise
             Note(0.5, 60, 1.0, 80, finger=2),
-            Note(1.0, 62, 1.5, 80, finger=3),  # D4, then A5: far out of reach, the hand moves
-            Note(1.5, 81, 2.0, 80, finger=3),  # the last note: nothing follows
+            Note(0.5, 62, 1.0, 80, finger=3),
+            Note(1.0, 62, 1.5, 80, finger=3),  # D4, then E4 a step up: the hand stays
+            Note(1.5, 64, 2.0, 80, finger=4),  # E4, then A5: far out of reach, the hand moves
+            Note(2.0, 81, 2.5, 80, finger=3),  # the last note: nothing follows
         ),
         bpm=120,
     )
-    early = [Note(n.onset, n.pitch, n.offset - 0.2, n.velocity, n.finger) for n in written.notes]
-    on_time = Note(0.5, 60, 0.97, 80, finger=2)  # within 50 ms of its end: not early
+
+    def early(n: Note) -> Note:
+        return Note(n.onset, n.pitch, n.offset - 0.2, n.velocity, n.finger)
+
+    notes = written.notes
     rows = (
-        NoteRow(written.notes[0], early[0]),
-        NoteRow(written.notes[1], on_time),
-        NoteRow(written.notes[2], early[2]),
-        NoteRow(written.notes[3], early[3]),
-        NoteRow(None, early[1]),  # an extra note counts for nothing here
+        NoteRow(notes[0], early(notes[0])),
+        NoteRow(notes[1], Note(0.5, 60, 0.97, 80, finger=2)),  # within 50 ms of its end: not early
+        NoteRow(notes[2], None),  # missed: not counted
+        NoteRow(notes[3], early(notes[3])),
+        NoteRow(notes[4], early(notes[4])),
+        NoteRow(notes[5], early(notes[5])),
+        NoteRow(None, early(notes[1])),  # an extra note counts for nothing here
     )
-    assert early_causes(written, rows, HandSpec()) == {"repeated key": 1, "hand move": 1, "other": 1}
+    counts = early_causes(written, rows, HandSpec())
+    assert counts == {"repeated key": 1, "hand move": 1, "other": 1, "last note": 1}

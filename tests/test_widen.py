@@ -9,6 +9,7 @@ from pianobot.agent.config import SACConfig
 from pianobot.agent.store import read_manifest
 from pianobot.agent.widen import WIDENED, context_sources, widen_actor, widen_policy
 from pianobot.errors import PianobotError
+from pianobot.music.instrument import HandSpec
 
 JOINTS, WIDTH = 4, 6
 OLD, NEW = FingerLayout(3, JOINTS, WIDTH), FingerLayout(4, JOINTS, WIDTH)
@@ -143,5 +144,7 @@ def test_the_packaged_melody_policy_widens_to_the_pianist_s_five_fingers(tmp_pat
         assert action.shape == (5 * 4 + 1,) and instance.action_space.contains(action.astype(np.float32))
     finally:
         instance.close()
+    same = widen_policy(source, tmp_path / "same-fingers", (2, 3, 4), "pianist")  # another body, the same fingers
+    assert policy_configs(same)[0].world.hand.spec == HandSpec((2, 3, 4), model="pianist")
     with pytest.raises(ValueError, match="choose one of allegro, pianist"):
         widen_policy(source, tmp_path / "bad", (1, 2, 3, 4), "shadow")

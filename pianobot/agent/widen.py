@@ -50,7 +50,7 @@ def context_sources(old: FingerLayout, new: FingerLayout, slots: list[int], rest
     if old.joints != new.joints or old.target_width != new.target_width:
         raise PianobotError(
             "the policy's fingers and the new hand's observe different joints or targets: widen a policy only "
-            "to the same environment with more fingers"
+            "to a hand whose fingers have the same joints"
         )
     sources = [0, 1]
     old_base, new_base = 2, 2
@@ -119,7 +119,8 @@ def widen_policy(source: Path, destination: Path, fingers: tuple[int, ...], mode
         raise PianobotError(
             f"fingers {','.join(map(str, fingers))}: the {model.name} hand has fingers {','.join(map(str, model.fingers))}"
         )
-    if not set(before) < set(fingers):
+    same_body = model.name == env.world.hand.spec.model
+    if not (set(before) < set(fingers) if same_body else set(before) <= set(fingers)):
         raise PianobotError(
             f"fingers {','.join(map(str, fingers))} do not add to the policy's own ({','.join(map(str, before))}): "
             "name all of them, e.g. --fingers 1,2,3,4"
@@ -127,7 +128,7 @@ def widen_policy(source: Path, destination: Path, fingers: tuple[int, ...], mode
     if (destination / store.MANIFEST_FILE).exists():
         raise PianobotError(f"{destination} already holds a policy: name a new folder")
     spec = HandSpec(tuple(sorted(fingers)), model=model.name)
-    hand = replace(env.world.hand, spec=spec) if model.name == env.world.hand.spec.model else hand_config(spec)
+    hand = replace(env.world.hand, spec=spec) if same_body else hand_config(spec)
     wide = replace(env, world=replace(env.world, hand=hand))
     target = policy_target(source)
     layouts, rests = [], []
@@ -175,12 +176,18 @@ def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("source", type=Path, help="a trained policy folder of the 'fingers' actor")
     parser.add_argument("destination", type=Path, help="a new folder for the widened policy")
-    parser.add_argument("--fingers", default="1,2,3,4", help="the new hand's fingers (default: 1,2,3,4)")
+    parser.add_argument(
+        "--fingers", help="the new hand's fingers (default: 1,2,3,4, or with --hand-model that model's default fingers)"
+    )
     parser.add_argument(
         "--hand-model", choices=tuple(HAND_MODELS), help="the new hand's model (default: the policy's own)"
     )
     args = parser.parse_args(argv)
     torch.set_num_threads(1)
+    if args.fingers is None:
+        args.fingers = (
+            "1,2,3,4" if args.hand_model is None else ",".join(map(str, hand_model(args.hand_model).finger_sets[0]))
+        )
     try:
         fingers = tuple(int(f) for f in args.fingers.split(","))
     except ValueError:

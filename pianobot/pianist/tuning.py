@@ -96,8 +96,9 @@ class PianistTuning:
     hold_slide: float = 0.008
     """Farthest the wrist may move in one step while a finger holds a key (m per control step)."""
     strike_slide: float = math.inf
-    """Farthest the wrist may move in one step while a finger strikes (m per control step; none: it
-    goes where the next strikes want it, a finger mid-strike following it with its abduction)."""
+    """Farthest the wrist may move in one step while a striking fingertip is low, on its way into its
+    key (m per control step; ``math.inf``, the default: no limit, the finger following the wrist
+    with its abduction). Fingers about to strike, not yet down, never limit it."""
     tilt_step: float = 0.15
     """Most change of the fingertip's tilt the inverse kinematics asks for in one step (rad per control step)."""
 
