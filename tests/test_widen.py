@@ -148,3 +148,13 @@ def test_the_packaged_melody_policy_widens_to_the_pianist_s_five_fingers(tmp_pat
     assert policy_configs(same)[0].world.hand.spec == HandSpec((2, 3, 4), model="pianist")
     with pytest.raises(ValueError, match="choose one of allegro, pianist"):
         widen_policy(source, tmp_path / "bad", (1, 2, 3, 4), "shadow")
+
+
+def test_the_widen_command_gives_another_body_its_own_fingers_by_default(tmp_path):
+    """``--hand-model pianist`` without ``--fingers``: the pianist's default five, not 1,2,3,4."""
+    from pianobot.agent.general import PACKAGED
+    from pianobot.agent.widen import main
+
+    main([str(next(PACKAGED.glob("task-melody-*"))), str(tmp_path / "five"), "--hand-model", "pianist"])
+    widened = read_manifest(tmp_path / "five")["widened"]
+    assert widened["fingers"] == [1, 2, 3, 4, 5] and widened["hand_model"] == "pianist"
