@@ -211,3 +211,23 @@ def test_train_says_why_nothing_was_trained_where_the_whole_piece_still_loses_no
     assert "no phrase policy of its own" in text and "so none was trained" in text
     monkeypatch.setattr(accept, "settle_piece", settle)  # the piece as it plays: whole, nothing to say
     assert "so none was trained" not in run(*args, "--models", tmp_path / "again").output
+
+
+def test_train_finish_ends_an_interrupted_run_at_its_checkpoint(tmp_path, monkeypatch):
+    """`--finish`: a run cut after its first round, rerun with it, trains no further: its best policy
+    so far is stored and its manifest says the steps it took (the same command would have gone on)."""
+    import pianobot.learn.dagger as dagger
+
+    song = EXAMPLES / "one-note.mid"
+    args = ("train", song, "--steps", "120", "--learner", "dagger", "--round-steps", "40", "--no-tactile")
+    real = dagger._dagger
+    monkeypatch.setattr(dagger, "_dagger", lambda r, stop_after: real(r, 40))  # cut after the first round
+    assert run(*args, "--models", tmp_path).exit_code == 0
+    monkeypatch.setattr(dagger, "_dagger", real)
+    result = run(*args, "--finish", "--models", tmp_path, "--json", "-")
+    assert result.exit_code == 0, result.output
+    assert "ending at its checkpoint (--finish) at step 45" in result.stderr  # (episodes of 45 steps)
+    (policy,) = json.loads(result.stdout)["policies"]
+    manifest = json.loads((Path(policy["folder"]) / "manifest.json").read_text())
+    assert policy["steps"] == 45 == manifest["steps"] and manifest["config"]["steps"] == 120
+    assert [e["step"] for e in manifest["evaluations"]] == [45]

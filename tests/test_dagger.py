@@ -12,6 +12,7 @@ from pianobot.agent import store
 from pianobot.agent.config import SACConfig
 from pianobot.agent.imitation import Imitation
 from pianobot.agent.policy import load_policy, make_agent
+from pianobot.agent.store import config_hash
 from pianobot.env.piano import EnvConfig
 from pianobot.learn.config import DaggerConfig, TrainConfig
 from pianobot.learn.dagger import dagger_policy
@@ -119,6 +120,27 @@ def test_an_interrupted_run_resumes_to_the_same_policy(tmp_path):
     assert a.keys() == b.keys() and all(torch.equal(a[k], b[k]) for k in a)
     manifests = [json.loads((tmp_path / f / store.MANIFEST_FILE).read_text()) for f in ("straight", "resumed")]
     assert manifests[0]["evaluations"] == manifests[1]["evaluations"]
+
+
+def test_finish_ends_an_interrupted_run_at_its_checkpoint_with_the_best_policy_so_far(tmp_path):
+    """TrainConfig.finish (`train --finish`): the same run, resumed, trains no further: the best policy
+    its checkpoint kept is stored, the manifest says the steps it took, and the checkpoint goes.
+    Without a checkpoint the option changes nothing: the run trains all its steps."""
+    torch.set_num_threads(1)
+    config = small()
+    assert config_hash(replace(config, finish=True)) == config_hash(config)  # the same folder
+    folder = tmp_path / "m"
+    assert dagger_policy(PHRASE, config, folder, stop_after=100) == {"interrupted_at": 140}
+    tensors, state, _ = store.load_checkpoint(folder)
+    best = {k[len("best.") :]: v for k, v in tensors.items() if k.startswith("best.")}
+    manifest = dagger_policy(PHRASE, replace(config, finish=True), folder)
+    assert manifest["steps"] == 140 < config.steps and manifest["evaluation"] == state["best"]
+    assert [e["step"] for e in manifest["evaluations"]] == [70, 140]  # no round after the checkpoint's
+    stored = store.load_tensors(folder / store.POLICY_FILE)
+    assert stored.keys() == best.keys() and all(torch.equal(stored[k], best[k]) for k in best)
+    assert store.is_trained(folder) and not (folder / store.CHECKPOINT_DIR).exists()
+    fresh = dagger_policy(PHRASE, replace(config, finish=True), tmp_path / "fresh")
+    assert fresh["steps"] >= config.steps  # (rounds of 70 steps: 210)
 
 
 def test_a_start_policy_that_already_plays_the_phrase_costs_one_evaluation(tmp_path):

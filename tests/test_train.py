@@ -61,6 +61,21 @@ def test_saved_policy_loads_and_acts_the_same(tmp_path):
     assert set(critic) == {"log_alpha"} | {k for k in first_agent.critic_tensors() if k.startswith("critic.layers.")}
 
 
+def test_finish_stores_an_interrupted_sac_runs_checkpointed_policy_evaluated(tmp_path):
+    """`train --finish` on a SAC run cut after its checkpoint at step 70 (no evaluation yet): no step
+    more; the checkpoint's policy is evaluated and stored, the manifest saying 70 steps."""
+    torch.set_num_threads(1)
+    config = small()
+    folder = tmp_path / "m"
+    assert train_policy(PHRASE, config, folder, stop_after=100) == {"interrupted_at": 105}
+    tensors, _, _ = store.load_checkpoint(folder)
+    manifest = train_policy(PHRASE, replace(config, finish=True), folder)
+    assert manifest["steps"] == 70 and manifest["evaluation"]["step"] == 70 and len(manifest["evaluations"]) == 1
+    stored = store.load_tensors(folder / store.POLICY_FILE)
+    assert all(torch.equal(stored[k], tensors[k]) for k in stored)  # the checkpoint's actor, not trained further
+    assert not (folder / store.CHECKPOINT_DIR).exists()
+
+
 def test_interrupted_training_resumes_to_the_same_state(tmp_path):
     torch.set_num_threads(1)
     config = small()

@@ -28,6 +28,7 @@ FLAGS = {
     "phrases.max_notes": "--phrase-notes",
     "jobs.force": "--force",
     "train.device": "--device",
+    "train.finish": "--finish",
     "train.dagger.round_steps": "--round-steps",
     "train.dagger.learning_rate": "--dagger-learning-rate",
     "store.models": "--models",

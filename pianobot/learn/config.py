@@ -80,6 +80,12 @@ class TrainConfig:
     """Environments stepped at once: 1 in the training process (the run is exactly what it always
     was); more, each in a worker process of its own, all stepping together while the learner waits.
     How a run executes, not what it trains: left out of the configuration's hash (the model folder)."""
+    finish: bool = field(default=False, metadata={"runtime": True})
+    """End an interrupted run at its checkpoint instead of training on: the best policy it evaluated
+    so far is stored (a SAC run's checkpointed policy is evaluated too, and kept where it plays
+    better), and the manifest's ``steps`` say how many it took. A run without a checkpoint trains
+    as usual. When to stop a run, not what it trains: left out of the hash, so the same command
+    with it finds the run's folder."""
     device: str = field(default="auto", metadata={"runtime": True})
     """Where the learner (networks, updates, replay batches) runs: 'auto' (cuda when torch sees a
     GPU, else cpu), 'cpu' or 'cuda'. Left out of the hash too: a run may resume on another device."""

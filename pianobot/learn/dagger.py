@@ -70,7 +70,7 @@ def _dagger(run: Run, stop_after: int | None) -> dict:
         return rng.random(n) < settings.teacher_share**rounds
 
     teacher_plays = new_episodes(np.ones(n, bool))
-    while final is None and step < config.steps:
+    while final is None and step < config.steps and not run.finishing:
         # 1. gather a round's steps, every one labelled with the teacher's action
         round_end = min(step + settings.round_steps, config.steps)
         gathered = 0
@@ -127,6 +127,8 @@ def _dagger(run: Run, stop_after: int | None) -> dict:
         observations, _ = envs.reset(options={"reset_mask": ended})  # the episodes that ended the round
         teacher_plays = np.where(ended, new_episodes(ended), teacher_plays)
 
+    if final is None and run.best is None:  # (finished at a checkpoint written before any evaluation)
+        run.keep_if_best(step, run.evaluate(agent), agent)
     if final is None:  # every round ended in an evaluation: the best of them is the policy
         final, tensors = run.best, run.best_tensors
     else:

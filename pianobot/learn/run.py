@@ -289,6 +289,11 @@ class Run:
         self.log.start(resumed_at=state["step"] if self.resumed else None)
         return observations, state, tensors
 
+    @property
+    def finishing(self) -> bool:
+        """True when an interrupted run ends at its checkpoint (:attr:`TrainConfig.finish`)."""
+        return self.resumed and self.config.finish
+
     def seconds(self) -> float:
         """Wall-clock seconds the run has taken, across interruptions."""
         return self.seconds_before + time.perf_counter() - self.started

@@ -107,7 +107,7 @@ def _train(run: Run, stop_after: int | None) -> dict:
     returns, losses = np.zeros(n), None
     final = run.evaluate_start(agent)  # fine-tuning: the start's figures, when it already plays well enough
 
-    while final is None and step < config.steps:
+    while final is None and step < config.steps and not run.finishing:
         # act in every environment: explore (the teacher's action plus noise), then sample the policy
         vectors, tactiles = agent.split_batch(observations)
         each = [{k: v[i] for k, v in observations.items()} for i in range(n)]  # each environment's observation

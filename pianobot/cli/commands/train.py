@@ -125,6 +125,13 @@ ENVS_OPTION = typer.Option(
     help="Environments each policy's training steps at once: 1 in the training process, more each in a worker "
     "process of its own.",
 )
+FINISH_OPTION = typer.Option(
+    TrainConfig.finish,
+    "--finish",
+    help="End interrupted runs at their checkpoints instead of training on: each stores the best policy it "
+    "evaluated so far, its manifest saying the steps it took (give the interrupted command's other options). "
+    "A run without a checkpoint trains as usual.",
+)
 DEVICE_OPTION = typer.Option(
     TrainConfig.device,
     "--device",
@@ -187,6 +194,7 @@ def train(
     workers: int = typer.Option(1, "--workers", help="Train this many phrases at once, in separate processes."),
     threads: int = THREADS_OPTION,
     envs: int = ENVS_OPTION,
+    finish: bool = FINISH_OPTION,
     device: Device = DEVICE_OPTION,
     control: Control = CONTROL_OPTION,
     reward: Reward = typer.Option(RewardConfig.kind, "--reward", help="Reward: linear, squared or wasserstein."),
@@ -222,6 +230,7 @@ def train(
     settings |= dict(dagger_learning_rate=dagger_learning_rate, from_general=from_general, device=device)
     settings |= dict(control=control, reward=reward, explore=explore, exploration_steps=exploration_steps)
     settings |= dict(actor=actor, tactile=tactile, joints=joints, fingering_gate=fingering_gate, task=task)
+    settings |= dict(finish=finish)
     config = _config(keyboard, hand, general_policy=general_policy, **settings)
     if general_policy is not None and not from_general:
         raise PianobotError(
@@ -249,7 +258,7 @@ def train(
     console.print(
         f"training {len(todo)} polic{'y' if len(todo) == 1 else 'ies'} for {said(plan.label)}, {steps} steps each"
     )
-    with _progress(console, todo, steps, task is not None) as on_progress:
+    with _progress(console, todo, steps, task is not None, finish) as on_progress:
         results = training.train_groups(plan, on_progress, cluster.value, workers, threads)
     trained = training.trained_policies(plan, results, models)
     verdict = _judge(console, plan, trained, models, song)
@@ -349,6 +358,7 @@ def _config(keyboard, hand, *, general_policy, task, **given) -> TrainConfig:
             eval_episodes=TASK_EVAL_EPISODES if task is not None else TrainConfig.eval_episodes,
             envs=envs,
             device=device.value,
+            finish=g["finish"],
         )
     return config
 
@@ -414,7 +424,7 @@ def _say_skipped(console, plan, models: Path) -> None:
 
 
 @contextlib.contextmanager
-def _progress(console, todo, steps: int, task: bool):
+def _progress(console, todo, steps: int, task: bool, finish: bool = False):
     """A progress bar per job while it trains; yields the ``on_progress(key, progress)`` that moves them."""
     from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 
@@ -434,9 +444,8 @@ def _progress(console, todo, steps: int, task: bool):
 
         def on_progress(key: str, progress) -> None:
             if progress.resumed:
-                bar.console.print(
-                    f"{bar.tasks[rows[key]].description}: resuming from its checkpoint at step {progress.step}"
-                )
+                what = "ending at its checkpoint (--finish)" if finish else "resuming from its checkpoint"
+                bar.console.print(f"{bar.tasks[rows[key]].description}: {what} at step {progress.step}")
             if progress.finished:  # stopped early (--until-f1) or at its last step: the bar ends full
                 bar.update(rows[key], total=progress.step, completed=progress.step)
                 return
