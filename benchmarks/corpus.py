@@ -33,7 +33,7 @@ hands lose by getting in each other's way. The hands' fingers are chosen per fil
 play`` chooses them (:func:`pianobot.perform.together.fingers_for_file`: the thumbs too where they
 keep notes three fingers leave out; the row's ``fingers``); ``--thumb`` gives each hand its thumb
 everywhere (``pianobot play --thumb``), ``--no-thumb`` three fingers everywhere, ``--hand-model
-pianist`` the pianist's five fingers (scripted pianist only: no general policy plays it yet); the general
+pianist`` the pianist's five fingers (its packaged parts policy beside the scripted pianist); the general
 policy plays where one for that hand is packaged (else the scripted pianist alone plays);
 ``--general DIR`` names the general policy to play both hands.
 """
@@ -273,8 +273,8 @@ def main() -> None:
     fingers.add_argument(
         "--hand-model",
         choices=tuple(HAND_MODELS),
-        help="each hand this model with its fingers (as play --hand-model); where no general policy is packaged "
-        "for it (the pianist's hand), the scripted pianist alone plays",
+        help="each hand this model with its fingers (as play --hand-model); the general policy plays where one "
+        "is packaged for it, else the scripted pianist alone",
     )
     parser.add_argument(
         "--general",

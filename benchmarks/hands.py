@@ -53,6 +53,7 @@ from pathlib import Path
 import numpy as np
 import torch
 
+from pianobot.agent.general import parts_policy
 from pianobot.errors import PianobotWarning
 from pianobot.music.duets import duet_set, random_duet
 from pianobot.music.instrument import THUMB, HandSpec, KeyboardSpec
@@ -285,18 +286,17 @@ def main() -> None:
     fingers.add_argument(
         "--hand-model",
         choices=tuple(HAND_MODELS),
-        help="each hand this model with its fingers (as play --hand-model); one no general policy is packaged for "
-        "(the pianist's hand) is played by the scripted pianist only, unless --general or --general-left names one",
+        help="each hand this model with its fingers (as play --hand-model); the general policy plays where one is "
+        "packaged for it (or --general or --general-left names one), else the scripted pianist alone",
     )
     parser.add_argument("--json", help="write every piece's figures here")
     args = parser.parse_args()
     hand = THUMB if args.thumb else HandSpec() if args.no_thumb else None  # (None: as play_hands chooses)
     players = PLAYERS
     if args.hand_model is not None and args.hand_model != HandSpec.model:
-        hand, players = (
-            default_fingers(args.hand_model),
-            PLAYERS if args.general or args.general_left else ("scripted",),
-        )
+        hand = default_fingers(args.hand_model)
+        packaged = parts_policy(None, None, hand) is not None
+        players = PLAYERS if args.general or args.general_left or packaged else ("scripted",)
     if (args.lowest_note is None) != (args.keys is None):
         parser.error("--lowest-note and --keys go together")
     keyboard = KeyboardSpec(args.lowest_note, args.keys) if args.keys is not None else None

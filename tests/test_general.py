@@ -421,6 +421,7 @@ def test_the_packaged_left_hand_policy_plays_left_hands_only_while_the_store_has
     one hand; a general policy of the user's own plays both hands (none is offered then), and so
     does the packaged general policy where the left hand's cannot play the keys (fewer than its own)."""
     from pianobot.agent.general import PARTS_KEY, general_candidates, parts_policy
+    from pianobot.agent.policy import policy_configs
     from pianobot.music.instrument import HandSpec, KeyboardSpec
 
     empty = tmp_path / "empty"
@@ -428,8 +429,11 @@ def test_the_packaged_left_hand_policy_plays_left_hands_only_while_the_store_has
     left = parts_policy(empty)
     assert left is not None and left.name.startswith(f"{PARTS_KEY}-") and PACKAGED in left.resolve().parents
     # the packaged general policy, then the parts policies (for a hand the general policy does not fit: the thumb)
-    assert [f.name.split("-")[1] for f in general_candidates(empty)] == ["melody", "parts", "parts"]
+    assert [f.name.split("-")[1] for f in general_candidates(empty)] == ["melody", "parts", "parts", "parts"]
     assert parts_policy(empty, hand=HandSpec((1, 2, 3, 4))) not in (None, left)  # the thumb's
+    pianist = parts_policy(empty, hand=HandSpec((1, 2, 3, 4, 5), model="pianist"))  # the pianist's hand's own
+    assert pianist is not None and policy_configs(pianist)[0].world.hand.spec.model == "pianist"
+    assert parts_policy(empty, hand=HandSpec((2, 3, 4, 5), model="pianist")) is None  # (not without its thumb)
     assert parts_policy(empty, KeyboardSpec()) == left
     assert parts_policy(empty, KeyboardSpec(lowest=36, count=36)) == left  # it plays any wider keyboard
     assert parts_policy(empty, KeyboardSpec(lowest=60, count=12)) is None  # not a narrower one

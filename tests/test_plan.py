@@ -72,6 +72,7 @@ def test_one_player_plans_and_refusals(tmp_path):
         PianobotError,
         match=r"no general policy plays it \(looked there and in .*policies; the packaged general policies play "
         r"with fingers 2 \(index\), 3 \(middle\), 4 \(ring\) or 1 \(thumb\), 2 \(index\), 3 \(middle\), "
+        r"4 \(ring\), 5 \(little\) of the pianist hand or 1 \(thumb\), 2 \(index\), 3 \(middle\), "
         r"4 \(ring\); this piece is read for fingers 1 \(thumb\), 2 \(index\), 3 \(middle\) \(hand.fingers, hand.model\)\)"
         r".*store.models",
     ):

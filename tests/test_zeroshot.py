@@ -189,8 +189,8 @@ def test_benchmarks_hands_thumb_gives_every_player_and_the_examples_reading_each
     assert asked == [thumb, thumb]  # both players of the one duet
 
 
-def test_benchmarks_hands_hand_model_pianist_plays_the_scripted_pianist_with_five_fingers(monkeypatch):
-    """No general policy plays the pianist's hand: only the scripted pianist plays, with its five fingers."""
+def test_benchmarks_hands_hand_model_pianist_plays_both_players_with_five_fingers(monkeypatch):
+    """The pianist's hand: its packaged parts policy and the scripted pianist play, each with its five fingers."""
     import sys
 
     from benchmarks import hands
@@ -203,4 +203,7 @@ def test_benchmarks_hands_hand_model_pianist_plays_the_scripted_pianist_with_fiv
     monkeypatch.setattr(hands, "table", lambda name, rows, players=None: "")
     monkeypatch.setattr(sys, "argv", ["hands", "--duets", "1", "--polyphonic", "0", "--hand-model", "pianist"])
     hands.main()
-    assert asked == [("scripted", default_fingers("pianist"))]
+    assert asked == [
+        ("sac", default_fingers("pianist")),
+        ("scripted", default_fingers("pianist")),
+    ]  # (its packaged policy)
