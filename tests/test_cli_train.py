@@ -220,6 +220,8 @@ def test_train_finish_ends_an_interrupted_run_at_its_checkpoint(tmp_path, monkey
 
     song = EXAMPLES / "one-note.mid"
     args = ("train", song, "--steps", "120", "--learner", "dagger", "--round-steps", "40", "--no-tactile")
+    fresh = run(*args, "--finish", "--models", tmp_path / "fresh")  # nothing to end: said, and trained as usual
+    assert fresh.exit_code == 0 and "holds no checkpoint of this run" in " ".join(fresh.output.split())
     real = dagger._dagger
     monkeypatch.setattr(dagger, "_dagger", lambda r, stop_after: real(r, 40))  # cut after the first round
     assert run(*args, "--models", tmp_path).exit_code == 0

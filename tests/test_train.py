@@ -74,6 +74,10 @@ def test_finish_stores_an_interrupted_sac_runs_checkpointed_policy_evaluated(tmp
     stored = store.load_tensors(folder / store.POLICY_FILE)
     assert all(torch.equal(stored[k], tensors[k]) for k in stored)  # the checkpoint's actor, not trained further
     assert not (folder / store.CHECKPOINT_DIR).exists()
+    # cut at a checkpoint before the first learning step (still exploring): nothing learnt to keep, it trains on
+    exploring = small(sac=replace(small().sac, exploration_steps=150))
+    assert train_policy(PHRASE, exploring, tmp_path / "e", stop_after=100) == {"interrupted_at": 105}
+    assert train_policy(PHRASE, replace(exploring, finish=True), tmp_path / "e")["steps"] >= exploring.steps
 
 
 def test_interrupted_training_resumes_to_the_same_state(tmp_path):

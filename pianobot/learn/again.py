@@ -66,6 +66,7 @@ def train_again(
         from_general=True,
         finetune_until_f1=1.0,
         envs=1,
+        finish=False,
         steps=steps or config.steps,
         **imitate,
     )

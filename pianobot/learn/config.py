@@ -83,8 +83,9 @@ class TrainConfig:
     finish: bool = field(default=False, metadata={"runtime": True})
     """End an interrupted run at its checkpoint instead of training on: the best policy it evaluated
     so far is stored (a SAC run's checkpointed policy is evaluated too, and kept where it plays
-    better), and the manifest's ``steps`` say how many it took. A run without a checkpoint trains
-    as usual. When to stop a run, not what it trains: left out of the hash, so the same command
+    better), and the manifest's ``steps`` say how many it took. A run without a checkpoint, or whose
+    checkpoint came before its first learning step (SAC's exploration), trains as usual: it has
+    learnt nothing to keep. When to stop a run, not what it trains: left out of the hash, so the same command
     with it finds the run's folder."""
     device: str = field(default="auto", metadata={"runtime": True})
     """Where the learner (networks, updates, replay batches) runs: 'auto' (cuda when torch sees a

@@ -128,7 +128,9 @@ def _dagger(run: Run, stop_after: int | None) -> dict:
         teacher_plays = np.where(ended, new_episodes(ended), teacher_plays)
 
     if final is None and run.best is None:  # (finished at a checkpoint written before any evaluation)
-        run.keep_if_best(step, run.evaluate(agent), agent)
+        figures = run.evaluate(agent)
+        run.evaluations.append({"step": step, "round": rounds, **figures})
+        run.keep_if_best(step, figures, agent)
     if final is None:  # every round ended in an evaluation: the best of them is the policy
         final, tensors = run.best, run.best_tensors
     else:

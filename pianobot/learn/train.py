@@ -107,7 +107,8 @@ def _train(run: Run, stop_after: int | None) -> dict:
     returns, losses = np.zeros(n), None
     final = run.evaluate_start(agent)  # fine-tuning: the start's figures, when it already plays well enough
 
-    while final is None and step < config.steps and not run.finishing:
+    finishing = run.finishing and agent.updates > 0  # (a checkpoint before any learning step trains on)
+    while final is None and step < config.steps and not finishing:
         # act in every environment: explore (the teacher's action plus noise), then sample the policy
         vectors, tactiles = agent.split_batch(observations)
         each = [{k: v[i] for k, v in observations.items()} for i in range(n)]  # each environment's observation

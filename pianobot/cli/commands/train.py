@@ -130,7 +130,7 @@ FINISH_OPTION = typer.Option(
     "--finish",
     help="End interrupted runs at their checkpoints instead of training on: each stores the best policy it "
     "evaluated so far, its manifest saying the steps it took (give the interrupted command's other options). "
-    "A run without a checkpoint trains as usual.",
+    "A run without a checkpoint (said), or one cut before its first learning step, trains as usual.",
 )
 DEVICE_OPTION = typer.Option(
     TrainConfig.device,
@@ -255,6 +255,16 @@ def train(
     models.mkdir(parents=True, exist_ok=True)
     _say_skipped(console, plan, models)
     todo = plan.todo
+    if finish:
+        from pianobot.agent import store
+
+        for job in todo:
+            if store.checkpoint_state(job.folder) is None:
+                console.print(
+                    f"--finish: {job.folder} holds no checkpoint of this run (were all the interrupted command's "
+                    "options given?): it trains as usual",
+                    soft_wrap=True,
+                )
     console.print(
         f"training {len(todo)} polic{'y' if len(todo) == 1 else 'ies'} for {said(plan.label)}, {steps} steps each"
     )
