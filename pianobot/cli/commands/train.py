@@ -319,29 +319,15 @@ def _config(keyboard, hand, *, general_policy, task, **given) -> TrainConfig:
     g = dict(given)
     control, reward, joints, round_steps = g["control"], g["reward"], g["joints"], g["round_steps"]
     dagger_learning_rate, exploration_steps, actor = g["dagger_learning_rate"], g["exploration_steps"], g["actor"]
-    fingering_gate, tactile, steps, seed, learner = (
-        g["fingering_gate"],
-        g["tactile"],
-        g["steps"],
-        g["seed"],
-        g["learner"],
-    )
-    explore, until_f1, from_general, envs, device = (
-        g["explore"],
-        g["until_f1"],
-        g["from_general"],
-        g["envs"],
-        g["device"],
-    )
     with option("--control", control):
         world = WorldConfig(keyboard=KeyboardConfig(spec=keyboard), hand=hand_config(hand), control=control.value)
     with option("--reward", reward):
-        rewards = RewardConfig(kind=reward.value, fingering_gate=fingering_gate)
+        rewards = RewardConfig(kind=reward.value, fingering_gate=g["fingering_gate"])
     with option("--joints", joints):
         env = EnvConfig(
             world=world,
             reward=rewards,
-            tactile=tactile,
+            tactile=g["tactile"],
             actuated=tuple(j.strip() for j in joints.split(",") if j.strip()),
         )
     with option("--round-steps", round_steps):
@@ -355,19 +341,19 @@ def _config(keyboard, hand, *, general_policy, task, **given) -> TrainConfig:
         sac = SACConfig(exploration_steps=exploration_steps, actor=value(actor) or SACConfig.actor)
     with option():
         config = TrainConfig(
-            steps=steps,
-            seed=seed,
-            learner=learner.value,
+            steps=g["steps"],
+            seed=g["seed"],
+            learner=g["learner"].value,
             dagger=dagger,
-            explore=explore.value,
-            until_f1=until_f1,
+            explore=g["explore"].value,
+            until_f1=g["until_f1"],
             # a task family trains from scratch, or continues the policy --general-policy names
-            from_general=from_general and (task is None or general_policy is not None),
+            from_general=g["from_general"] and (task is None or general_policy is not None),
             sac=sac,
             env=env,
             eval_episodes=TASK_EVAL_EPISODES if task is not None else TrainConfig.eval_episodes,
-            envs=envs,
-            device=device.value,
+            envs=g["envs"],
+            device=g["device"].value,
             finish=g["finish"],
         )
     return config
