@@ -7,7 +7,9 @@ one hand, the longest one-hand example (`mary.mid`, 19.2 s) with the scripted pi
 hands, a two-hand chorale (`chorale-performed.mid`, 41.6 s) with the default controller (the
 packaged general policies through the hold guard). Beside each, in the same run, the same
 performance in this process after start-up (the plan performed and scored: what the command
-adds is the difference). With ``--peer DIR`` (a checkout of another pianobot commit, e.g. a
+adds is the difference). The commands run as a user's would: Python writes and reuses its
+bytecode cache (``PYTHONDONTWRITEBYTECODE`` is dropped from their environment), and one untimed
+run of each checkout fills it first, as any earlier use of the command does. With ``--peer DIR`` (a checkout of another pianobot commit, e.g. a
 ``git worktree``), the same commands of that checkout, run in turn with ours: the ratio of the
 medians is the speed-up. Real-time factor: seconds of music per second of wall clock; medians.
 Prints a Markdown table for docs/benchmarks.md.
@@ -16,6 +18,7 @@ Prints a Markdown table for docs/benchmarks.md.
 from __future__ import annotations
 
 import argparse
+import os
 import statistics
 import subprocess
 import sys
@@ -34,8 +37,9 @@ COMMANDS = {
 def command_seconds(song: str, options: list[str], scratch: Path, checkout: Path = ROOT) -> float:
     """Wall-clock seconds of `pianobot play <song>` in a fresh process, of the package in ``checkout``."""
     args = [sys.executable, "-m", "pianobot", "play", str(EXAMPLES / song), "-o", str(scratch / "o.mid"), "-q"]
+    env = {name: value for name, value in os.environ.items() if name != "PYTHONDONTWRITEBYTECODE"}
     started = time.perf_counter()
-    subprocess.run([*args, *options], check=True, capture_output=True, cwd=checkout)
+    subprocess.run([*args, *options], check=True, capture_output=True, cwd=checkout, env=env)
     return time.perf_counter() - started
 
 
@@ -76,6 +80,8 @@ def main(argv: list[str] | None = None) -> int:
         for name, (song, options) in COMMANDS.items():
             duration = pianobot.load_piece(EXAMPLES / song).duration
             library_seconds(song, options)  # (warm: imports and the policies' first load)
+            for checkout in [ROOT, args.peer] if args.peer else [ROOT]:
+                command_seconds(song, options, Path(scratch), checkout)  # (warm: the bytecode cache)
             ends, insides, peers = [], [], []
             for _ in range(args.runs):
                 ends.append(command_seconds(song, options, Path(scratch)))
