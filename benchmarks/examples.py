@@ -4,8 +4,9 @@ the figures of models/README.md and of the README's rows that quote them, writte
     python -m benchmarks.examples            # play, write models/examples.json and the tables
     python -m benchmarks.examples --check    # play, and fail where a recorded figure no longer holds
 
-The examples with phrase policies of their own (models/) and the two-hand examples (the
-packaged general policies) are played through the command line itself (`pianobot play
+The examples with phrase policies of their own (models/), the two-hand examples (the
+packaged general policies) and the two-hand examples played by the pianist's hands (:data:`PIANIST`:
+`make demo`'s second piece) are played through the command line itself (`pianobot play
 examples/midi/<name>.mid --seed N`, in this process), so that what is measured is what a user
 runs. The tables sit between ``<!-- examples:NAME -->`` and ``<!-- /examples:NAME -->`` markers;
 everything between them is rewritten. ``tests/test_examples_play.py`` runs the check.
@@ -53,11 +54,13 @@ def play(name: str, seed: int, scratch: Path) -> dict:
     from pianobot.cli.app import app
 
     stem, *options = name.split()
-    out, report = scratch / f"{stem}-{seed}.mid", scratch / f"{stem}-{seed}.json"
+    file = "".join(c if c.isalnum() else "-" for c in name)  # (its options too: one file per entry)
+    out, report = scratch / f"{file}-{seed}.mid", scratch / f"{file}-{seed}.json"
     args = ["play", str(EXAMPLES / f"{stem}.mid"), "-o", str(out), "--seed", str(seed), "--json", str(report), "-q"]
     result = CliRunner().invoke(app, [*args, *options, *PHRASE_POLICIES.get(name, [])])
     if result.exit_code:
-        raise RuntimeError(f"pianobot play {name}.mid --seed {seed} failed: {result.output.strip()}")
+        said = " ".join([f"{stem}.mid", *options])
+        raise RuntimeError(f"pianobot play {said} --seed {seed} failed: {result.output.strip()}")
     figures = json.loads(report.read_text())
     warnings = [line for line in result.output.splitlines() if line.startswith("warning:")]
     return {
@@ -177,7 +180,11 @@ def main(argv: list[str] | None = None) -> int:
     if args.tables:
         write_tables(json.loads(RECORD.read_text()))
         return 0
-    names = args.only.split(",") if args.only else [*PHRASE_POLICIES, *TWO_HANDS, *PIANIST]
+    known = [*PHRASE_POLICIES, *TWO_HANDS, *PIANIST]
+    names = [" ".join(name.split()) for name in args.only.split(",")] if args.only else known
+    unknown = [name for name in names if name not in known]
+    if unknown:
+        parser.error(f"--only {', '.join(unknown)}: not an example of the record; choose among {', '.join(known)}")
     played = play_all(names)
     recorded = json.loads(RECORD.read_text())["examples"] if RECORD.exists() else {}
     found = problems(played, recorded if args.check else {})
