@@ -115,6 +115,14 @@ def _f1s(entry: dict) -> str:
     return f"{f1s[0]:.3f} ×{len(f1s)}" if len(set(f1s)) == 1 else " / ".join(f"{f:.3f}" for f in f1s)
 
 
+def _each(entry: dict) -> str:
+    """An entry's note F1 in words: '1.000 from each of hand starts 0–3', or each start's."""
+    f1s = {seed: v["f1"] for seed, v in entry["seeds"].items()}
+    if len(set(f1s.values())) == 1:
+        return f"{next(iter(f1s.values())):.3f} from each of hand starts {min(f1s)}–{max(f1s)}"
+    return ", ".join(f"{f:.3f} from hand start {seed}" for seed, f in f1s.items())
+
+
 def _who(performer: str) -> str:
     """A performer in few words: 'own policies', 'task-parts-v2-... (hold guard)'."""
     who = performer.removeprefix("general policy ").replace(" (both hands in one simulation)", "")
@@ -145,7 +153,9 @@ def tables(record: dict) -> dict[str, str]:
     two = [e for e in record["examples"].values() if e["kind"] == "two-hand"]
     pianist = {name: e for name, e in record["examples"].items() if e["kind"] == "pianist"}
     lowest = lambda entries: min(v["f1"] for e in entries for v in e["seeds"].values())  # noqa: E731
-    by_pianist = "".join(f"; {_shown(name)} (`make demo`'s second piece): {_f1s(e)}" for name, e in pianist.items())
+    by_pianist = "".join(
+        f"; {_shown(name)} (`make demo`'s second piece, the pianist's hands): {_each(e)}" for name, e in pianist.items()
+    )
     return {
         "phrase": head + "\n".join(rows["phrase"]),
         "two-hand": head + "\n".join(rows["two-hand"] + rows["pianist"]),
