@@ -6,7 +6,20 @@ from __future__ import annotations
 
 import json
 
-from benchmarks.examples import FLOOR, PHRASE_POLICIES, PIANIST, RECORD, ROOT, TWO_HANDS, play_all, problems, tables
+import pytest
+
+from benchmarks.examples import (
+    FLOOR,
+    PHRASE_POLICIES,
+    PIANIST,
+    RECORD,
+    ROOT,
+    TWO_HANDS,
+    main,
+    play_all,
+    problems,
+    tables,
+)
 
 
 def _record() -> dict:
@@ -51,3 +64,15 @@ def test_a_figure_that_falls_is_found():
     fallen = json.loads(json.dumps({"twinkle": record["twinkle"]}))
     fallen["twinkle"]["seeds"]["0"]["f1"] = 0.929
     assert problems(fallen, record) and problems(fallen, {})  # below the record and below the floor
+
+
+def test_only_refuses_an_example_the_record_does_not_hold(capsys):
+    """`--only` names entries of the record (spaces normalised); another name is one line and exit 2,
+    before anything is played."""
+    with pytest.raises(SystemExit) as raised:
+        main(["--only", "ode-to-joy-performed  --hand-model pianist,no-such-piece"])
+    assert raised.value.code == 2
+    error = capsys.readouterr().err.strip().splitlines()[-1]
+    assert "--only no-such-piece: not an example of the record" in error
+    assert "ode-to-joy-performed --hand-model pianist" in error  # (the known names listed; the spaced one accepted)
+    assert "--only ode-to-joy" not in error
