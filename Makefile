@@ -17,7 +17,7 @@ install: $(BIN)/pianobot
 demo: install
 	mkdir -p out
 	$(BIN)/pianobot play examples/midi/twinkle.mid -o out/twinkle.mid --video out/twinkle.mp4 --html out/twinkle.html  # the paper's per-phrase SAC policies in models/
-	$(BIN)/pianobot play examples/midi/ode-to-joy-performed.mid --hand-model pianist -o out/ode-to-joy-pianist.mid --video out/ode-to-joy-pianist.mp4 --html out/ode-to-joy-pianist.html  # both hands, the pianist's five-finger hands (their packaged general policy)
+	$(BIN)/pianobot play examples/midi/ode-to-joy-performed.mid -o out/ode-to-joy-pianist.mid --video out/ode-to-joy-pianist.mp4 --html out/ode-to-joy-pianist.html  # both hands: the pianist's five-finger hands, a two-hand file's default (their packaged general policy)
 	@echo "open out/twinkle.html and out/ode-to-joy-pianist.html in a browser (they work offline): the video with its sound, the piano roll, every note"
 
 test: install

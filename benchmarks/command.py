@@ -2,10 +2,11 @@
 
     python -m benchmarks.command [--runs 5] [--peer DIR]
 
-Two commands, each run ``--runs`` times as a fresh process (`python -m pianobot play ... -q`):
+Three commands, each run ``--runs`` times as a fresh process (`python -m pianobot play ... -q`):
 one hand, the longest one-hand example (`mary.mid`, 19.2 s) with the scripted pianist; two
 hands, a two-hand chorale (`chorale-performed.mid`, 41.6 s) with the default controller (the
-packaged general policies through the hold guard). Beside each, in the same run, the same
+packaged general policies through the hold guard), played by the pianist's hands (the default for
+both hands) and by the Allegro-like hand (`--hand-model allegro`). Beside each, in the same run, the same
 performance in this process after start-up (the plan performed and scored: what the command
 adds is the difference). The commands run as a user's would: Python writes and reuses its
 bytecode cache (``PYTHONDONTWRITEBYTECODE`` is dropped from their environment), and one untimed
@@ -30,7 +31,11 @@ ROOT = Path(__file__).parent.parent
 EXAMPLES = ROOT / "examples" / "midi"
 COMMANDS = {
     "one hand, scripted pianist (`mary.mid`)": ("mary.mid", ["--controller", "scripted"]),
-    "two hands, default controller (`chorale-performed.mid`)": ("chorale-performed.mid", []),
+    "two hands, default controller: the pianist's hands (`chorale-performed.mid`)": ("chorale-performed.mid", []),
+    "two hands, the Allegro-like hand (`chorale-performed.mid --hand-model allegro`)": (
+        "chorale-performed.mid",
+        ["--hand-model", "allegro"],
+    ),
 }
 
 
@@ -49,16 +54,18 @@ def library_seconds(song: str, options: list[str]) -> float:
 
     import pianobot
     from pianobot.perform.together import read_hands
+    from pianobot.sim.hand import default_fingers
 
     controller = "scripted" if "scripted" in options else "sac"
     started = time.perf_counter()
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         if song == "mary.mid":
-            piece = pianobot.load_piece(EXAMPLES / song)
-        else:
-            piece = read_hands(EXAMPLES / song).piece
-        pianobot.play(piece, controller=controller, models=ROOT / "models").report()
+            piece, hand = pianobot.load_piece(EXAMPLES / song), {}
+        else:  # (both hands: the pianist's, unless the options name the Allegro-like hand, as `play` reads them)
+            spec = default_fingers("allegro" if "allegro" in options else "pianist")
+            piece, hand = read_hands(EXAMPLES / song, spec=spec).piece, {"hand": spec}
+        pianobot.play(piece, controller=controller, models=ROOT / "models", **hand).report()
     return time.perf_counter() - started
 
 

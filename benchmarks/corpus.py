@@ -29,9 +29,10 @@ has fingers) count as missed. ``notes`` is the file as ``pianobot play`` reads i
 more notes than two hands have fingers thinned), ``notes given`` how many of them the hands were
 given to play after that reduction: the most a player can strike. ``--apart`` plays each hand in a
 simulation of its own (``pianobot.perform.together.play_hands(..., together=False)``): what the
-hands lose by getting in each other's way. The hands' fingers are chosen per file as ``pianobot
-play`` chooses them (:func:`pianobot.perform.together.fingers_for_file`: the thumbs too where they
-keep notes three fingers leave out; the row's ``fingers``); ``--thumb`` gives each hand its thumb
+hands lose by getting in each other's way. By default the Allegro-like hand plays (``pianobot play
+--hand-model allegro``; ``play`` alone gives two-hand files the pianist's hands), its fingers chosen
+per file as ``play`` chooses them (:func:`pianobot.perform.together.fingers_for_file`: the thumbs
+too where they keep notes three fingers leave out; the row's ``fingers``); ``--thumb`` gives each hand its thumb
 everywhere (``pianobot play --thumb``), ``--no-thumb`` three fingers everywhere, ``--hand-model
 pianist`` the pianist's five fingers (its packaged parts policy beside the scripted pianist); the general
 policy plays where one for that hand is packaged (else the scripted pianist alone plays);
@@ -142,30 +143,47 @@ def write_excerpt(path: str, parts, first: int, out: Path) -> dict:
     return {"source": path, "measures": f"{first}-{last}"}
 
 
-def write_training(out: Path, count: int = TRAINING_COUNT) -> list[Path]:
+QUARTETS = ("mozart", "haydn", "beethoven")
+"""The composers whose string quartets :func:`write_training` may add (``quartets``): four parts that
+two hands play reduced, as in a quartet's piano reduction."""
+
+
+def write_training(out: Path, count: int = TRAINING_COUNT, quartets: bool = False) -> list[Path]:
     """Write excerpts of the first ``count`` Bach chorales of music21's corpus (its MusicXML files, by path, each
     from its first measure within the limits, as the test chorales are) to ``out``, none of the
     test or validation pieces, nor the Well-Tempered Clavier's prelude: training pieces for
-    ``pianobot train --task parts --pieces``. A chorale music21 cannot excerpt is passed over (said)."""
+    ``pianobot train --task parts --pieces``; ``quartets``: then an excerpt of every movement of the
+    string quartets of :data:`QUARTETS` (MusicXML), all four parts, from measure 1. A piece music21
+    cannot excerpt is passed over (said)."""
     from music21 import corpus
 
     used = {path for _, path, *_ in EXCERPTS + VALIDATION} | {"bach/bwv846"}
     scores = [str(p).split("corpus/")[-1] for p in corpus.getComposer("bach")]
     found = {p.rsplit(".", 1)[0] for p in scores if p.endswith(".mxl")}
     chorales = [p for p in sorted(found) if p not in used]
+    quartet_paths = []
+    for composer in QUARTETS if quartets else ():
+        paths = sorted(str(p).split("corpus/")[-1] for p in corpus.getComposer(composer))
+        quartet_paths += [p.rsplit(".", 1)[0] for p in paths if p.endswith(".mxl") and p.rsplit(".", 1)[0] not in used]
     out.mkdir(parents=True, exist_ok=True)
     written = []
     for path in chorales:
         if len(written) == count:
             break
-        file = out / (path.split("/")[-1].replace(".", "-") + ".mid")
-        try:
-            write_excerpt(path, None, 0, file)
-        except Exception as error:  # (music21's own errors: a score it cannot excerpt)
-            print(f"{path}: passed over ({str(error)[:80]})")
-            continue
-        written.append(file)
+        written += _excerpt_to(path, 0, out / (path.split("/")[-1].replace(".", "-") + ".mid"))
+    for path in quartet_paths:
+        written += _excerpt_to(path, 1, out / (path.replace("/", "-").replace(".", "-") + ".mid"))
     return written
+
+
+def _excerpt_to(path: str, first: int, file: Path) -> list[Path]:
+    """[``file``] with the excerpt of ``path`` from measure ``first`` written to it; [] (said) where music21 cannot."""
+    try:
+        write_excerpt(path, None, first, file)
+    except Exception as error:  # (music21's own errors: a score it cannot excerpt)
+        print(f"{path}: passed over ({str(error)[:80]})")
+        return []
+    return [file]
 
 
 def play_corpus(
@@ -289,6 +307,11 @@ def main() -> None:
         help="only write excerpts of other chorales to DIR, to train on (pianobot train --task parts --pieces DIR)",
     )
     parser.add_argument(
+        "--quartets",
+        action="store_true",
+        help="with --write-training: also excerpts of the string quartets of " + ", ".join(QUARTETS),
+    )
+    parser.add_argument(
         "--count",
         type=int,
         default=TRAINING_COUNT,
@@ -303,11 +326,13 @@ def main() -> None:
     if args.count < 1:
         parser.error(f"--count {args.count}: give 1 or more chorales")
     if args.write_training is not None:
-        written = write_training(args.write_training, args.count)
-        print(f"{len(written)} chorale excerpts written to {args.write_training}")
+        written = write_training(args.write_training, args.count, args.quartets)
+        print(f"{len(written)} excerpts written to {args.write_training}")
         return
     started = time.perf_counter()
-    hand = THUMB if args.thumb else HandSpec() if args.no_thumb else None  # (None: as play chooses)
+    hand = (
+        THUMB if args.thumb else HandSpec() if args.no_thumb else None
+    )  # (None: as play --hand-model allegro chooses)
     if args.hand_model is not None and args.hand_model != HandSpec.model:
         hand = default_fingers(args.hand_model)
     out = args.out or Path("out/corpus" if args.set == "test" else "out/corpus-validation")
@@ -315,7 +340,13 @@ def main() -> None:
     seconds = time.perf_counter() - started
     print()
     print(table(rows))
-    chosen = "with thumbs; " if args.thumb else "three fingers; " if args.no_thumb else "fingers as play chooses; "
+    chosen = (
+        "with thumbs; "
+        if args.thumb
+        else "three fingers; "
+        if args.no_thumb
+        else "the Allegro-like hand's fingers as play chooses; "
+    )
     if args.hand_model is not None:
         chosen = f"the {args.hand_model} hand; "
     how = ("each hand apart; " if args.apart else "") + chosen

@@ -151,8 +151,13 @@ def test_polyphony_and_missing_fingers(tmp_path):
     assert both.exit_code == 0, both.output
     text = " ".join(both.stdout.split())
     assert "`pianobot play` plays both" in text, text
-    assert "c.mid: one hand cannot play it (4 notes sound at once at 0.000 s" in " ".join(both.stderr.split())
-    assert re.search(r"right hand: [123] notes?, .* left hand: [123] notes?, ", text), text
+    # (no hand model named: the pianist's hands, whose one hand spans less than this seventh)
+    assert "c.mid: one hand cannot play it (the chord C4 E4 G4 B4 at 0.000 s spans" in " ".join(both.stderr.split())
+    assert re.search(r"right hand: [1-3] notes?, .* left hand: [1-3] notes?, ", text), text
+    allegro = run("inspect", tmp_path / "c.mid", "--hand-model", "allegro")
+    assert allegro.exit_code == 0, allegro.output
+    assert "c.mid: one hand cannot play it (4 notes sound at once at 0.000 s" in " ".join(allegro.stderr.split())
+    assert re.search(r"right hand: [123] notes?, .* left hand: [123] notes?, ", " ".join(allegro.stdout.split()))
     little = write_midi(Piece((Note(0, 60, 1, 80, 5),)), tmp_path / "l.mid")
     assert_one_line_error(run("inspect", little), "fingered 5 (little)")
 

@@ -135,10 +135,11 @@ def test_what_a_hand_is_given_is_said_once_per_kind(tmp_path):
 def test_both_hands_take_their_thumbs_where_they_keep_more_notes(tmp_path):
     """A right-hand chord of four notes: three fingers keep three of them, the thumb the fourth.
     By default both hands take their thumbs, said in one line, and every note plays; --no-thumb
-    plays with three fingers (six notes) and says nothing; a file three fingers play whole keeps them."""
+    plays with three fingers (six notes) and says nothing; a file three fingers play whole keeps them.
+    (The Allegro-like hand's rule: named with --hand-model allegro, as both hands are otherwise the pianist's.)"""
     right = _track((72, 0, 2), (76, 0, 2), (79, 0, 2), (84, 0, 2), (81, 2, 4))
     song = _duet(tmp_path / "four.mid", right=right)
-    result = run("play", song, "-o", tmp_path / "out.mid", "--controller", "scripted")
+    result = run("play", song, "-o", tmp_path / "out.mid", "--controller", "scripted", "--hand-model", "allegro")
     assert result.exit_code == 0, result.output
     lines = [line for line in " ".join(result.output.split()).split("warning: ") if "thumbs" in line]
     assert len(lines) == 1 and lines[0].startswith(
@@ -154,10 +155,10 @@ def test_both_hands_take_their_thumbs_where_they_keep_more_notes(tmp_path):
     assert "thumbs" not in three.output
     three = json.loads((tmp_path / "three.report.json").read_text())["hands"]["right"]
     assert three["given_to_the_hand"] == 4 and three["fingers"] == [2, 3, 4]
-    inspected = " ".join(run("inspect", song).output.split())
+    inspected = " ".join(run("inspect", song, "--hand-model", "allegro").output.split())
     assert "both hands play with their thumbs too: they are given 7 of the notes, three fingers 6" in inspected
     whole = _duet(tmp_path / "whole.mid")  # every note given to three fingers: they keep playing
-    result = run("play", whole, "-o", tmp_path / "w.mid", "--controller", "scripted")
+    result = run("play", whole, "-o", tmp_path / "w.mid", "--controller", "scripted", "--hand-model", "allegro")
     assert "thumbs" not in result.output
     assert json.loads((tmp_path / "w.report.json").read_text())["hands"]["left"]["fingers"] == [2, 3, 4]
 
@@ -235,8 +236,10 @@ def test_more_notes_at_once_than_two_hands_have_fingers_are_thinned_in_one_line(
     assert len(said) == 1 and "dropped 3 inner note(s)" in said[0], result.stderr
     report = json.loads((tmp_path / "out.report.json").read_text())
     assert report["reference_notes"] == 7  # the piece as both hands can hold it
-    # by default the hands take their thumbs, which hold eight of the nine
-    result = run("play", song, "-o", tmp_path / "out.mid", "--controller", "scripted", "--quiet")
+    # by default the Allegro-like hands take their thumbs, which hold eight of the nine
+    result = run(
+        "play", song, "-o", tmp_path / "out.mid", "--controller", "scripted", "--quiet", "--hand-model", "allegro"
+    )
     said = [line for line in result.stderr.splitlines() if "more than two hands of 4 fingers" in line]
     assert len(said) == 1 and "dropped 1 inner note(s)" in said[0], result.stderr
 
@@ -331,11 +334,12 @@ def test_the_keyboard_options_name_the_keys_each_hand_plays_on(tmp_path):
     report = tmp_path / "out.report.json"
     assert run(*args).exit_code == 0
     default = json.loads(report.read_text())["hands"]
-    assert default["right"]["played_as"] == "on C5-B5 (12 keys)"  # the scripted pianist: the part's own octaves
+    assert default["right"]["played_as"] == "on C5-B5 (12 keys), the pianist hand"  # the part's own octaves
     assert run(*args, "--lowest-note", "C3", "--keys", "36").exit_code == 0
     hands = json.loads(report.read_text())["hands"]
-    assert hands["right"]["played_as"] == "on C3-B5 (36 keys)"
-    assert hands["left"]["played_as"] == "mirrored about D, on C3-B5 (36 keys)" and hands["left"]["f1"] == 1.0
+    assert hands["right"]["played_as"] == "on C3-B5 (36 keys), the pianist hand"
+    assert hands["left"]["played_as"] == "mirrored about D, on C3-B5 (36 keys), the pianist hand"
+    assert hands["left"]["f1"] == 1.0
 
 
 def test_a_pig_file_with_both_hands_channels_plays_both_hands(tmp_path):
@@ -356,10 +360,17 @@ def test_finger_writes_each_hands_fingering_one_track_each(tmp_path):
     assert result.exit_code == 0, result.output
     fingered = read_midi(tmp_path / "fingered.mid")
     assert fingered.hands == ("right", "left") and fingered.has_fingering
-    assert all(n.finger in (2, 3, 4) for n in fingered.notes)
+    assert all(n.finger in (1, 2, 3, 4, 5) for n in fingered.notes)  # (the pianist's hands: a two-hand file's)
     assert [(n.pitch, n.hand) for n in fingered.notes] == [(n.pitch, n.hand) for n in load_hands(song).notes]
     text = " ".join(result.stdout.split())
-    assert "left hand, fingers 2 (index), 3 (middle), 4 (ring): wrist travel" in text and "one track per hand" in text
+    assert (
+        "left hand, fingers 1 (thumb), 2 (index), 3 (middle), 4 (ring), 5 (little) of the pianist hand: wrist" in text
+    )
+    assert "one track per hand" in text
+    allegro = run("finger", song, "-o", tmp_path / "allegro.mid", "--hand-model", "allegro")
+    assert allegro.exit_code == 0, allegro.output
+    assert all(n.finger in (2, 3, 4) for n in read_midi(tmp_path / "allegro.mid").notes)
+    assert "left hand, fingers 2 (index), 3 (middle), 4 (ring): wrist travel" in " ".join(allegro.stdout.split())
 
 
 def test_both_hands_play_the_packaged_parts_policy_unless_policy_names_another(tmp_path):
@@ -499,7 +510,8 @@ def test_score_of_one_hand_of_a_wide_part_scores_it(tmp_path):
 
 def test_a_one_hand_file_with_chords_is_fingered_once(tmp_path, monkeypatch):
     """Asking whether one hand plays an unfingered file with chords plans its fingering; reading it
-    for that hand then reuses the plan rather than planning the same notes again."""
+    for that hand then reuses the plan rather than planning the same notes again (with no hand model
+    named, the pianist's one hand is asked too: one plan more)."""
     from pianobot.pianist import fingering
 
     calls = []
@@ -507,9 +519,12 @@ def test_a_one_hand_file_with_chords_is_fingered_once(tmp_path, monkeypatch):
     monkeypatch.setattr(fingering, "plan_fingering", lambda *a, **k: calls.append(1) or planner(*a, **k))
     fingering._plan.cache_clear()
     song = _one_track(tmp_path / "chords.mid", (60, 0, 1), (64, 0, 1), (62, 1, 2), (65, 1, 2), (64, 2, 3), (67, 2, 3))
-    result = run("inspect", song)
+    result = run("inspect", song, "--hand-model", "allegro")
     assert result.exit_code == 0, result.output
     assert "playable" in result.stdout and len(calls) == 1, (calls, result.output)
+    fingering._plan.cache_clear()
+    result = run("inspect", song)
+    assert result.exit_code == 0 and "playable" in result.stdout and len(calls) == 3, (calls, result.output)
 
 
 def test_a_two_hand_files_own_fingering_is_said_to_be_replaced_by_the_planners(tmp_path):
@@ -519,10 +534,16 @@ def test_a_two_hand_files_own_fingering_is_said_to_be_replaced_by_the_planners(t
 
     right = RIGHT + [(round(beat * 480), lyric("3")) for beat in range(4)]
     song = _duet(tmp_path / "fingered.mid", right=right)
-    quiet = run("play", song, "-o", tmp_path / "out.mid", "--controller", "scripted", "--quiet")
+    quiet = run(
+        "play", song, "-o", tmp_path / "out.mid", "--controller", "scripted", "--quiet", "--hand-model", "allegro"
+    )
     assert quiet.exit_code == 0, quiet.output
     said = " ".join(quiet.stderr.split())
     assert said.count("fingering (4 of 6 notes) is not used with both hands") == 1, said
+    pianist = run("play", song, "-o", tmp_path / "pianist.mid", "--controller", "scripted", "--quiet")
+    assert (
+        pianist.exit_code == 0 and "is not used" not in pianist.stderr
+    )  # (a human's marks: the pianist's hands keep them)
     assert "--hand right or --hand left" in said
     plain = run("play", _duet(tmp_path / "plain.mid"), "-o", tmp_path / "p.mid", "--controller", "scripted", "-q")
     assert "is not used with both hands" not in plain.stderr
@@ -537,12 +558,14 @@ def test_finger_says_when_the_fingered_file_holds_fewer_notes_than_the_piece(tmp
         result.output.split()
     )
     assert len(read_midi(tmp_path / "fingered.mid").notes) == 6
-    # by default the hands take their thumbs, which span the octave: every note, one for a thumb
-    thumbs = run("finger", song, "-o", tmp_path / "thumbs.mid")
+    # by default the Allegro-like hands take their thumbs, which span the octave: every note, one for a thumb
+    thumbs = run("finger", song, "-o", tmp_path / "thumbs.mid", "--hand-model", "allegro")
     assert "both hands play with their thumbs too" in " ".join(thumbs.output.split()), thumbs.output
     fingered = read_midi(tmp_path / "thumbs.mid").notes
     assert len(fingered) == 7 and any(n.finger == 1 for n in fingered)
-    whole = run("finger", _duet(tmp_path / "plain.mid"), "-o", tmp_path / "plain-fingered.mid")
+    whole = run(
+        "finger", _duet(tmp_path / "plain.mid"), "-o", tmp_path / "plain-fingered.mid", "--hand-model", "allegro"
+    )
     assert "reduced away" not in whole.output
 
 
@@ -564,10 +587,10 @@ def test_score_of_one_hands_part_off_the_default_keys_reduces_it_as_play_did(tmp
 def test_the_thumbs_count_a_chord_note_three_fingers_reading_thinned(tmp_path):
     """A seven-note chord: read for three fingers (six on two hands) one inner note is thinned
     away before any hand is given it; the hands with their thumbs keep all seven, so they play
-    with them."""
+    with them (the Allegro-like hand's rule)."""
     chord = _track(*[(p, 0, 2) for p in (48, 52, 55, 60, 64, 67, 72)], (74, 2, 4), (45, 2, 4))
     song = midi_file(tmp_path / "seven.mid", [("Piano", chord)])
-    result = run("play", song, "-o", tmp_path / "out.mid", "--controller", "scripted")
+    result = run("play", song, "-o", tmp_path / "out.mid", "--controller", "scripted", "--hand-model", "allegro")
     assert result.exit_code == 0, result.output
     assert "both hands play with their thumbs too: they are given 9 of the notes, three fingers 8" in " ".join(
         result.output.split()

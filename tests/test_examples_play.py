@@ -9,9 +9,9 @@ import json
 import pytest
 
 from benchmarks.examples import (
+    ALLEGRO,
     FLOOR,
     PHRASE_POLICIES,
-    PIANIST,
     RECORD,
     ROOT,
     TWO_HANDS,
@@ -41,7 +41,7 @@ def test_the_docs_hold_the_record_s_figures():
 
 def test_the_record_keeps_the_promises():
     record = _record()["examples"]
-    assert set(record) == {*PHRASE_POLICIES, *TWO_HANDS, *PIANIST}
+    assert set(record) == {*PHRASE_POLICIES, *TWO_HANDS, *ALLEGRO}
     for entry in record.values():
         assert [int(s) for s in entry["seeds"]] == [0, 1, 2, 3]
         assert all(v["f1"] >= FLOOR[entry["kind"]] for v in entry["seeds"].values())
@@ -53,9 +53,10 @@ def test_the_examples_with_phrase_policies_play_as_recorded_from_every_hand_star
 
 
 def test_the_two_hand_examples_play_as_recorded_from_hand_start_0():
-    """Either hand model's (`make demo`'s second piece, the pianist's hands, among them). (Hand
-    starts 1-3 too with `python -m benchmarks.examples --check`: four minutes more.)"""
-    played = play_all([*TWO_HANDS, *PIANIST], seeds=(0,), say=lambda line: None)
+    """As `play` plays them (the pianist's hands; `make demo`'s second piece among them), and two of
+    them with the Allegro-like hand. (Every entry from hand starts 0-3 with `python -m
+    benchmarks.examples --check`: ten minutes more.)"""
+    played = play_all([*TWO_HANDS, *ALLEGRO[:2]], seeds=(0,), say=lambda line: None)
     assert not problems(played, _record()["examples"])
 
 
@@ -70,9 +71,9 @@ def test_only_refuses_an_example_the_record_does_not_hold(capsys):
     """`--only` names entries of the record (spaces normalised); another name is one line and exit 2,
     before anything is played."""
     with pytest.raises(SystemExit) as raised:
-        main(["--only", "ode-to-joy-performed  --hand-model pianist,no-such-piece"])
+        main(["--only", "ode-to-joy-performed  --hand-model allegro,no-such-piece"])
     assert raised.value.code == 2
     error = capsys.readouterr().err.strip().splitlines()[-1]
     assert "--only no-such-piece: not an example of the record" in error
-    assert "ode-to-joy-performed --hand-model pianist" in error  # (the known names listed; the spaced one accepted)
+    assert "ode-to-joy-performed --hand-model allegro" in error  # (the known names listed; the spaced one accepted)
     assert "--only ode-to-joy" not in error

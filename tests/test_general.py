@@ -223,7 +223,7 @@ def test_train_a_two_hand_file_trains_each_hands_part_and_play_plays_what_was_ju
 
     right, left = track((72, 0, 1), (74, 1, 2), (76, 2, 3)), track((48, 0, 2), (55, 2, 3))
     song = midi_file(tmp_path / "duet.mid", [("Right Hand", right), ("Left Hand", left)])
-    result = run("train", song, *QUICK, "--models", models, "--json", "-")
+    result = run("train", song, *QUICK, "--models", models, "--json", "-", "--hand-model", "allegro")
     assert result.exit_code == 0, result.output
     said = " ".join(result.stderr.split())
     assert f"starting the right hand's phrases from the general policy {general}" in said

@@ -187,7 +187,8 @@ def find_general(
     user's (``path``, or in ``models``) that does not fit is refused: a one-line
     :class:`PianobotError` naming the first field that differs (and its option) and ``remedy``.
     The packaged one that does not fit is passed over (a run with other options than the
-    committed policy's trains from scratch, as it would with no general policy)."""
+    committed policy's trains from scratch, as it would with no general policy), and so is one in
+    ``models`` of another hand model (a body it cannot drive, not an option mistyped)."""
     if path is not None:
         if not store.is_trained(Path(path)):
             raise PianobotError(
@@ -204,6 +205,8 @@ def find_general(
     first = None
     for folder in candidates:
         their_env, their_sac = policy_configs(folder)
+        if path is None and their_env.world.hand.spec.model != env.world.hand.spec.model:
+            continue
         their_env = on_keyboard(their_env, their_sac, env.world.keyboard.spec)
         found = difference(env, their_env, sac, their_sac if sac is not None else None)
         if found is None:

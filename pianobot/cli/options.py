@@ -6,7 +6,8 @@ import contextlib
 import functools
 import inspect
 import os
-from dataclasses import dataclass
+import warnings
+from dataclasses import dataclass, replace
 from enum import StrEnum
 from pathlib import Path
 from typing import Optional
@@ -16,7 +17,7 @@ import typer
 from pianobot.agent.config import ACTORS, DEVICES
 from pianobot.agent.store import DEFAULT_STORE
 from pianobot.env.rewards import REWARDS
-from pianobot.errors import PianobotError, SettingError, quote
+from pianobot.errors import PianobotError, PianobotWarning, SettingError, quote
 from pianobot.learn.config import LEARNERS
 from pianobot.learn.explore import EXPLORATIONS
 from pianobot.music.instrument import PIANO, HandSpec, KeyboardSpec
@@ -112,7 +113,7 @@ READING = {  # parameter name: (type, option); the commands' --help shows them i
     "pedal": _reading(bool, LoadOptions.pedal, "--pedal/--no-pedal", "Play and score the file's sustain pedal (CC64)."),
     "lowest_note": _reading(Optional[str], None, "--lowest-note", f"Lowest key, e.g. C4 or 60 (default {pitch_name(KeyboardSpec.lowest)} or the piece's).", INSTRUMENT),
     "keys": _reading(Optional[int], None, "--keys", f"Number of keys (default {KeyboardSpec.count} or the piece's).", INSTRUMENT),
-    "hand_model": _reading(HandModelName, HandSpec.model, "--hand-model", "allegro (the paper's) or pianist (five fingers).", INSTRUMENT),
+    "hand_model": _reading(Optional[HandModelName], None, "--hand-model", "allegro (the paper's; one hand's default) or pianist (both hands').", INSTRUMENT),
     "thumb": _reading(Optional[bool], None, "--thumb/--no-thumb", "The Allegro hand's thumb (default: if more notes).", INSTRUMENT),
 }
 # fmt: on
@@ -131,6 +132,10 @@ class Reading:
     hand_named: bool = False
     """Whether the fingers are named: --thumb or --no-thumb given, or a hand with one finger set (else the reading
     (:func:`~pianobot.pianist.reading.choose_fingers`) may give both hands their thumbs)."""
+    model_named: bool = True
+    """Whether the hand model is named: --hand-model given, or --thumb/--no-thumb (the Allegro-like
+    hand's); else :attr:`hand` is the Allegro-like hand's, and the reading chooses the model
+    (:func:`~pianobot.pianist.reading.choose_model`)."""
 
 
 def make_reading(**given) -> Reading:
@@ -149,6 +154,7 @@ def make_reading(**given) -> Reading:
             "keyboard.lowest",
             "keyboard.count",
         )
+    model_named = values["hand_model"] is not None or values["thumb"] is not None
     hand, hand_named = _fingers(value(values["hand_model"]) or HandSpec.model, values["thumb"])
     return Reading(
         options=LoadOptions(
@@ -166,6 +172,7 @@ def make_reading(**given) -> Reading:
         hand=hand,
         keyboard_named=named,
         hand_named=hand_named,
+        model_named=model_named,
     )
 
 
@@ -279,14 +286,29 @@ WORDING = dict(
 """What undoes a choice the reading makes, in the command line's words (:class:`~pianobot.pianist.reading.Wording`)."""
 
 
-def read_file(song, reading: Reading, *, finger: bool = True, quiet: bool = False, both: bool = True, fit: bool = True):
+def read_file(
+    song,
+    reading: Reading,
+    *,
+    finger: bool = True,
+    quiet: bool = False,
+    both: bool = True,
+    fit: bool = True,
+    models: Path | None = None,
+    policy: Path | None = None,
+):
     """``song`` (a path, or a file already read: :func:`~pianobot.pianist.reading.open_song`) read as the reading options say, once (:func:`~pianobot.pianist.reading.read_piece`):
-    the keyboard and the fingers chosen where --lowest-note/--keys and --thumb/--no-thumb name none,
-    each choice said in one line (not ``quiet``); ``finger``: one hand's part fingered too;
-    ``both``: both hands where the file plays both; ``fit``: a one-hand part wider than the keys refused."""
-    from pianobot.pianist.reading import Wording, read_piece
+    the keyboard, the hand model and the fingers chosen where --lowest-note/--keys, --hand-model and
+    --thumb/--no-thumb name none, each choice said in one line (not ``quiet``); ``finger``: one hand's part fingered too;
+    ``both``: both hands where the file plays both; ``fit``: a one-hand part wider than the keys refused;
+    ``models``: a model store whose phrase policies for this file were trained with one hand model
+    makes that the model where none is named (:func:`stored_model`); ``policy``: a general policy's
+    folder named, whose hand (model and fingers) is played where none is named (:func:`policy_hand`)."""
+    from pianobot.pianist.reading import PIANIST, Wording, read_piece
 
-    return read_piece(
+    reading = reading if policy is None else policy_hand(reading, Path(policy))
+    stored = None if reading.model_named else stored_model(song, models)
+    read = read_piece(
         song,
         reading.options,
         reading.keyboard if reading.keyboard_named else None,
@@ -296,8 +318,46 @@ def read_file(song, reading: Reading, *, finger: bool = True, quiet: bool = Fals
         fit=fit,
         quiet=quiet,
         wording=Wording(**WORDING),
-        model=reading.hand.model,
+        model=reading.hand.model if reading.model_named else stored,
     )
+    if stored is not None and not quiet and (stored == PIANIST) != read.both:  # (the file would choose another)
+        warnings.warn(
+            PianobotWarning(
+                f"{read.name}: played with the {stored} hand, which its phrase policies in {models} were trained "
+                "for (--hand-model names another)"
+            )
+        )
+    return read
+
+
+def stored_model(song, models: Path | None) -> str | None:
+    """The hand model of the phrase policies the store ``models`` holds for ``song`` (by the file's
+    name), where they are all of one; else None (the reading chooses:
+    :func:`~pianobot.pianist.reading.choose_model`). So a piece trained before keeps playing with
+    the hand its policies were trained for."""
+    from pianobot.agent.store import piece_hand_models
+    from pianobot.music.midi_io import source_path
+
+    if models is None:
+        return None
+    name = source_path(song).name
+    found = piece_hand_models(models, name)
+    if len(found) != 1:
+        return None
+    (model,) = found
+    return model
+
+
+def policy_hand(reading: Reading, folder: Path) -> Reading:
+    """``reading`` with the hand (model and fingers) the policy in ``folder`` was trained for, where
+    its options name no hand model: a general policy named plays the hand it knows."""
+    from pianobot.agent.policy import policy_configs
+    from pianobot.agent.store import is_trained
+
+    if reading.model_named or not is_trained(folder):  # (a folder without a policy: the command says so)
+        return reading
+    spec = policy_configs(folder)[0].world.hand.spec
+    return replace(reading, hand=spec, hand_named=True, model_named=True)
 
 
 def finger_file(read, reading: Reading):

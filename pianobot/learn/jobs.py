@@ -27,7 +27,8 @@ from pianobot.music.instrument import check_playable
 from pianobot.music.load import LoadOptions
 from pianobot.music.phrases import Phrase
 from pianobot.music.tasks import GIVEN_SHARE, PARTS, VERSIONS
-from pianobot.pianist.reading import prepare_part, two_hands
+from pianobot.pianist.parts import prepare_part
+from pianobot.pianist.reading import two_hands
 
 
 @dataclass

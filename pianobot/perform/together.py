@@ -48,15 +48,14 @@ from pianobot.perform.judge import play_one_hand
 from pianobot.perform.plan import Performance
 from pianobot.perform.rollout import Rollout
 from pianobot.pianist.assign import finger_apart
+from pianobot.pianist.parts import given_notes, prepare_part  # noqa: F401 (kept here too)
 from pianobot.pianist.reading import (  # noqa: F401 (the reading, pianist/reading.py's: these names kept here too)
     THUMBS_CHOSEN,
     HandsReading,
     _warn_again,
     fingers_for_file,
-    given_notes,
     names_hands,
     one_hand_refusal,
-    prepare_part,
     read_hands,
     thumbs_keep_more,
     two_hands,
@@ -114,15 +113,21 @@ class HandPerformance:
 
     def describe(self) -> str:
         """Where and with what the simulated hand played the part: 'mirrored about D, moved up 1
-        octave, on C4-B5 (24 keys)', and ', with its thumb' where it had one."""
+        octave, on C4-B5 (24 keys)', and ', with its thumb' where the Allegro-like hand had one (another
+        hand model: ', the pianist hand')."""
         moves = []
         if self.hand == "left":
             moves.append("mirrored about D")
         if self.window.octaves:
             octaves = abs(self.window.octaves)
             moves.append(f"moved {'up' if self.window.octaves > 0 else 'down'} {octaves} octave{'s' * (octaves > 1)}")
-        thumb = [f"with its {FINGER_NAMES[1]}"] if 1 in self.performance.plan.config.world.hand.spec.fingers else []
-        return ", ".join(moves + [f"on {self.window.keyboard.describe()}"] + thumb)
+        spec = self.performance.plan.config.world.hand.spec
+        thumb = [f"with its {FINGER_NAMES[1]}"] if 1 in spec.fingers else []
+        return ", ".join(
+            moves
+            + [f"on {self.window.keyboard.describe()}"]
+            + (thumb if spec.model == "allegro" else [f"the {spec.model} hand"])
+        )
 
 
 @dataclass(frozen=True)

@@ -5,8 +5,10 @@ Every command that reads a piece (``play``, ``score``, ``inspect``, ``finger``, 
 
 1. :func:`open_song`: the file read and parsed, once (a PIG .txt file is read as text where
    needed); every later step derives what it needs from what was read;
-2. :func:`choose_fingers`: the hand model's finger set both hands play with where none is named
-   (:func:`keeps_more`: the Allegro-like hand's thumbs where they keep notes three fingers leave out);
+2. :func:`choose_model`: where no hand model is named, the pianist's hands for a file they play
+   with both hands, else the Allegro-like hand; :func:`choose_fingers`: the hand model's finger set
+   both hands play with where none is named (:func:`keeps_more`: the Allegro-like hand's thumbs
+   where they keep notes three fingers leave out);
 3. :func:`read_both_hands`: whether the file plays both hands (:func:`two_hands`), and then every
    note with its hand (:class:`HandsReading`);
 4. otherwise one hand's part: :func:`choose_keys` (the keys it needs where none are named) and
@@ -19,7 +21,7 @@ Every command that reads a piece (``play``, ``score``, ``inspect``, ``finger``, 
 hand's part, what was reduced and why, fingering, fingers, keyboard, the sustain pedal). Each step
 says what it did in a :class:`~pianobot.errors.PianobotWarning`, or refuses a file in a one-line
 :class:`~pianobot.errors.PianobotError`; the caller words what undoes a choice (:class:`Wording`).
-Each hand's part as its player is given it (:func:`prepare_part`) is here too.
+Each hand's part as its player is given it is :mod:`pianobot.pianist.parts`'s.
 """
 
 from __future__ import annotations
@@ -31,15 +33,15 @@ from pathlib import Path
 from pianobot.errors import PianobotError, PianobotWarning
 from pianobot.music import midi_io
 from pianobot.music.instrument import THUMB, HandSpec, KeyboardSpec, check_playable, keys_for, suggest_transpose
-from pianobot.music.load import LoadOptions, end_legato, load_hands, load_part, load_pedal, load_piece, thin_hand
+from pianobot.music.load import LoadOptions, end_legato, load_hands, load_part, load_pedal, load_piece
 from pianobot.music.midi_io import MidiSource, TrackInfo, source_path
 from pianobot.music.pedal import Pedal
 from pianobot.music.piece import HANDS, Piece, pitch_name
-from pianobot.music.window import Window, window_for
-from pianobot.pianist.assign import load_two_hands, reduce_hand
+from pianobot.pianist.assign import load_two_hands
 from pianobot.pianist.fingering import FingeringPlan, ensure_fingering
+from pianobot.pianist.parts import given_notes
 from pianobot.pianist.reduce import load_for_hand
-from pianobot.sim.hand import hand_model
+from pianobot.sim.hand import default_fingers, hand_model
 
 Source = Path | MidiSource
 """A file to read: a PIG .txt file's path, or a .mid file read once (:func:`open_song`)."""
@@ -124,6 +126,31 @@ def choose_fingers(
     return hand, counts
 
 
+PIANIST = "pianist"
+"""The hand model that plays a two-hand file where none is named (:func:`choose_model`)."""
+
+
+def choose_model(
+    source: Source, options: LoadOptions, keyboard: KeyboardSpec | None = None
+) -> tuple[str, HandsReading | None]:
+    """The hand model a file is played with where none is named, and its both hands' reading: the
+    pianist's hands (:data:`PIANIST`) where they play the file with both hands (:func:`two_hands`:
+    tracks named for hands, or notes one of their hands cannot play), as the validation sets favour
+    them for two-hand music (docs/benchmarks.md, "The pianist's hand"); else the Allegro-like hand
+    (``HandSpec.model``), whose melody policy plays one hand's melodies better (its reading then
+    says what it says, the pianist's reading nothing: also where that refused the file)."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            hands = two_hands(source, options, default_fingers(PIANIST), keyboard or KeyboardSpec())
+        except PianobotError:
+            hands = None
+    if hands is None:
+        return HandSpec.model, None
+    _warn_again(caught)
+    return PIANIST, hands
+
+
 def read_both_hands(
     source: Source, options: LoadOptions, fingers: HandSpec, keyboard: KeyboardSpec = KeyboardSpec()
 ) -> HandsReading | None:
@@ -206,11 +233,12 @@ def read_piece(
     fit: bool = True,
     quiet: bool = False,
     wording: Wording = Wording(),
-    model: str = HandSpec.model,
+    model: str | None = HandSpec.model,
 ) -> ReadPiece:
     """The file at ``path`` read once for its players, step by step (the module's notes).
     ``keyboard``, ``fingers``: None where none are named (then chosen, ``fingers`` among ``model``'s
-    finger sets, each choice said unless ``quiet``). ``finger``: one hand's part also fingered
+    finger sets, each choice said unless ``quiet``); ``model`` None: the hand model is chosen too
+    (:func:`choose_model`; without ``both``, the Allegro-like hand). ``finger``: one hand's part also fingered
     (:func:`finger_part`; else :attr:`ReadPiece.piece` is None for one hand). ``both``: ask whether
     it plays both hands. ``fit``: as :func:`~pianobot.pianist.reduce.load_for_hand`'s."""
     source = open_song(path)
@@ -218,8 +246,15 @@ def read_piece(
     tracks = tracks_of(source)
     pedal = load_pedal(source, options)
     thumbs = None
+    if fingers is None and model is None and both:
+        model, hands = choose_model(source, options, keyboard)
+        if hands is not None:
+            keys = keyboard or KeyboardSpec()
+            return ReadPiece(
+                name, source, tracks, keys, default_fingers(model), None, hands, piece=hands.piece, pedal=pedal
+            )
     if fingers is None:
-        fingers, thumbs = choose_fingers(source, options, quiet, wording, model)
+        fingers, thumbs = choose_fingers(source, options, quiet, wording, model or HandSpec.model)
     hands = read_both_hands(source, options, fingers, keyboard or KeyboardSpec()) if both else None
     if hands is not None:
         keys = keyboard or KeyboardSpec()
@@ -382,64 +417,6 @@ def one_hand_refusal(piece: Piece, spec: HandSpec, keyboard: KeyboardSpec, refin
 def _warn_again(caught: list) -> None:
     for warning in caught:
         warnings.warn(warning.message)
-
-
-def prepare_part(
-    piece: Piece,
-    hand: str,
-    keyboard: KeyboardSpec | None,
-    fingers: HandSpec,
-    start: float | None = None,
-    grow: bool = False,
-) -> tuple[Window, Piece, float, int]:
-    """``hand``'s part of ``piece`` as the simulated hand is given it: (window, part, start, notes
-    left out), the part moved ``start`` seconds earlier (default: to its first note); ``grow``: a
-    part wider than ``keyboard`` is given its own range instead (:func:`~pianobot.music.window.window_for`).
-    Each kind of change is one :class:`PianobotWarning`, worded for the written part."""
-    window, reduced, start, left_out = _reduced_part(piece, hand, keyboard, fingers, start, grow)
-    written = hand_model(fingers.model).written_fingering  # (the file's marks kept where the hand can)
-    fingered, _ = ensure_fingering(reduced, window.keyboard, fingers, refinger=not written)
-    return window, fingered, start, left_out
-
-
-def _reduced_part(
-    piece: Piece, hand: str, keyboard: KeyboardSpec | None, fingers: HandSpec, start: float | None, grow: bool
-) -> tuple[Window, Piece, float, int]:
-    """:func:`prepare_part`'s part before it is fingered."""
-    part = piece.part(hand)
-    window = window_for(part, hand, keyboard, grow)
-    inside = [n for n in part.notes if window.inward(n.pitch) in window.keyboard]
-    left_out = len(part) - len(inside)
-    if left_out:
-        warnings.warn(
-            PianobotWarning(
-                f"the {hand} hand's part spans more than the {window.keyboard.count} keys its player knows: "
-                f"left out {left_out} note(s) outside them"
-            )
-        )
-    if not inside:
-        raise PianobotError(f"none of the {hand} hand's notes fits the keyboard its player knows")
-    marks = hand_model(fingers.model).written_fingering and all(n.finger in (None, *fingers.fingers) for n in inside)
-    moved = Piece(tuple(replace(n, pitch=window.inward(n.pitch), hand=None) for n in inside), bpm=piece.bpm)
-    moved = moved if marks else moved.without_fingering()
-    start = moved.notes[0].onset if start is None else start
-    # (the simulated hand is a right hand: its top notes are a left hand's lowest)
-    thinned = thin_hand(moved.shift(-start), hand, fingers, "lowest" if hand == "left" else "highest")
-    return window, reduce_hand(thinned, window.keyboard, fingers, hand), start, left_out
-
-
-def given_notes(piece: Piece, fingers: HandSpec, keyboard: KeyboardSpec | None = None) -> int | None:
-    """How many of ``piece``'s notes both hands are given with ``fingers`` (:func:`prepare_part`), on
-    ``keyboard`` (default: 24 keys or a wider part's own octaves); None where a part is refused."""
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", PianobotWarning)
-        try:
-            return sum(
-                len(_reduced_part(piece, h, keyboard or KeyboardSpec(), fingers, None, keyboard is None)[1])
-                for h in piece.hands
-            )
-        except PianobotError:
-            return None
 
 
 def keeps_more(

@@ -60,19 +60,19 @@ def inspect(
     source = open_song(song)  # (the file read once: all below derives from it)
     tracks, named, tempi = _show_tracks(console, song, source, options)
     try:
-        read = read_file(source, reading, finger=False)
+        read = read_file(source, reading, finger=False, models=models)
     except PianobotError:
         if named:
             raise  # the two-hand reading's refusal (notes beyond the piano)
         read = None  # one hand's reading, below, says what it found, then what is wrong
     both = None if read is None else read.hands
     if both is not None:
-        _both_hands(console, both, tracks, json_path, tempi)
+        _both_hands(console, both, tracks, json_path, tempi, read.fingers)
         return
     if len([t for t in tracks if t.notes]) > 1 and options.track is None and options.hand is None:
         console.print("[yellow]several tracks are merged; play one part with --track N or --hand right|left[/yellow]")
     if read is None:
-        read = read_file(source, reading, finger=False, both=False)
+        read = read_file(source, reading, finger=False, both=False, models=models)
     keyboard, hand_spec, piece = read.keyboard, read.fingers, read.part
     line, data = _summary(piece, tempi)
     console.print(line)
@@ -187,8 +187,9 @@ def _summary(piece, tempi: list[float] | None = None) -> tuple[str, dict]:
     return line, data
 
 
-def _both_hands(console, reading, tracks, json_path, tempi=None) -> None:
-    """What `inspect` says of a file `play` plays with both hands: each hand in play's words."""
+def _both_hands(console, reading, tracks, json_path, tempi, fingers) -> None:
+    """What `inspect` says of a file `play` plays with both hands: each hand in play's words, and
+    the hand (``fingers``: the model and fingers the reading chose)."""
     from pianobot.perform.together import TOGETHER
 
     line, data = _summary(reading.piece, tempi)
@@ -196,7 +197,8 @@ def _both_hands(console, reading, tracks, json_path, tempi=None) -> None:
     for hand in reading.piece.hands:
         console.print(said(reading.describe(hand)), soft_wrap=True)
     console.print(
-        f"[green]two hands[/green]: `pianobot play` plays both, {TOGETHER}; --hand right|left plays one hand's part",
+        f"[green]two hands[/green]: `pianobot play` plays both, {TOGETHER}, with fingers {said(fingers.describe())}; "
+        "--hand right|left plays one hand's part",
         soft_wrap=True,
     )
     if json_path is not None:
@@ -207,6 +209,8 @@ def _both_hands(console, reading, tracks, json_path, tempi=None) -> None:
                 **data,
                 "hands": {hand: reading.to_dict(hand) for hand in reading.piece.hands},
                 "played_as": f"both hands, {TOGETHER}",
+                "hand_model": fingers.model,
+                "fingers": list(fingers.fingers),
             },
         )
 

@@ -123,7 +123,8 @@ def play(
     report_path, shown["console"] = _check_files(
         song, output, reading, controller, models, json_path, html, wav, video, soundfont, gui
     )
-    read = read_file(song, reading, finger=False)
+    named = next(iter(_policy_folders(policy, controller).values()), None)  # (its hand plays: read_file)
+    read = read_file(song, reading, finger=False, models=models if controller == "sac" else None, policy=named)
     hands = read.hands
     players = _players(policy, song, hands is not None, controller)
     wrist_guard, hold_guard = GUARDS[guard.value]
@@ -202,7 +203,18 @@ def _check_files(song, output, reading, controller, models, json_path, html, wav
 def _players(policy: str, song: Path, two_hands: bool, controller) -> dict:
     """--policy as the plan's options: whether the general policy plays (``general``), which one
     (``general_policy``: a folder, or each hand's), and whether the scripted pianist plays what
-    no policy plays (``fallback``). Each folder named must hold a trained policy."""
+    no policy plays (``fallback``)."""
+    if policy in NAMED:
+        return dict(general=policy == "general", general_policy=None, fallback=policy == "scripted")
+    named = _policy_folders(policy, controller)
+    if "" not in named and not two_hands:
+        raise PianobotError(f"--policy {policy}: {song.name} plays one hand: name the general policy's folder alone")
+    return dict(general=True, general_policy=named if "" not in named else named[""], fallback=False)
+
+
+def _policy_folders(policy: str, controller) -> dict[str, Path]:
+    """The folders --policy names (by hand, right=DIR,left=DIR; else one, by ''), each holding a
+    trained policy; none where it names none (:data:`NAMED`)."""
     from pianobot.agent import store
 
     if policy != "general" and controller != "sac":
@@ -210,7 +222,7 @@ def _players(policy: str, song: Path, two_hands: bool, controller) -> dict:
             f"--policy {policy}: --controller {controller.value} plays every phrase itself: drop --policy"
         )
     if policy in NAMED:
-        return dict(general=policy == "general", general_policy=None, fallback=policy == "scripted")
+        return {}
     by_hand = "=" in policy and not Path(policy).is_dir()
     parts = [part.partition("=") for part in policy.split(",")] if by_hand else [("", "=", policy)]
     folders = {hand: folder for hand, _, folder in parts}
@@ -220,16 +232,13 @@ def _players(policy: str, song: Path, two_hands: bool, controller) -> dict:
         raise PianobotError(
             f"--policy {policy}: name each hand's general policy once, as right=DIR,left=DIR (or one of them)"
         )
-    if by_hand and not two_hands:
-        raise PianobotError(f"--policy {policy}: {song.name} plays one hand: name the general policy's folder alone")
     for folder in folders.values():
         if not store.is_trained(Path(folder)):
             raise PianobotError(
                 f"--policy {policy}: {folder} is not a trained policy folder (one holding {store.POLICY_FILE} and "
                 f"{store.MANIFEST_FILE}, e.g. one `pianobot train --task parts` wrote), nor one of {', '.join(NAMED)}"
             )
-    named = {hand: Path(folder) for hand, folder in folders.items()}
-    return dict(general=True, general_policy=named if by_hand else named[""], fallback=False)
+    return {hand: Path(folder) for hand, folder in folders.items()}
 
 
 def play_one(
@@ -333,7 +342,8 @@ def play_both(
 
     console, quiet = shown["console"], shown["quiet"]
     if not quiet:
-        console.print(f"both hands, {TOGETHER}; {AGAINST}", soft_wrap=True)
+        model = "" if hand.model == "allegro" else f" (the {hand.model} hand; --hand-model allegro plays the paper's)"
+        console.print(f"both hands{model}, {TOGETHER}; {AGAINST}", soft_wrap=True)
         for name in reading.piece.hands:
             console.print(said(reading.describe(name)), soft_wrap=True)
     with (

@@ -223,7 +223,7 @@ def train(
     console = err if json_path is not None and str(json_path) == "-" else out  # standard output carries the JSON
     if models.exists() and not models.is_dir():
         raise PianobotError(f"--models {models} is a file: give a folder")
-    read = read_file(song, reading, finger=False) if song is not None else None  # (fingered below)
+    read = read_file(song, reading, finger=False, models=models, policy=general_policy) if song else None
     hands = None if read is None else read.hands
     keyboard, hand = (reading.keyboard, reading.hand) if read is None else (read.keyboard, read.fingers)
     settings = dict(steps=steps, seed=seed, learner=learner, round_steps=round_steps, until_f1=until_f1, envs=envs)

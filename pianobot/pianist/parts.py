@@ -1,0 +1,75 @@
+"""Each hand's part of a two-hand piece as its simulated hand is given it: moved onto the keys its
+player knows, thinned and reduced to what the hand can play, and fingered (:func:`prepare_part`);
+how many notes that leaves (:func:`given_notes`, by which the reading chooses fingers)."""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import replace
+
+from pianobot.errors import PianobotError, PianobotWarning
+from pianobot.music.instrument import HandSpec, KeyboardSpec
+from pianobot.music.load import thin_hand
+from pianobot.music.piece import Piece
+from pianobot.music.window import Window, window_for
+from pianobot.pianist.assign import reduce_hand
+from pianobot.pianist.fingering import ensure_fingering
+from pianobot.sim.hand import hand_model
+
+
+def prepare_part(
+    piece: Piece,
+    hand: str,
+    keyboard: KeyboardSpec | None,
+    fingers: HandSpec,
+    start: float | None = None,
+    grow: bool = False,
+) -> tuple[Window, Piece, float, int]:
+    """``hand``'s part of ``piece`` as the simulated hand is given it: (window, part, start, notes
+    left out), the part moved ``start`` seconds earlier (default: to its first note); ``grow``: a
+    part wider than ``keyboard`` is given its own range instead (:func:`~pianobot.music.window.window_for`).
+    Each kind of change is one :class:`PianobotWarning`, worded for the written part."""
+    window, reduced, start, left_out = _reduced_part(piece, hand, keyboard, fingers, start, grow)
+    written = hand_model(fingers.model).written_fingering  # (the file's marks kept where the hand can)
+    fingered, _ = ensure_fingering(reduced, window.keyboard, fingers, refinger=not written)
+    return window, fingered, start, left_out
+
+
+def _reduced_part(
+    piece: Piece, hand: str, keyboard: KeyboardSpec | None, fingers: HandSpec, start: float | None, grow: bool
+) -> tuple[Window, Piece, float, int]:
+    """:func:`prepare_part`'s part before it is fingered."""
+    part = piece.part(hand)
+    window = window_for(part, hand, keyboard, grow)
+    inside = [n for n in part.notes if window.inward(n.pitch) in window.keyboard]
+    left_out = len(part) - len(inside)
+    if left_out:
+        warnings.warn(
+            PianobotWarning(
+                f"the {hand} hand's part spans more than the {window.keyboard.count} keys its player knows: "
+                f"left out {left_out} note(s) outside them"
+            )
+        )
+    if not inside:
+        raise PianobotError(f"none of the {hand} hand's notes fits the keyboard its player knows")
+    marks = hand_model(fingers.model).written_fingering and all(n.finger in (None, *fingers.fingers) for n in inside)
+    moved = Piece(tuple(replace(n, pitch=window.inward(n.pitch), hand=None) for n in inside), bpm=piece.bpm)
+    moved = moved if marks else moved.without_fingering()
+    start = moved.notes[0].onset if start is None else start
+    # (the simulated hand is a right hand: its top notes are a left hand's lowest)
+    thinned = thin_hand(moved.shift(-start), hand, fingers, "lowest" if hand == "left" else "highest")
+    return window, reduce_hand(thinned, window.keyboard, fingers, hand), start, left_out
+
+
+def given_notes(piece: Piece, fingers: HandSpec, keyboard: KeyboardSpec | None = None) -> int | None:
+    """How many of ``piece``'s notes both hands are given with ``fingers`` (:func:`prepare_part`), on
+    ``keyboard`` (default: 24 keys or a wider part's own octaves); None where a part is refused."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", PianobotWarning)
+        try:
+            return sum(
+                len(_reduced_part(piece, h, keyboard or KeyboardSpec(), fingers, None, keyboard is None)[1])
+                for h in piece.hands
+            )
+        except PianobotError:
+            return None

@@ -1,0 +1,109 @@
+"""Which hand plays where no `--hand-model` is named: the pianist's hands for a file both hands
+play, the Allegro-like hand for one hand's part; a hand the options, a named general policy or the
+store's phrase policies for the file name instead."""
+
+import json
+import shutil
+import warnings
+from pathlib import Path
+
+import pytest
+from conftest import midi_file, off, on, run
+
+from pianobot.agent.store import piece_hand_models
+from pianobot.cli.options import make_reading, read_file
+from pianobot.errors import PianobotWarning
+from pianobot.pianist.reading import choose_model, open_song, read_piece
+
+ROOT = Path(__file__).parent.parent
+ALLEGRO_POLICY = ROOT / "pianobot" / "policies" / "task-parts-v2-92ae607013d9"
+A_PHRASE_POLICY = next(f for f in sorted((ROOT / "models").iterdir()) if (f / "manifest.json").exists())
+
+
+def _track(*notes):
+    return [event for p, a, b in notes for event in ((round(a * 480), on(p)), (round(b * 480), off(p)))]
+
+
+def _duet(path):
+    right = _track((72, 0, 1), (74, 1, 2), (76, 2, 3), (77, 3, 4))
+    left = _track((48, 0, 2), (55, 2, 4))
+    return midi_file(path, [("Right Hand", right), ("Left Hand", left)])
+
+
+def _melody(path):
+    return midi_file(path, [("Melody", _track((60, 0, 1), (62, 1, 2), (64, 2, 3)))])
+
+
+def _played_by(tmp_path, song, *options) -> tuple[str, list[int]]:
+    out = tmp_path / "out.mid"
+    result = run("play", song, "-o", out, "--controller", "scripted", *options)
+    assert result.exit_code == 0, result.output
+    report = json.loads(out.with_suffix(".report.json").read_text())
+    report = report["hands"]["right"] if "hands" in report else report  # (both hands: each hand's)
+    return report["hand_model"], report["fingers"]
+
+
+def test_both_hands_of_a_file_are_the_pianist_s_and_one_hand_s_part_the_allegro_s(tmp_path):
+    duet, melody = _duet(tmp_path / "duet.mid"), _melody(tmp_path / "melody.mid")
+    assert _played_by(tmp_path, duet)[0] == "pianist"
+    assert _played_by(tmp_path, melody) == ("allegro", [2, 3, 4])
+    # a model or the Allegro-like hand's thumb named: that hand, whatever the file holds
+    assert _played_by(tmp_path, duet, "--hand-model", "allegro")[0] == "allegro"
+    assert _played_by(tmp_path, duet, "--thumb") == ("allegro", [1, 2, 3, 4])
+    assert _played_by(tmp_path, melody, "--hand-model", "pianist") == ("pianist", [1, 2, 3, 4, 5])
+    # one hand's part of a two-hand file is one hand's: the Allegro-like hand's
+    assert _played_by(tmp_path, duet, "--hand", "right")[0] == "allegro"
+    # inspect says which hand plays both
+    inspected = run("inspect", duet, "--json", tmp_path / "i.json")
+    assert inspected.exit_code == 0 and "of the pianist hand" in " ".join(inspected.stdout.split())
+    assert json.loads((tmp_path / "i.json").read_text())["hand_model"] == "pianist"
+
+
+def test_the_library_chooses_the_same_way_and_keeps_its_allegro_default(tmp_path):
+    duet = _duet(tmp_path / "duet.mid")
+    assert read_piece(duet, model=None).fingers.model == "pianist"
+    assert read_piece(duet).fingers.model == "allegro"  # (the library's default hand, as before)
+    assert choose_model(open_song(_melody(tmp_path / "m.mid")), make_reading().options) == ("allegro", None)
+
+
+def _store_for(tmp_path, piece: str, model: str | None = None) -> Path:
+    """A store holding one phrase policy (a committed one's manifest) trained for ``piece``."""
+    store = tmp_path / "store"
+    folder = store / A_PHRASE_POLICY.name
+    shutil.copytree(A_PHRASE_POLICY, folder)
+    manifest = json.loads((folder / "manifest.json").read_text())
+    manifest["piece"] = piece
+    if model is not None:
+        manifest["config"]["env"]["world"]["hand"]["spec"]["model"] = model
+    (folder / "manifest.json").write_text(json.dumps(manifest))
+    return store
+
+
+def test_a_store_trained_for_the_file_with_the_allegro_hand_keeps_it_playing_with_that_hand(tmp_path):
+    duet = _duet(tmp_path / "duet.mid")
+    store = _store_for(tmp_path, "duet.mid (right hand)")
+    assert piece_hand_models(store, "duet.mid") == {"allegro"}
+    assert piece_hand_models(store, "duet") == set() and piece_hand_models(store, "duet.mid.mid") == set()
+    with pytest.warns(PianobotWarning, match="played with the allegro hand, which its phrase policies in .* were"):
+        assert read_file(duet, make_reading(), finger=False, models=store).fingers.model == "allegro"
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", PianobotWarning)  # (a hand named: nothing chosen, nothing said)
+        named = read_file(duet, make_reading(hand_model=None, thumb=False), finger=False, models=store)
+    assert named.fingers.model == "allegro"
+    # policies for another file, or none: the file chooses
+    assert read_file(duet, make_reading(), finger=False, models=_store_for(tmp_path / "b", "other.mid")).both
+    assert read_file(duet, make_reading(), finger=False, models=tmp_path / "none").fingers.model == "pianist"
+    # the pianist's policies for a one-hand file: the pianist's hand plays it, said
+    melody = _melody(tmp_path / "melody.mid")
+    store = _store_for(tmp_path / "c", "melody.mid", model="pianist")
+    with pytest.warns(PianobotWarning, match="played with the pianist hand"):
+        assert read_file(melody, make_reading(), models=store).fingers.model == "pianist"
+
+
+def test_a_general_policy_named_plays_the_hand_it_was_trained_for(tmp_path):
+    duet = _duet(tmp_path / "duet.mid")
+    out = tmp_path / "out.mid"
+    result = run("play", duet, "-o", out, "--policy", ALLEGRO_POLICY)
+    assert result.exit_code == 0, result.output
+    report = json.loads(out.with_suffix(".report.json").read_text())
+    assert {h["hand_model"] for h in report["hands"].values()} == {"allegro"} and report["f1"] > 0.5
