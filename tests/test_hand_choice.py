@@ -84,20 +84,47 @@ def test_a_store_trained_for_the_file_with_the_allegro_hand_keeps_it_playing_wit
     store = _store_for(tmp_path, "duet.mid (right hand)")
     assert piece_hand_models(store, "duet.mid") == {"allegro"}
     assert piece_hand_models(store, "duet") == set() and piece_hand_models(store, "duet.mid.mid") == set()
-    with pytest.warns(PianobotWarning, match="played with the allegro hand, which its phrase policies in .* were"):
+    with pytest.warns(
+        PianobotWarning, match="played with the allegro hand, the hand its policies in .* were trained for"
+    ):
         assert read_file(duet, make_reading(), finger=False, models=store).fingers.model == "allegro"
     with warnings.catch_warnings():
         warnings.simplefilter("error", PianobotWarning)  # (a hand named: nothing chosen, nothing said)
         named = read_file(duet, make_reading(hand_model=None, thumb=False), finger=False, models=store)
     assert named.fingers.model == "allegro"
     # policies for another file, or none: the file chooses
-    assert read_file(duet, make_reading(), finger=False, models=_store_for(tmp_path / "b", "other.mid")).both
+    other = read_file(duet, make_reading(), finger=False, models=_store_for(tmp_path / "b", "other.mid"))
+    assert other.fingers.model == "pianist"
     assert read_file(duet, make_reading(), finger=False, models=tmp_path / "none").fingers.model == "pianist"
     # the pianist's policies for a one-hand file: the pianist's hand plays it, said
     melody = _melody(tmp_path / "melody.mid")
     store = _store_for(tmp_path / "c", "melody.mid", model="pianist")
     with pytest.warns(PianobotWarning, match="played with the pianist hand"):
         assert read_file(melody, make_reading(), models=store).fingers.model == "pianist"
+
+
+def test_a_store_s_own_general_policy_for_hands_parts_keeps_its_hand_and_a_matching_one_is_not_said(tmp_path):
+    duet = _duet(tmp_path / "duet.mid")
+    store = tmp_path / "store"
+    shutil.copytree(ALLEGRO_POLICY, store / ALLEGRO_POLICY.name)
+    assert piece_hand_models(store, None) == {"allegro"} and piece_hand_models(store, "duet.mid") == set()
+    with pytest.warns(PianobotWarning, match="duet.mid: played with the allegro hand"):
+        assert read_file(duet, make_reading(), finger=False, models=store).fingers.model == "allegro"
+    melody = _melody(tmp_path / "melody.mid")  # (the Allegro-like hand's anyway: nothing to say)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", PianobotWarning)
+        assert read_file(melody, make_reading(), finger=False, models=store).fingers.model == "allegro"
+
+
+def test_a_chordal_part_the_allegro_hand_would_give_to_both_hands_is_the_pianist_s_one_hand(tmp_path):
+    """One unnamed track of five-note chords: the Allegro-like hand's fingers are too few (its
+    reading gives the notes to both hands), the pianist's one hand plays them."""
+    chords = _track(*[(p, 0, 1) for p in (60, 62, 64, 65, 67)], *[(p, 1, 2) for p in (60, 62, 64, 65, 67)])
+    song = midi_file(tmp_path / "five.mid", [("Piano", chords)])
+    assert choose_model(open_song(song), make_reading().options) == ("pianist", None)
+    read = read_piece(song, model=None)
+    assert read.fingers.model == "pianist" and not read.both
+    assert read_piece(song, model="allegro").both  # (the Allegro-like hand needs both)
 
 
 def test_a_general_policy_named_plays_the_hand_it_was_trained_for(tmp_path):

@@ -113,7 +113,7 @@ READING = {  # parameter name: (type, option); the commands' --help shows them i
     "pedal": _reading(bool, LoadOptions.pedal, "--pedal/--no-pedal", "Play and score the file's sustain pedal (CC64)."),
     "lowest_note": _reading(Optional[str], None, "--lowest-note", f"Lowest key, e.g. C4 or 60 (default {pitch_name(KeyboardSpec.lowest)} or the piece's).", INSTRUMENT),
     "keys": _reading(Optional[int], None, "--keys", f"Number of keys (default {KeyboardSpec.count} or the piece's).", INSTRUMENT),
-    "hand_model": _reading(Optional[HandModelName], None, "--hand-model", "allegro (the paper's; one hand's default) or pianist (both hands').", INSTRUMENT),
+    "hand_model": _reading(Optional[HandModelName], None, "--hand-model", "allegro (the paper's, and --thumb's; one hand's default) or pianist (both hands').", INSTRUMENT),
     "thumb": _reading(Optional[bool], None, "--thumb/--no-thumb", "The Allegro hand's thumb (default: if more notes).", INSTRUMENT),
 }
 # fmt: on
@@ -304,7 +304,7 @@ def read_file(
     ``models``: a model store whose phrase policies for this file were trained with one hand model
     makes that the model where none is named (:func:`stored_model`); ``policy``: a general policy's
     folder named, whose hand (model and fingers) is played where none is named (:func:`policy_hand`)."""
-    from pianobot.pianist.reading import PIANIST, Wording, read_piece
+    from pianobot.pianist.reading import Wording, read_piece
 
     reading = reading if policy is None else policy_hand(reading, Path(policy))
     stored = None if reading.model_named else stored_model(song, models)
@@ -320,28 +320,38 @@ def read_file(
         wording=Wording(**WORDING),
         model=reading.hand.model if reading.model_named else stored,
     )
-    if stored is not None and not quiet and (stored == PIANIST) != read.both:  # (the file would choose another)
+    if stored is not None and not quiet and stored != _file_model(read, reading):
         warnings.warn(
             PianobotWarning(
-                f"{read.name}: played with the {stored} hand, which its phrase policies in {models} were trained "
-                "for (--hand-model names another)"
+                f"{read.name}: played with the {stored} hand, the hand its policies in {models} were trained for "
+                "(--hand-model names another)"
             )
         )
     return read
 
 
+def _file_model(read, reading: Reading) -> str:
+    """The hand model the file alone chooses (:func:`~pianobot.pianist.reading.choose_model`)."""
+    from pianobot.pianist.reading import choose_model
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        keyboard = reading.keyboard if reading.keyboard_named else None
+        return choose_model(read.source, reading.options, keyboard)[0]
+
+
 def stored_model(song, models: Path | None) -> str | None:
     """The hand model of the phrase policies the store ``models`` holds for ``song`` (by the file's
-    name), where they are all of one; else None (the reading chooses:
+    name), where they are all of one; where it holds none for it, of its general policies for
+    hands' parts (``task-parts``), where they are all of one; else None (the reading chooses:
     :func:`~pianobot.pianist.reading.choose_model`). So a piece trained before keeps playing with
-    the hand its policies were trained for."""
+    the hand its policies were trained for, and a general policy of the user's own plays."""
     from pianobot.agent.store import piece_hand_models
     from pianobot.music.midi_io import source_path
 
     if models is None:
         return None
-    name = source_path(song).name
-    found = piece_hand_models(models, name)
+    found = piece_hand_models(models, source_path(song).name) or piece_hand_models(models, None)
     if len(found) != 1:
         return None
     (model,) = found

@@ -134,21 +134,30 @@ def choose_model(
     source: Source, options: LoadOptions, keyboard: KeyboardSpec | None = None
 ) -> tuple[str, HandsReading | None]:
     """The hand model a file is played with where none is named, and its both hands' reading: the
-    pianist's hands (:data:`PIANIST`) where they play the file with both hands (:func:`two_hands`:
-    tracks named for hands, or notes one of their hands cannot play), as the validation sets favour
-    them for two-hand music (docs/benchmarks.md, "The pianist's hand"); else the Allegro-like hand
-    (``HandSpec.model``), whose melody policy plays one hand's melodies better (its reading then
-    says what it says, the pianist's reading nothing: also where that refused the file)."""
+    Allegro-like hand (``HandSpec.model``) where its one hand plays the file, as its melody policy
+    plays one hand's melodies better; else the pianist's hands (:data:`PIANIST`), as the
+    validation sets favour them for two-hand music (docs/benchmarks.md, "The pianist's hand"):
+    both of them where they play the file with both hands (:func:`two_hands`: tracks named for
+    hands, or notes one of their hands cannot play; their reading then), else one (a chordal part
+    the Allegro-like hand would give to both hands). Where the pianist's reading refuses the file,
+    the Allegro-like hand's reads it, and says why where it refuses it too."""
+    keys = keyboard or KeyboardSpec()
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         try:
-            hands = two_hands(source, options, default_fingers(PIANIST), keyboard or KeyboardSpec())
+            hands = two_hands(source, options, default_fingers(PIANIST), keys)
         except PianobotError:
-            hands = None
-    if hands is None:
-        return HandSpec.model, None
-    _warn_again(caught)
-    return PIANIST, hands
+            return HandSpec.model, None
+    if hands is not None:
+        _warn_again(caught)
+        return PIANIST, hands
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # (the chosen hand's reading says what it finds)
+        try:
+            allegro_both = two_hands(source, options, HandSpec(), keys) is not None
+        except PianobotError:
+            allegro_both = True  # (refused for it, and the pianist's one hand plays it)
+    return (PIANIST if allegro_both else HandSpec.model), None
 
 
 def read_both_hands(

@@ -342,7 +342,7 @@ def play_both(
 
     console, quiet = shown["console"], shown["quiet"]
     if not quiet:
-        model = "" if hand.model == "allegro" else f" (the {hand.model} hand; --hand-model allegro plays the paper's)"
+        model = "" if hand.model == "allegro" else f" (the {hand.model} hand; --hand-model names the hand)"
         console.print(f"both hands{model}, {TOGETHER}; {AGAINST}", soft_wrap=True)
         for name in reading.piece.hands:
             console.print(said(reading.describe(name)), soft_wrap=True)
