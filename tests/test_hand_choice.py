@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 from conftest import midi_file, off, on, run
 
-from pianobot.agent.store import piece_hand_models
+from pianobot.agent.general import piece_hand_models
 from pianobot.cli.options import make_reading, read_file
 from pianobot.errors import PianobotWarning
 from pianobot.pianist.reading import choose_model, open_song, read_piece

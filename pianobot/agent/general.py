@@ -256,3 +256,26 @@ def passed_over(keyboard: KeyboardSpec, hand: HandSpec) -> str:
         f"the packaged general policies play keyboards of {world.keyboard.spec.count} keys or more; this piece is "
         f"read for {keyboard.describe()} (keyboard.count)"
     )
+
+
+def piece_hand_models(root: Path, piece: str | None) -> set[str]:
+    """The hand models (``HandSpec.model``) of the phrase policies in the store ``root`` trained for
+    the file named ``piece`` (its manifests' ``piece``: the file's name, a two-hand file's parts as
+    '<name> (right hand)'; a phrase two files share is recorded for the first one trained), or,
+    ``piece`` None, of the store's general policies for hands' parts (``task-parts*``); empty where
+    there are none. A manifest that cannot be read is passed over."""
+    found = set()
+    for folder in Path(root).iterdir() if Path(root).is_dir() else ():
+        general = folder.name.startswith("task-")
+        wanted = folder.name.startswith("task-parts") if piece is None else not general
+        if not wanted or not store.is_trained(folder):
+            continue
+        try:
+            manifest = store.read_manifest(folder)
+        except PianobotError:
+            continue
+        named = manifest.get("piece")
+        if piece is None or (isinstance(named, str) and (named == piece or named.startswith(f"{piece} ("))):
+            spec = manifest["config"]["env"].get("world", {}).get("hand", {}).get("spec", {})
+            found.add(spec.get("model", "allegro") if isinstance(spec, dict) else "allegro")
+    return found

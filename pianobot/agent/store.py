@@ -293,33 +293,6 @@ def find_policies(root: Path, key: str) -> list[Path]:
     return sorted(found, key=saved_at, reverse=True)
 
 
-def piece_hand_models(root: Path, piece: str | None) -> set[str]:
-    """The hand models (``HandSpec.model``) of the phrase policies in ``root`` trained for the file
-    named ``piece`` (its manifests' ``piece``: the file's name, a two-hand file's parts as
-    '<name> (right hand)'; a phrase two files share is recorded for the first one trained), or,
-    ``piece`` None, of its general policies for hands' parts (``task-parts*``); empty where there
-    are none. A manifest that cannot be read is passed over."""
-    root = Path(root)
-    if not root.is_dir():
-        return set()
-    found = set()
-    for folder in root.iterdir():
-        general = folder.name.startswith("task-")
-        if general != (piece is None) or (general and not folder.name.startswith("task-parts")):
-            continue
-        if not folder.is_dir() or not is_trained(folder):
-            continue
-        try:
-            manifest = read_manifest(folder)
-        except PianobotError:
-            continue
-        named = manifest.get("piece")
-        if piece is None or (isinstance(named, str) and (named == piece or named.startswith(f"{piece} ("))):
-            spec = manifest["config"]["env"].get("world", {}).get("hand", {}).get("spec", {})
-            found.add(spec.get("model", "allegro") if isinstance(spec, dict) else "allegro")
-    return found
-
-
 DEFAULT_STORE = Path("models")
 """The model store commands read and write by default (``--models``): ``models`` in the working folder,
 which may be absent (the packaged policies then play)."""

@@ -346,7 +346,7 @@ def stored_model(song, models: Path | None) -> str | None:
     hands' parts (``task-parts``), where they are all of one; else None (the reading chooses:
     :func:`~pianobot.pianist.reading.choose_model`). So a piece trained before keeps playing with
     the hand its policies were trained for, and a general policy of the user's own plays."""
-    from pianobot.agent.store import piece_hand_models
+    from pianobot.agent.general import piece_hand_models
     from pianobot.music.midi_io import source_path
 
     if models is None:
