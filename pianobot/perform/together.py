@@ -48,7 +48,7 @@ from pianobot.perform.judge import play_one_hand
 from pianobot.perform.plan import Performance
 from pianobot.perform.rollout import Rollout
 from pianobot.pianist.assign import finger_apart
-from pianobot.pianist.parts import given_notes, prepare_part  # noqa: F401 (kept here too)
+from pianobot.pianist.parts import prepare_part
 from pianobot.pianist.reading import (  # noqa: F401 (the reading, pianist/reading.py's: these names kept here too)
     THUMBS_CHOSEN,
     HandsReading,
