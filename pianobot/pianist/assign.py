@@ -296,7 +296,9 @@ def load_two_hands(
 ) -> Piece:
     """A two-hand piece with every note's hand: :func:`~pianobot.music.load.load_hands` (hands
     from track names, bad input refused in one line), chords of more notes than both hands' fingers
-    thinned (one warning), and the notes without a hand given one by :func:`assign_hands`."""
+    thinned (one warning), the notes without a hand given one by :func:`assign_hands`, and, for a hand
+    model that lends notes, those of a chord one hand cannot reach given to the other hand where it
+    reaches them (:func:`~pianobot.pianist.lend.lend_if_more`, one warning)."""
     piece, dropped = thin_for_hands(load_hands(path, options), spec)
     if dropped:
         warnings.warn(
@@ -306,9 +308,19 @@ def load_two_hands(
                 f"dropped {dropped} inner note(s)"
             )
         )
-    if all(n.hand is not None for n in piece.notes):
-        return piece
-    return assign_hands(piece, spec).piece
+    if any(n.hand is None for n in piece.notes):
+        piece = assign_hands(piece, spec).piece
+    from pianobot.pianist.lend import lend_if_more  # (lend.py builds on this module)
+
+    piece, lent = lend_if_more(piece, spec)
+    if lent:
+        warnings.warn(
+            PianobotWarning(
+                f"{midi_io.source_path(path).name} has chords wider than one hand reaches: gave {lent} of their "
+                "notes to the other hand, which reaches them"
+            )
+        )
+    return piece
 
 
 @dataclass(frozen=True)

@@ -96,6 +96,10 @@ class HandModel:
     """Whether a file's 1-5 fingering, written for a human hand, is this hand's: its marks are kept
     where the hand can play them, in a partly fingered part and in both hands' parts (else a part
     not wholly fingered, and both hands' parts, are fingered anew for this hand)."""
+    lends_notes: bool = False
+    """Whether a note of a chord one hand cannot reach goes to the other hand where that one can take
+    it, as pianists do, in a file that names each note's hand too (:mod:`pianobot.pianist.lend`;
+    else the hand's reduction drops it)."""
 
     def __post_init__(self) -> None:
         numbers = [f for f, _, _ in self.bases]

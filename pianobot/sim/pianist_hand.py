@@ -39,6 +39,7 @@ PIANIST = HandModel(
     ),
     passes=frozenset({(1, 2), (1, 3), (1, 4)}),
     written_fingering=True,
+    lends_notes=True,
     settings=(
         ("palm_height", 0.0575),
         ("palm_y", 0.1575),
