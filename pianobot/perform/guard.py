@@ -10,7 +10,13 @@ policy still strikes every note and moves the wrist, but for one stretch: while 
 and no finger's next note starts within :data:`QUIET_STEPS`, the teacher moves the wrist too
 (alone over a long held chord, the policy's wrist drifted towards the next one and dragged the
 holding fingers onto the keys beside theirs). The policy has the wrist back in time for every
-strike. ``pianobot play`` plays a general policy of
+strike. With the pianist's hand, a held key the teacher has let up (its fingertip
+:attr:`~pianobot.pianist.tuning.PianistTuning.let_up_height` over it) stays up until its note ends:
+pressed again, it sounded twice (the prelude's left index did, six times on one C4). Remembering
+every key the teacher let go, even for one step, kept keys up that the policy's wrist had drawn out
+of reach only briefly (per-step F1 0.869 -> 0.809 on the validation duets); 8 mm was chosen on
+validation sets among 0, 5, 8 and 12 mm (docs/history.md). The Allegro-like hand's guard presses
+every held key on, as before. ``pianobot play`` plays a general policy of
 the families in :data:`HOLD_GUARD_FAMILIES` through it (the packaged left hand's policy), and
 any general policy with ``--hold-guard``; ``--no-hold-guard`` plays each alone. A phrase's own
 policy plays unguarded.
@@ -37,13 +43,14 @@ training evaluated it; a general policy that drags keys while the hand shifts pl
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import numpy as np
 
 from pianobot.agent import store
 from pianobot.env.piano import EnvConfig, actuated_indices, finger_counts
-from pianobot.music.tensor import FINGER
+from pianobot.music.tensor import FINGER, NOTE
 from pianobot.perform.rollout import Controller
 from pianobot.pianist.layout import KeyLayout
 from pianobot.pianist.motion import Motion
@@ -93,6 +100,32 @@ class HoldGuard:
         """Finger-steps the teacher moved, since the guard was made."""
         self.wrist = 0
         """Control steps in which the teacher moved the wrist, since the guard was made."""
+        self.holding: dict[int, int] = {}
+        """Finger (its slot) -> the key it held in the previous step."""
+        self.lifted: set[tuple[int, int]] = set()
+        """(slot, key) of the held notes whose key was let up: left up until the note ends."""
+
+    def _let_up(self, observation: dict, row: np.ndarray, holding: np.ndarray) -> frozenset[tuple[int, int]]:
+        """(finger, key) of the held notes whose fingertip has risen ``let_up_height`` over the key's top
+        since the finger held it (the teacher is told they were let go, and leaves them up)."""
+        if self.teacher.tuning.let_up_height == math.inf:
+            return frozenset()
+        joints = np.asarray(observation["joints"], dtype=float).reshape(len(self.joints_of), -1)
+        held = {}
+        for slot in holding:
+            keys = np.flatnonzero((row[:, NOTE] > 0.5) & (row[:, FINGER + slot] > 0.5))
+            if keys.size:
+                held[int(slot)] = int(keys[-1])
+        self.lifted = {(slot, key) for slot, key in self.lifted if held.get(slot) == key}  # (until the note ends)
+        layout, motion = self.teacher.layout, self.teacher.motion
+        for slot, key in held.items():
+            if (
+                self.holding.get(slot) == key
+                and motion.tip(joints[slot]).height > layout.key_top[key] + self.teacher.tuning.let_up_height
+            ):
+                self.lifted.add((slot, key))
+        self.holding = held
+        return frozenset((self.teacher.fingers[slot], key) for slot, key in self.lifted)
 
     def _before(self, row: np.ndarray, holding: np.ndarray) -> np.ndarray:
         """The score row the teacher is told came before ``row``: the notes the ``holding`` fingers hold
@@ -112,15 +145,15 @@ class HoldGuard:
     def reset(self) -> None:
         self.policy.reset()
         self.teacher.reset()
+        self.holding, self.lifted = {}, set()
 
     def act(self, observation: dict) -> np.ndarray:
         action = np.array(self.policy.act(observation), dtype=np.float32)  # a copy: the policy's own is left alone
         holding = np.flatnonzero(observation["targets"][:, -1] > 0)
         if holding.size:
-            self.teacher.previous_row = self._before(observation["score"][0], holding)
-            # (nor what it let go: the policy moves the wrist, and remembered, a key let go for one
-            # step stayed up, which cost per-step F1 on the validation pieces: docs/history.md)
-            self.teacher.released = frozenset()
+            row = observation["score"][0]
+            self.teacher.previous_row = self._before(row, holding)
+            self.teacher.released = self._let_up(observation, row, holding)
             taught = self.teacher.act(observation)
             for slot in holding:
                 action[self.joints_of[slot]] = taught[self.joints_of[slot]]

@@ -101,6 +101,12 @@ class PianistTuning:
     with its abduction). Fingers about to strike, not yet down, never limit it."""
     tilt_step: float = 0.15
     """Most change of the fingertip's tilt the inverse kinematics asks for in one step (rad per control step)."""
+    let_up_height: float = math.inf
+    """Under the hold guard (:class:`~pianobot.perform.guard.HoldGuard`): a holding finger whose tip has
+    risen this far over its key's top let the key up, and its note ended; the guard's teacher leaves the
+    key up while the note is still written to sound (pressed again it would sound twice). A key let go
+    less far is pressed on (m; ``math.inf``, the default: every held key is pressed on, as the
+    Allegro-like hand's guard always did)."""
 
 
 def tuning_for(hand: HandConfig) -> PianistTuning:

@@ -36,6 +36,7 @@ PIANIST = HandModel(
         ("thumb_stretch", 0.5),
         ("prepare_steps", 2),
         ("strike_slide", 0.004),
+        ("let_up_height", 0.008),
     ),
     passes=frozenset({(1, 2), (1, 3), (1, 4)}),
     written_fingering=True,
@@ -73,6 +74,7 @@ finger's stretch cost in the planner (``thumb_stretch``), so a scale passes the 
 1 2 3 4 5) at any tempo, as pianists finger it, rather than shifting the whole hand after the fifth
 finger. While a fingertip is on its way into its key the wrist slides at most 4 mm a control step
 (``strike_slide``, as while a finger holds one): a thumb turned towards its key lags a quicker
-slide and was dragged off it."""
+slide and was dragged off it. Under the hold guard, a held key whose fingertip has risen 8 mm over
+it stays up until its note ends (``let_up_height``): pressed again, it sounded twice."""
 
 register_hand_model(PIANIST)
