@@ -232,3 +232,27 @@ def test_an_alberti_bass_in_semiquavers_plays_whole_because_the_wrist_waits_for_
     monkeypatch.setattr(scripted, "tuning_for", lambda hand: replace(unlimited(hand), strike_slide=math.inf))
     problems, f1 = play(line(alberti(), 0.125), FIVE)
     assert problems == 0 and f1 < 1.0  # the wrist sliding under the thumb: a note lost
+
+
+def test_a_held_key_is_let_go_in_time_for_its_finger_s_far_move_to_strike_on_time():
+    """Four chords of the upper voices of Bach's chorale BWV 81.7 (the right hand's, as `play` gives
+    them to it): the little finger holds G5, then strikes F#5, drawing back into the black keys' band.
+    Counting a fingertip's whole positioning move a step, the scripted pianist let G5 go too late and
+    F#5 sounded 100 ms late; counting three quarters (the pianist's ``travel_share``) it is on time."""
+    from pianobot.perform.perform import PLAY_CONFIG, perform
+    from pianobot.pianist.scripted import ScriptedPianist
+
+    hand = hand_config(FIVE)
+    config = replace(PLAY_CONFIG, world=replace(PLAY_CONFIG.world, hand=hand))
+    chords = [(71, 0.0, 0.5, 1), (76, 0.0, 0.5, 4), (71, 0.5, 1.0, 1), (79, 0.5, 1.0, 5)]
+    chords += [(72, 1.0, 1.5, 2), (78, 1.0, 1.5, 5), (71, 1.5, 1.6, 1), (78, 1.5, 1.6, 5)]
+    piece = Piece(tuple(Note(onset, pitch, end, 80, finger) for pitch, onset, end, finger in chords), bpm=60)
+    assert tuning_for(hand).travel_share == 0.75 and PianistTuning().travel_share == 1.0  # (the Allegro-like hand's)
+
+    def played(share: float):
+        tuning = replace(tuning_for(hand), travel_share=share)
+        return perform(piece, lambda env: ScriptedPianist(env.config, tuning), config).report()
+
+    assert played(0.75).f1 == 1.0
+    late = played(1.0)
+    assert [(r.reference.pitch, r.reference.onset) for r in late.rows if r.played is None] == [(78, 1.0)]

@@ -185,8 +185,8 @@ class StrikePlanner:
     def positioning_steps(self, tip: Tip, key: int, height: float) -> int:
         """Control steps a fingertip at ``tip`` takes to hover ``height`` over ``key``'s top in front
         of its strike point, along the path :mod:`~pianobot.pianist.motion` takes: up first, across
-        (into or out of the black keys' band only above their tops), then down, at most ``max_move``
-        per step; and ``settle_steps`` more to be still there before the strike starts."""
+        (into or out of the black keys' band only above their tops), then down, ``travel_share`` of
+        ``max_move`` per step; and ``settle_steps`` more to be still there before the strike starts."""
         layout, tuning = self.layout, self.tuning
         goal_y, goal_height = layout.contact_y(key), layout.key_top[key] + height
         across = abs(goal_y - tip.y)
@@ -196,7 +196,7 @@ class StrikePlanner:
             crossing = (goal_y < layout.black_band_y) != (tip.y < layout.black_band_y)
             top = max(goal_height, tip.height, layout.black_rise + tuning.band_clearance if crossing else 0.0)
             path = (top - tip.height) + across + (top - goal_height)
-        return math.ceil(path / tuning.max_move - 1e-9) + tuning.settle_steps
+        return math.ceil(path / (tuning.max_move * tuning.travel_share) - 1e-9) + tuning.settle_steps
 
     def hop_steps(self, from_key: int, to_key: int, velocity: float) -> int:
         """Fewest control steps from one note's onset to the next note's onset for the same finger:

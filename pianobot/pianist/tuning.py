@@ -91,6 +91,11 @@ class PianistTuning:
     One that rose towards it could stop a hair short of it and wait there for ever."""
     max_move: float = 0.016
     """Longest fingertip move in one step when positioning; strikes are not limited (m per control step)."""
+    travel_share: float = 1.0
+    """Share of ``max_move`` a fingertip is counted on to cover in a control step when the strike planner
+    times its way to its next key (when a held key is let go for it): less than 1 where the fingertip is
+    slower than its waypoints (it rises first, draws back out of the black keys' band and turns while
+    the wrist moves; the pianist's hand's light fingers took five or six steps where three were counted)."""
     max_joint_move: float = 0.6
     """Largest change of a flexion joint's angle in one step when positioning (rad per control step)."""
     hold_slide: float = 0.008

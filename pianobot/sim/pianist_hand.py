@@ -37,6 +37,7 @@ PIANIST = HandModel(
         ("prepare_steps", 2),
         ("strike_slide", 0.004),
         ("let_up_height", 0.008),
+        ("travel_share", 0.75),
     ),
     passes=frozenset({(1, 2), (1, 3), (1, 4)}),
     written_fingering=True,
@@ -75,6 +76,10 @@ finger's stretch cost in the planner (``thumb_stretch``), so a scale passes the 
 finger. While a fingertip is on its way into its key the wrist slides at most 4 mm a control step
 (``strike_slide``, as while a finger holds one): a thumb turned towards its key lags a quicker
 slide and was dragged off it. Under the hold guard, a held key whose fingertip has risen 8 mm over
-it stays up until its note ends (``let_up_height``): pressed again, it sounded twice."""
+it stays up until its note ends (``let_up_height``): pressed again, it sounded twice. The strike
+planner counts on its fingertips covering three quarters of their longest positioning move a step
+(``travel_share``), so a held key is let go early enough for its finger's far move (from a black key
+across to a white one) to strike on time, and the fingering planner gives a finger that time between
+its notes."""
 
 register_hand_model(PIANIST)
