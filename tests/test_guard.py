@@ -13,6 +13,7 @@ from pianobot.env.piano import EnvConfig, actuated_indices, idle_pose
 from pianobot.music.instrument import HandSpec
 from pianobot.music.load import LoadOptions, load_piece
 from pianobot.music.piece import Note, Piece
+from pianobot.music.tensor import FINGER, NOTE
 from pianobot.perform.guard import QUIET_STEPS, HoldGuard, WristGuard
 from pianobot.perform.perform import PLAY_CONFIG, perform
 from pianobot.pianist.scripted import ScriptedPianist
@@ -227,11 +228,11 @@ PIANIST = replace(
 )
 
 
-def _told(config: EnvConfig, lift: float = 1.0) -> tuple[list[frozenset], list[dict]]:
+def _told(config: EnvConfig, lift: float = 1.0, piece: Piece = LEGATO) -> tuple[list[frozenset], list[dict]]:
     """What the hold guard's teacher is told it let go, each step it is asked, with a policy that lifts
     every holding finger at ``lift`` of its top speed; and that policy's observations."""
     recorder = LetsGo(config, lift)
-    perform(LEGATO, lambda env: recorder, config)
+    perform(piece, lambda env: recorder, config)
     guard = HoldGuard(Constant(np.zeros(len(actuated_indices(config)), np.float32)), config)
     act, told = guard.teacher.act, []
     guard.teacher.act = lambda observation: told.append(guard.teacher.released) or act(observation)
@@ -246,7 +247,9 @@ def test_the_pianist_s_hold_guard_leaves_up_a_held_key_its_finger_let_up_until_t
     note ends; a fingertip that rose less is not (remembering every key let go even for a step kept
     keys up that the policy's wrist had drawn out of reach only briefly: per-step F1 0.869 -> 0.809
     on the validation duets)."""
-    told, observations = _told(PIANIST, lift=0.1)  # (slowly: its fingertips pass through 0-8 mm)
+    # G4 held past E4, then struck again: in the step it is struck again no note is held
+    repeated = Piece(LEGATO.notes[:3] + (Note(2.5, 67, 3.25, 80, 4), Note(3.25, 67, 3.75, 80, 4)), bpm=60)
+    told, observations = _told(PIANIST, lift=0.1, piece=repeated)  # (slowly: its tips pass through 0-8 mm)
     teacher = ScriptedPianist(PIANIST)  # (its geometry, to tell where each fingertip is)
     assert teacher.tuning.let_up_height == 0.008
     fingers = PIANIST.world.hand.spec.fingers
@@ -255,9 +258,10 @@ def test_the_pianist_s_hold_guard_leaves_up_a_held_key_its_finger_let_up_until_t
         row, joints = observation["score"][0], observation["joints"].reshape(len(fingers), -1)
         holding = {}
         for slot in np.flatnonzero(observation["targets"][:, -1] > 0):
-            keys = np.flatnonzero((row[:, 0] > 0.5) & (row[:, 2 + slot] > 0.5))
+            keys = np.flatnonzero((row[:, NOTE] > 0.5) & (row[:, FINGER + slot] > 0.5))
             holding[slot] = int(keys[-1])
-        if not holding:
+        if not holding:  # (no note held: every let-up note has ended)
+            seen, before = set(), {}
             continue
         seen = {(slot, key) for slot, key in seen if holding.get(slot) == key}
         for slot, key in holding.items():

@@ -10,7 +10,7 @@ from pianobot.music.load import LoadOptions
 from pianobot.music.piece import Note, Piece
 from pianobot.perform.together import play_hands
 from pianobot.pianist.assign import load_two_hands, reaches
-from pianobot.pianist.lend import given, lend_if_more, lend_notes
+from pianobot.pianist.lend import lend_if_more, lend_notes, notes_given
 
 FIVE = HandSpec((1, 2, 3, 4, 5), model="pianist")
 
@@ -31,7 +31,7 @@ def test_a_note_the_right_hand_cannot_reach_goes_to_the_free_left_hand_and_is_pl
     assert count == 1
     g3 = next(n for n in lent.notes if n.pitch == 55)
     assert g3.hand == "left" and g3.finger is None  # (its written finger was the right hand's)
-    assert given(lent, FIVE) == 4 and given(piece, FIVE) == 3
+    assert notes_given(lent, FIVE) == 4 and notes_given(piece, FIVE) == 3
     assert play_hands(lent, "scripted", hand=FIVE, seed=0).report().f1 == 1.0
 
 
@@ -43,11 +43,29 @@ def test_no_note_is_lent_across_the_other_hand_nor_by_the_allegro_hand():
     assert lend_if_more(free, HandSpec()) == (free, 0)
 
 
-def test_a_lent_note_the_other_hand_cannot_get_to_in_time_is_not_lent():
-    # the left hand strikes C1 just before: G3, three octaves up, 0.1 s later is beyond its wrist
-    far = Piece.of(_right() + [Note(0.4, 24, 0.5, 70, None, "left")])
-    assert lend_notes(far, FIVE)[1] == 1
-    assert lend_if_more(far, FIVE) == (far, 0)
+def test_each_lending_is_kept_only_where_it_gives_the_hands_more_notes():
+    """The left hand strikes C1 just before the first G3 under C5 (three octaves up, 0.1 s later: beyond
+    its wrist), then holds C3 under the second: only the second G3 is lent; the left hand's C1 is
+    kept, where lending the first too would have cost it (one lending is judged apart from another)."""
+    right = _right() + [Note(2.0, 55, 3.0, 80, None, "right"), Note(2.0, 72, 3.0, 80, None, "right")]
+    left = [Note(0.4, 24, 0.5, 70, None, "left"), Note(2.0, 48, 3.0, 70, None, "left")]
+    piece = Piece.of(right + left)
+    assert lend_notes(piece, FIVE)[1] == 2  # (both fit under the left hand at their onsets)
+    lent, count = lend_if_more(piece, FIVE)
+    assert count == 1
+    assert [(n.onset, n.pitch) for n in lent.notes if n.hand == "left"] == [(0.4, 24), (2.0, 48), (2.0, 55)]
+    assert notes_given(lent, FIVE) == notes_given(piece, FIVE) + 1
+
+
+def test_the_left_hand_lends_its_top_note_up_and_no_lent_note_crosses_its_own_hand():
+    left = [Note(0.5, 36, 1.5, 70, None, "left"), Note(0.5, 52, 1.5, 70, None, "left")]  # C2 under E3: a tenth
+    lent, count = lend_notes(Piece.of(left + [Note(0.5, 57, 1.5, 80, None, "right")]), FIVE)
+    assert count == 1 and {n.pitch: n.hand for n in lent.notes} == {36: "left", 52: "right", 57: "right"}
+    # a right hand's six notes: those the hand does not keep may lie between those it keeps
+    chord = [Note(0.5, p, 1.5, 80, None, "right") for p in (64, 66, 67, 68, 69, 72)]
+    lent, _ = lend_notes(Piece.of(chord + [Note(2.0, 48, 2.5, 70, None, "left")]), FIVE)  # (the left hand free)
+    # the hand keeps C5 A4 G#4 G4 and E4, not F#4, which lies between them: it is not lent, which would cross
+    assert {n.pitch: n.hand for n in lent.notes if n.onset == 0.5}[66] == "right"
 
 
 def test_a_file_with_tracks_named_for_hands_lends_and_says_so(tmp_path):

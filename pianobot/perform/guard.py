@@ -162,6 +162,8 @@ class HoldGuard:
             if not np.any(observation["targets"][:, 3] >= 1.0 - QUIET_STEPS / steps):
                 action[self.wrist_at] = taught[self.wrist_at]
                 self.wrist += 1
+        else:  # (no note held: every let-up note has ended, a repeat of one included)
+            self.holding, self.lifted = {}, set()
         return action
 
 
