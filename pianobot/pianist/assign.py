@@ -355,6 +355,17 @@ def reduce_hand(part: Piece, keyboard: KeyboardSpec, spec: HandSpec, hand: str) 
     return reduced
 
 
+def reduced_part(piece: Piece, hand: str, spec: HandSpec) -> tuple[KeyboardSpec, Piece]:
+    """``hand``'s part of ``piece`` as a right hand's (the left hand's mirrored), thinned to the
+    fingers and reduced to what the hand can play (one warning per kind of change), on the keys it
+    needs; and those keys."""
+    part = piece.part(hand)
+    part = part.mirror() if hand == "left" else part  # now a right hand's part
+    thinned = thin_hand(part, hand, spec, "lowest" if hand == "left" else "highest")
+    keyboard = keyboard_for(thinned)
+    return keyboard, reduce_hand(thinned.with_hands(None), keyboard, spec, hand)
+
+
 def finger_hands(piece: Piece, spec: HandSpec = HandSpec(), refinger: bool = False) -> HandsFingering:
     """Each hand's part of ``piece`` (every note has a hand) thinned and reduced to what the hand
     can play (:func:`~pianobot.music.load.thin_hand`, :func:`~pianobot.pianist.reduce.reduce_part`,
@@ -368,11 +379,7 @@ def finger_hands(piece: Piece, spec: HandSpec = HandSpec(), refinger: bool = Fal
     plans: dict[str, FingeringPlan | None] = {}
     views: dict[str, tuple[windows.Window, Piece]] = {}
     for hand in piece.hands:
-        part = piece.part(hand)
-        part = part.mirror() if hand == "left" else part  # now a right hand's part
-        thinned = thin_hand(part, hand, spec, "lowest" if hand == "left" else "highest")
-        keyboard = keyboard_for(thinned)
-        reduced = reduce_hand(thinned.with_hands(None), keyboard, spec, hand)
+        keyboard, reduced = reduced_part(piece, hand, spec)
         fingered, plan = ensure_fingering(reduced, keyboard, spec, refinger=refinger)
         views[hand] = (windows.Window(hand, keyboard, 0), fingered)
         plans[hand] = plan

@@ -34,10 +34,9 @@ import warnings
 from dataclasses import replace
 
 from pianobot.errors import PianobotWarning
-from pianobot.music.instrument import HandSpec, keyboard_for
-from pianobot.music.load import thin_hand
+from pianobot.music.instrument import HandSpec
 from pianobot.music.piece import Piece
-from pianobot.pianist.assign import group_chords, reaches, reduce_hand
+from pianobot.pianist.assign import group_chords, reaches, reduced_part
 from pianobot.sim.hand import hand_model
 
 OTHER = {"right": "left", "left": "right"}
@@ -93,16 +92,10 @@ def lend_notes(piece: Piece, spec: HandSpec) -> tuple[Piece, int]:
 
 
 def notes_given(piece: Piece, spec: HandSpec) -> int:
-    """How many of ``piece``'s notes both hands' reductions give the hands (as each hand's part is reduced to play)."""
-    total = 0
+    """How many of ``piece``'s notes both hands' reductions give the hands (:func:`~pianobot.pianist.assign.reduced_part`)."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", PianobotWarning)
-        for hand in piece.hands:
-            part = piece.part(hand)
-            part = part.mirror() if hand == "left" else part
-            thinned = thin_hand(part, hand, spec, "lowest" if hand == "left" else "highest")
-            total += len(reduce_hand(thinned.with_hands(None), keyboard_for(thinned), spec, hand))
-    return total
+        return sum(len(reduced_part(piece, hand, spec)[1]) for hand in piece.hands)
 
 
 def lend_if_more(piece: Piece, spec: HandSpec) -> tuple[Piece, int]:
