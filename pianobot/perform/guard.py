@@ -12,11 +12,9 @@ and no finger's next note starts within :data:`QUIET_STEPS`, the teacher moves t
 holding fingers onto the keys beside theirs). The policy has the wrist back in time for every
 strike. With the pianist's hand, a held key the teacher has let up (its fingertip
 :attr:`~pianobot.pianist.tuning.PianistTuning.let_up_height` over it) stays up until its note ends:
-pressed again, it sounded twice (the prelude's left index did, six times on one C4). Remembering
-every key the teacher let go, even for one step, kept keys up that the policy's wrist had drawn out
-of reach only briefly (per-step F1 0.869 -> 0.809 on the validation duets); 8 mm was chosen on
-validation sets among 0, 5, 8 and 12 mm (docs/history.md). The Allegro-like hand's guard presses
-every held key on, as before. ``pianobot play`` plays a general policy of
+pressed again, it would sound twice; a key let go less far is pressed on, so a key the policy's
+wrist drew out of reach only briefly is held again (docs/history.md). The Allegro-like hand's guard
+presses every held key on. ``pianobot play`` plays a general policy of
 the families in :data:`HOLD_GUARD_FAMILIES` through it (the packaged left hand's policy), and
 any general policy with ``--hold-guard``; ``--no-hold-guard`` plays each alone. A phrase's own
 policy plays unguarded.

@@ -96,8 +96,7 @@ class PianistTuning:
     times its way to its next key: when a held key is let go for it, and so how soon the fingering
     planner lets a finger strike again (and the reduction drops notes as too fast). Less than 1 where
     the fingertip is slower than its waypoints (it rises first, draws back out of the black keys' band
-    and turns while the wrist moves; the pianist's hand's light fingers took five or six steps where
-    three were counted)."""
+    and turns while the wrist moves)."""
     max_joint_move: float = 0.6
     """Largest change of a flexion joint's angle in one step when positioning (rad per control step)."""
     hold_slide: float = 0.008

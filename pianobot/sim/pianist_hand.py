@@ -76,7 +76,7 @@ finger's stretch cost in the planner (``thumb_stretch``), so a scale passes the 
 finger. While a fingertip is on its way into its key the wrist slides at most 4 mm a control step
 (``strike_slide``, as while a finger holds one): a thumb turned towards its key lags a quicker
 slide and was dragged off it. Under the hold guard, a held key whose fingertip has risen 8 mm over
-it stays up until its note ends (``let_up_height``): pressed again, it sounded twice. The strike
+it stays up until its note ends (``let_up_height``): pressed again, it would sound twice. The strike
 planner counts on its fingertips covering three quarters of their longest positioning move a step
 (``travel_share``), so a held key is let go early enough for its finger's far move (from a black key
 across to a white one) to strike on time, and the fingering planner gives a finger that time between
