@@ -285,7 +285,13 @@ def test_inspect_shows_each_hand_in_plays_words(tmp_path):
     assert "right hand: 4 notes, C5-F5, named by its track" in text and "--hand right|left" in text
     assert "both hands in one simulation" in text
     found = json.loads((tmp_path / "i.json").read_text())
-    assert found["hands"]["left"] == {"notes": 2, "range": ["C3", "G3"], "named_by_file": 2, "assigned_by_planner": 0}
+    assert found["hands"]["left"] == {
+        "notes": 2,
+        "range": ["C3", "G3"],
+        "named_by_file": 2,
+        "lent_by_other_hand": 0,
+        "assigned_by_planner": 0,
+    }
     unnamed = _one_track(tmp_path / "bass.mid", (72, 0, 1), (74, 1, 2), (40, 0, 2), (43, 2, 4), (76, 2, 4))
     text = " ".join(run("inspect", unnamed).stdout.split())
     assert "left hand: 2 notes, E2-G2, assigned by the fingering planner" in text

@@ -11,6 +11,7 @@ from pianobot.music.piece import Note, Piece
 from pianobot.perform.together import play_hands
 from pianobot.pianist.assign import load_two_hands, reaches
 from pianobot.pianist.lend import lend_if_more, lend_notes, notes_given
+from pianobot.pianist.reading import read_hands
 
 FIVE = HandSpec((1, 2, 3, 4, 5), model="pianist")
 
@@ -86,3 +87,17 @@ def test_a_file_with_tracks_named_for_hands_lends_and_says_so(tmp_path):
     assert said == [
         "wide.mid has chords wider than one hand reaches: gave 1 of their notes to the other hand, which reaches them"
     ]
+    # what inspect and play say of each hand: the lent note is the right hand's track's, not the planner's
+    reading = read_hands(tmp_path / "wide.mid", LoadOptions(), FIVE)
+    assert (
+        reading.describe("left")
+        == "left hand: 2 notes, C3-G3, 1 named by its track, 1 lent by the right hand (out of its reach)"
+    )
+    assert reading.describe("right") == "right hand: 1 note, C5-C5, named by its track"
+    assert reading.to_dict("left") == {
+        "notes": 2,
+        "range": ["C3", "G3"],
+        "named_by_file": 1,
+        "lent_by_other_hand": 1,
+        "assigned_by_planner": 0,
+    }

@@ -286,34 +286,44 @@ def finger_read(read: ReadPiece, options: LoadOptions, wording: Wording = Wordin
 @dataclass(frozen=True)
 class HandsReading:
     """A two-hand file read for both hands: every note with its hand, and how many of each hand's the file
-    named (tracks' names, a PIG file's channels), not the planner (:func:`~pianobot.pianist.assign.assign_hands`)."""
+    named (tracks' names, a PIG file's channels) and how many the file named for the other hand but that
+    hand lent (:mod:`~pianobot.pianist.lend`: out of its reach); the rest the planner assigned
+    (:func:`~pianobot.pianist.assign.assign_hands`)."""
 
     piece: Piece
     named: dict[str, int]
     source: str = "its track"
     """What named a note's hand in the file: 'its track', 'the PIG channel'."""
+    lent: dict[str, int] = field(default_factory=dict)
+    """Per hand: its notes that the file named for the other hand, which lent them."""
 
     def to_dict(self, hand: str) -> dict:
-        """``hand``'s part: how many notes, its range, how many the file named and the planner assigned."""
+        """``hand``'s part: how many notes, its range, how many the file named, the other hand lent
+        and the planner assigned."""
         part = self.piece.part(hand)
-        named = min(self.named.get(hand, 0), len(part))  # (a note the reading thinned away may have been named)
+        named, lent = self.named.get(hand, 0), self.lent.get(hand, 0)
         return {
             "notes": len(part),
             "range": [pitch_name(min(n.pitch for n in part.notes)), pitch_name(max(n.pitch for n in part.notes))],
             "named_by_file": named,
-            "assigned_by_planner": len(part) - named,
+            "lent_by_other_hand": lent,
+            "assigned_by_planner": len(part) - named - lent,
         }
 
     def describe(self, hand: str) -> str:
         """One line on ``hand``'s part: 'right hand: 64 notes, C4-D5, named by its track'."""
         part = self.to_dict(hand)
-        named, assigned = part["named_by_file"], part["assigned_by_planner"]
-        if assigned == 0:
+        named, lent, assigned = part["named_by_file"], part["lent_by_other_hand"], part["assigned_by_planner"]
+        if assigned == lent == 0:
             who = f"named by {self.source}"
-        elif named == 0:
+        elif named == lent == 0:
             who = "assigned by the fingering planner"
         else:
-            who = f"{named} named by {self.source}, {assigned} assigned by the fingering planner"
+            other = "left" if hand == "right" else "right"
+            shares = ((named, f"named by {self.source}"), (lent, f"lent by the {other} hand (out of its reach)"))
+            who = ", ".join(
+                f"{k} {what}" for k, what in (*shares, (assigned, "assigned by the fingering planner")) if k
+            )
         notes = f"{part['notes']} note{'s' * (part['notes'] != 1)}"
         return f"{hand} hand: {notes}, {'-'.join(part['range'])}, {who}"
 
@@ -326,8 +336,15 @@ def read_hands(
         warnings.simplefilter("ignore", PianobotWarning)  # said by load_two_hands
         given = load_hands(source := open_song(path), options)
     piece = load_two_hands(source, options, spec)
-    named = {hand: sum(n.hand == hand for n in given.notes) for hand in HANDS}
-    return HandsReading(piece, named, "the PIG channel" if source_path(path).suffix.lower() == ".txt" else "its track")
+    written = {(n.pitch, n.onset): n.hand for n in given.notes if n.hand is not None}
+    named, lent = {hand: 0 for hand in HANDS}, {hand: 0 for hand in HANDS}
+    for note in piece.notes:  # (notes the reading thinned away count for neither)
+        hand = written.get((note.pitch, note.onset))
+        if hand is not None:
+            (named if hand == note.hand else lent)[note.hand] += 1
+    return HandsReading(
+        piece, named, "the PIG channel" if source_path(path).suffix.lower() == ".txt" else "its track", lent
+    )
 
 
 def names_hands(path: str | Path | MidiSource, track: str | None = None) -> bool:
