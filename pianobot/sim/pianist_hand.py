@@ -56,7 +56,9 @@ thumb to little, their knuckles 22 mm apart, phalanges 45, 25 and 26 mm, a human
 ranges, the Shadow hand's joint speed and torque. The thumb is a finger like the others beside the
 index (as the Allegro-like hand's) that turns farther sideways (0.6 rad either way, as a thumb
 reaches under the palm); it passes under the index, middle and ring fingers and they over it
-(:attr:`HandModel.passes`: the fingering planner lets their fingertips cross). Its planner holds
+(:attr:`HandModel.passes`: the fingering planner lets their fingertips cross; turned to its limit
+its tip reaches one white key past a held index, but not past a held middle finger, so a 1 2 3 1 in
+a scale shifts the hand: docs/simulator.md). Its planner holds
 notes to their written end as a pianist does (a higher ``legato_cost``): the thumb passes under
 in a scale rather than the hand jumping. Its fingers turn sideways less far than the
 Allegro-like hand's longer ones, so the wrist strays less from straight over a held or struck
