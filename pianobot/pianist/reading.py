@@ -312,18 +312,14 @@ class HandsReading:
 
     def describe(self, hand: str) -> str:
         """One line on ``hand``'s part: 'right hand: 64 notes, C4-D5, named by its track'."""
-        part = self.to_dict(hand)
-        named, lent, assigned = part["named_by_file"], part["lent_by_other_hand"], part["assigned_by_planner"]
-        if assigned == lent == 0:
-            who = f"named by {self.source}"
-        elif named == lent == 0:
-            who = "assigned by the fingering planner"
-        else:
-            other = "left" if hand == "right" else "right"
-            shares = ((named, f"named by {self.source}"), (lent, f"lent by the {other} hand (out of its reach)"))
-            who = ", ".join(
-                f"{k} {what}" for k, what in (*shares, (assigned, "assigned by the fingering planner")) if k
-            )
+        part, other = self.to_dict(hand), "left" if hand == "right" else "right"
+        shares = [
+            (part["named_by_file"], f"named by {self.source}"),
+            (part["lent_by_other_hand"], f"lent by the {other} hand (out of its reach)"),
+            (part["assigned_by_planner"], "assigned by the fingering planner"),
+        ]
+        shares = [(count, what) for count, what in shares if count]
+        who = shares[0][1] if len(shares) == 1 else ", ".join(f"{count} {what}" for count, what in shares)
         notes = f"{part['notes']} note{'s' * (part['notes'] != 1)}"
         return f"{hand} hand: {notes}, {'-'.join(part['range'])}, {who}"
 
