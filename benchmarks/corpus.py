@@ -3,6 +3,7 @@ scores, written to MIDI files and played as ``pianobot play`` plays them, agains
 
     pip install -e ".[corpus]"      # music21, which carries its corpus
     python -m benchmarks.corpus [--set test|validation] [--out out/corpus] [--json out.json] [--only NAME ...]
+                                [--hold-guard | --no-hold-guard]
 
 Each excerpt is a piece's first measures (from :data:`EXCERPTS`' first measure), as many as keep
 it within :data:`MAX_NOTES` notes and :data:`MAX_SECONDS` seconds at the score's own tempo
@@ -193,12 +194,14 @@ def play_corpus(
     hand: HandSpec | None = None,
     general: Path | None = None,
     excerpts: tuple = EXCERPTS,
+    hold_guard: bool | None = None,
 ) -> list[dict]:
     """Write the excerpts to ``folder`` and play each with both players (``together``: both hands
     in one simulation, as ``pianobot play`` plays them; ``hand``: each hand's fingers, default
     chosen per file as ``pianobot play`` chooses them; ``general``:
     the general policy on both hands, default the packaged one for ``hand``, and where none is
-    packaged for it the scripted pianist alone plays); a row each."""
+    packaged for it the scripted pianist alone plays; ``hold_guard``: the general policy through the
+    hold guard, or alone, default as ``pianobot play`` plays it); a row each."""
     folder.mkdir(parents=True, exist_ok=True)
     rows = []
     for name, path, parts, first in excerpts:
@@ -223,7 +226,11 @@ def play_corpus(
             continue
         with tempfile.TemporaryDirectory() as models:  # (an empty store: the packaged policies play)
             piece = reading.piece
-            policy = figures(piece, "sac", models, general, together=together, hand=fingers) if plays else None
+            policy = (
+                figures(piece, "sac", models, general, together=together, hold_guard=hold_guard, hand=fingers)
+                if plays
+                else None
+            )
             row.update(
                 notes=len(piece),
                 sac=policy,
@@ -301,6 +308,12 @@ def main() -> None:
         "where none is packaged for it, the scripted pianist alone plays)",
     )
     parser.add_argument(
+        "--hold-guard",
+        action=argparse.BooleanOptionalAction,
+        help="the general policy through the hold guard, or (--no-hold-guard) alone; default: as `pianobot play` "
+        "plays it (through the guard)",
+    )
+    parser.add_argument(
         "--write-training",
         type=Path,
         metavar="DIR",
@@ -336,7 +349,7 @@ def main() -> None:
     if args.hand_model is not None and args.hand_model != HandSpec.model:
         hand = default_fingers(args.hand_model)
     out = args.out or Path("out/corpus" if args.set == "test" else "out/corpus-validation")
-    rows = play_corpus(out, tuple(args.only), not args.apart, hand, args.general, SETS[args.set])
+    rows = play_corpus(out, tuple(args.only), not args.apart, hand, args.general, SETS[args.set], args.hold_guard)
     seconds = time.perf_counter() - started
     print()
     print(table(rows))
@@ -350,6 +363,9 @@ def main() -> None:
     if args.hand_model is not None:
         chosen = f"the {args.hand_model} hand; "
     how = ("each hand apart; " if args.apart else "") + chosen
+    how += {True: "the general policy through the hold guard; ", False: "the general policy alone; "}.get(
+        args.hold_guard, ""
+    )
     print(f"\nmusic21 {music21.__version__}; {how}{seconds:.0f} s")
     if args.json:
         record = {
@@ -359,6 +375,7 @@ def main() -> None:
             "thumb": True if args.thumb else False if args.no_thumb else "as play chooses",
             "hand_model": hand.model if hand is not None else HandSpec.model,
             "general": None if args.general is None else str(args.general),
+            "hold_guard": "as play plays it" if args.hold_guard is None else args.hold_guard,
             "seconds": round(seconds),
             "rows": rows,
         }

@@ -132,8 +132,9 @@ def test_the_corpus_options_reach_the_players(monkeypatch, tmp_path):
 
     asked = {}
 
-    def play_corpus(folder, only=(), together=True, hand=None, general=None, excerpts=corpus.EXCERPTS):
+    def play_corpus(folder, only=(), together=True, hand=None, general=None, excerpts=corpus.EXCERPTS, hold_guard=None):
         asked.update(folder=folder, only=only, together=together, hand=hand, general=general, excerpts=excerpts)
+        asked.update(hold_guard=hold_guard)
         return []
 
     monkeypatch.setitem(sys.modules, "music21", types.SimpleNamespace(__version__="test"))
@@ -149,9 +150,11 @@ def test_the_corpus_options_reach_the_players(monkeypatch, tmp_path):
         "hand": HandSpec((1, 2, 3, 4)),
         "general": tmp_path / "policy",
         "excerpts": corpus.EXCERPTS,
+        "hold_guard": None,
     }
     record = json.loads(out.read_text())
     assert record["apart"] is True and record["thumb"] is True and record["rows"] == []
+    assert record["hold_guard"] == "as play plays it"
     assert record["general"] == str(tmp_path / "policy")
     monkeypatch.setattr(sys, "argv", ["corpus", "--out", str(tmp_path)])
     corpus.main()
@@ -161,11 +164,47 @@ def test_the_corpus_options_reach_the_players(monkeypatch, tmp_path):
     monkeypatch.setattr(sys, "argv", ["corpus", "--out", str(tmp_path), "--no-thumb", "--json", str(out)])
     corpus.main()
     assert asked["hand"] == HandSpec() and json.loads(out.read_text())["thumb"] is False
+    monkeypatch.setattr(sys, "argv", ["corpus", "--out", str(tmp_path), "--no-hold-guard", "--json", str(out)])
+    corpus.main()
+    assert asked["hold_guard"] is False and json.loads(out.read_text())["hold_guard"] is False
     monkeypatch.setattr(sys, "argv", ["corpus", "--set", "validation"])
     corpus.main()
     assert asked["excerpts"] == corpus.VALIDATION and asked["folder"] == Path("out/corpus-validation")
     assert not {name for name, *_ in corpus.VALIDATION} & {name for name, *_ in corpus.EXCERPTS}
     assert not {path for _, path, *_ in corpus.VALIDATION} & {path for _, path, *_ in corpus.EXCERPTS}
+
+
+def test_the_corpus_plays_the_general_policy_alone_with_no_hold_guard(monkeypatch, tmp_path):
+    """play_corpus hands --hold-guard/--no-hold-guard to the general policy's player only (the
+    scripted pianist has no guard), as benchmarks.hands does (the excerpt's writing and reading stood in for)."""
+    import types
+
+    from benchmarks import corpus
+    from pianobot.music.instrument import HandSpec
+    from pianobot.music.piece import Note, Piece
+
+    played = []
+    piece = Piece.of([Note(0.0, 60, 0.5, 80, None, "right"), Note(0.0, 48, 0.5, 80, None, "left")])
+    monkeypatch.setattr(corpus, "write_excerpt", lambda path, parts, first, out: {"source": path, "measures": "1-2"})
+    monkeypatch.setattr(corpus, "two_hands", lambda file, options, fingers: types.SimpleNamespace(piece=piece))
+
+    def figures(piece, controller, models, general=None, together=True, hold_guard=None, seed=0, hand=None):
+        played.append((controller, hold_guard))
+        return {"f1": 1.0, "given": len(piece)}
+
+    monkeypatch.setattr(corpus, "figures", figures)
+    five = HandSpec((1, 2, 3, 4, 5), model="pianist")
+    excerpt = corpus.EXCERPTS[:1]
+    for guard in (None, False, True):
+        corpus.play_corpus(tmp_path, hand=five, general=tmp_path, excerpts=excerpt, hold_guard=guard)
+    assert played == [
+        ("sac", None),
+        ("scripted", None),
+        ("sac", False),
+        ("scripted", None),
+        ("sac", True),
+        ("scripted", None),
+    ]
 
 
 def test_benchmarks_hands_thumb_gives_every_player_and_the_examples_reading_each_hands_thumb(monkeypatch, tmp_path):

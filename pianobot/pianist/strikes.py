@@ -251,7 +251,7 @@ class StrikePlanner:
             and (previous_row[key, NOTE] > 0.5 and previous_row[key, FINGER + slot] > 0.5)
         )
         if current is None or (began_earlier and (self.fingers[slot], key) in released):
-            return self._approach(upcoming, tip) if upcoming is not None else None
+            return self._approach(upcoming, tip, key) if upcoming is not None else None
         if not began_earlier:
             return self._approach(current, tip)  # the onset step itself: strike now
         tip_height = tip.height - self.layout.key_top[key]
@@ -263,8 +263,25 @@ class StrikePlanner:
         next_lead = lead + self.preparing_steps(tip, key, upcoming.key, height)
         return Plan(key, "hold", goal=goal, next_note=upcoming, next_lead=next_lead)
 
-    def _approach(self, run: Run, tip: Tip) -> Plan:
-        """The plan for striking ``run``: hover while its onset is far, else strike (``tip``: where the fingertip is)."""
+    def _approach(self, run: Run, tip: Tip, pressed: int | None = None) -> Plan:
+        """The plan for striking ``run``: hover while its onset is far, else strike (``tip``: where the
+        fingertip is). Striking again ``pressed``, the key the finger has let go of, a fingertip more than
+        ``path_tolerance`` under its strike's path has not risen from it: it rises first (the key must come
+        up to sound again), and strikes once up, late and louder if it must, rather than press on a key
+        that never rose."""
+        plan = self._strike(run, tip)
+        if run.key == pressed and plan.phase == "strike" and run.start > 0:
+            speed = self.tip_speed(run.key, run.velocity)
+            path = (
+                -self.strike_depth(run.key)
+                - self.overshoot(speed)
+                + speed * self.dt * (run.start - 1 + self.strike_point(speed))
+            )
+            if path > tip.height - self.layout.key_top[run.key] + self.tuning.path_tolerance:
+                return Plan(run.key, "ready", height=plan.height, start=run.start, lead=plan.lead)
+        return plan
+
+    def _strike(self, run: Run, tip: Tip) -> Plan:
         key, start = run.key, run.start
         speed = self.tip_speed(key, run.velocity)
         depth = self.strike_depth(key)
@@ -305,7 +322,7 @@ class StrikePlanner:
             if upcoming is None:
                 del plans[finger]
             else:
-                plans[finger] = self._approach(upcoming, tips[finger])
+                plans[finger] = self._approach(upcoming, tips[finger], plans[finger].key)
 
         for finger, plan in list(plans.items()):
             if plan.phase == "hold" and plan.next_note is not None and plan.next_note.start - plan.next_lead <= 0:
