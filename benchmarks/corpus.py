@@ -311,7 +311,7 @@ def main() -> None:
         "--hold-guard",
         action=argparse.BooleanOptionalAction,
         help="the general policy through the hold guard, or (--no-hold-guard) alone; default: as `pianobot play` "
-        "plays it (through the guard)",
+        "plays it (a parts policy through the guard, a melody policy alone)",
     )
     parser.add_argument(
         "--write-training",

@@ -88,6 +88,34 @@ def test_a_repeated_key_is_let_go_later_than_one_the_finger_must_leave():
     assert planner.release_steps(5, 5, 64) < planner.release_steps(5, 7, 64) <= planner.hop_steps(5, 7, 64)
 
 
+def test_a_finger_still_on_the_key_it_let_go_of_rises_before_striking_it_again():
+    """A strike only goes down from where the fingertip is: a finger still pressing the key it let go
+    of, its repeat due, must rise first (it hovers, 'ready'), whether the note it let go is still
+    written or has ended; on its strike's path, or striking another key, it strikes. The pianist's
+    hand's rule (``rise_before_repeat``); the Allegro-like hand's planner strikes as before."""
+    world = WorldConfig()
+    planner = StrikePlanner(world, KeyLayout(world), replace(PianistTuning(), rise_before_repeat=True))
+    finger, slot = world.hand.spec.fingers[1], 1
+    tips = {f: Tip(height=0.01, y=0.11) for f in world.hand.spec.fingers}
+    soft = 0.25  # a strike from the ready height several steps long
+    repeat = window([(5, 0, 2, soft, slot), (5, 3, 9, soft, slot)])  # (a row apart: two notes)
+    lead = planner.ready(Run(5, 0, 1, soft * 127))[1]
+    assert lead >= 3
+    tips[finger] = planner._pressed(5)  # still at the bottom of the key
+    released = frozenset({(finger, 5)})
+    written = planner.plan(repeat[1:], repeat[0], tips, released=released)[finger]
+    assert (written.phase, written.key) == ("ready", 5)  # the note let go is still written
+    ended = window([(5, 1, 7, soft, slot)])  # its written end passed (the previous row held it)
+    assert planner.plan(ended, repeat[0], tips)[finger].phase == "ready"
+    tips[finger] = Tip(height=planner.layout.key_top[5] + planner._path_height(Run(5, 1, 7, soft * 127)), y=0.11)
+    assert planner.plan(ended, repeat[0], tips)[finger].phase == "strike"  # on its path: it strikes
+    tips[finger] = planner._pressed(5)
+    other = window([(7, 1, 7, soft, slot)])
+    assert planner.plan(other, repeat[0], tips)[finger].phase == "strike"  # another key: as before
+    allegro = StrikePlanner(world, KeyLayout(world), PianistTuning())  # (the Allegro-like hand's: unchanged)
+    assert allegro.plan(ended, repeat[0], tips)[finger].phase == "strike"
+
+
 def test_a_note_let_go_before_its_end_is_not_pressed_again():
     """A left hand holds C3 and G3 and strikes C3 again under the held G3 (a new user's organ
     file): the pianist let go of G3 for the repeat, then pressed it again while it was still

@@ -176,7 +176,7 @@ def test_the_corpus_options_reach_the_players(monkeypatch, tmp_path):
 
 def test_the_corpus_plays_the_general_policy_alone_with_no_hold_guard(monkeypatch, tmp_path):
     """play_corpus hands --hold-guard/--no-hold-guard to the general policy's player only (the
-    scripted pianist has no guard), as benchmarks.hands does (the excerpt's writing and reading stood in for)."""
+    scripted pianist has no guard; the excerpt's writing and reading stood in for)."""
     import types
 
     from benchmarks import corpus

@@ -295,7 +295,8 @@ class HandsReading:
     source: str = "its track"
     """What named a note's hand in the file: 'its track', 'the PIG channel'."""
     lent: dict[str, int] = field(default_factory=dict)
-    """Per hand: its notes that the file named for the other hand, which lent them."""
+    """Per hand: the notes it was lent, which the file named for the other hand (a note the planner
+    assigned and then lent counts as the planner's)."""
 
     def to_dict(self, hand: str) -> dict:
         """``hand``'s part: how many notes, its range, how many the file named, the other hand lent

@@ -4,7 +4,9 @@ Every control step the planner reads each finger's notes from the score window
 (:func:`finger_runs`) and gives the finger a :class:`Plan` for this step:
 
 - ``ready``: hover over the next key at the height from which constant-speed travel, started
-  :attr:`Plan.lead` steps before the onset, reaches the strike depth on time;
+  :attr:`Plan.lead` steps before the onset, reaches the strike depth on time; or rise to that
+  height from a key the finger has let go of but still presses, before it strikes it again
+  (:meth:`StrikePlanner._approach`);
 - ``strike``: go down at the speed that the keyboard's velocity curve turns into the target
   velocity, so as to pass the strike depth in the onset's step. Every step re-plans from
   where the fingertip actually is (closed loop);
@@ -251,7 +253,10 @@ class StrikePlanner:
             and (previous_row[key, NOTE] > 0.5 and previous_row[key, FINGER + slot] > 0.5)
         )
         if current is None or (began_earlier and (self.fingers[slot], key) in released):
-            return self._approach(upcoming, tip, key) if upcoming is not None else None
+            if upcoming is None:
+                return None
+            pressed = key if current is not None else self._pressed_before(previous_row, slot)
+            return self._approach(upcoming, tip, pressed)
         if not began_earlier:
             return self._approach(current, tip)  # the onset step itself: strike now
         tip_height = tip.height - self.layout.key_top[key]
@@ -263,25 +268,42 @@ class StrikePlanner:
         next_lead = lead + self.preparing_steps(tip, key, upcoming.key, height)
         return Plan(key, "hold", goal=goal, next_note=upcoming, next_lead=next_lead)
 
+    @staticmethod
+    def _pressed_before(previous_row: np.ndarray | None, slot: int) -> int | None:
+        """The key the finger in ``slot`` was written to hold in the previous step's row, if any."""
+        if previous_row is None:
+            return None
+        keys = np.flatnonzero((previous_row[:, NOTE] > 0.5) & (previous_row[:, FINGER + slot] > 0.5))
+        return int(keys[-1]) if keys.size else None
+
     def _approach(self, run: Run, tip: Tip, pressed: int | None = None) -> Plan:
         """The plan for striking ``run``: hover while its onset is far, else strike (``tip``: where the
-        fingertip is). Striking again ``pressed``, the key the finger has let go of, a fingertip more than
-        ``path_tolerance`` under its strike's path has not risen from it: it rises first (the key must come
-        up to sound again), and strikes once up, late and louder if it must, rather than press on a key
-        that never rose."""
+        fingertip is; ``pressed``: the key the finger held last, which it has let go of).
+
+        A strike only goes down from where the fingertip is. So, with ``rise_before_repeat`` (the
+        pianist's hand), a finger that strikes ``pressed`` again while its tip is still under the key's
+        top, more than ``path_tolerance`` under its strike's path (it has not risen from the key, which
+        must come up to sound again: a repeat sooner than the strike from the ready height takes),
+        hovers instead: it rises, and strikes once up, late and louder if it must."""
         plan = self._strike(run, tip)
-        if run.key == pressed and plan.phase == "strike" and run.start > 0:
-            speed = self.tip_speed(run.key, run.velocity)
-            path = (
-                -self.strike_depth(run.key)
-                - self.overshoot(speed)
-                + speed * self.dt * (run.start - 1 + self.strike_point(speed))
-            )
-            if path > tip.height - self.layout.key_top[run.key] + self.tuning.path_tolerance:
+        tip_height = tip.height - self.layout.key_top[run.key]
+        rise = self.tuning.rise_before_repeat and run.key == pressed
+        if rise and plan.phase == "strike" and run.start > 0 and tip_height < 0:
+            if self._path_height(run) > tip_height + self.tuning.path_tolerance:
                 return Plan(run.key, "ready", height=plan.height, start=run.start, lead=plan.lead)
         return plan
 
+    def _path_height(self, run: Run) -> float:
+        """Where the fingertip should be after this step, over the key's top (m), on the constant-speed
+        travel that passes the strike depth at the strike point of ``run``'s onset step, ``run.start``
+        (at least 1) steps on."""
+        speed = self.tip_speed(run.key, run.velocity)
+        depth = self.strike_depth(run.key)
+        return -depth - self.overshoot(speed) + speed * self.dt * (run.start - 1 + self.strike_point(speed))
+
     def _strike(self, run: Run, tip: Tip) -> Plan:
+        """Hover over ``run``'s key while its onset is far, else strike it (closed loop: re-planned each
+        step from where the fingertip is)."""
         key, start = run.key, run.start
         speed = self.tip_speed(key, run.velocity)
         depth = self.strike_depth(key)
@@ -289,13 +311,12 @@ class StrikePlanner:
         point = self.strike_point(speed)
         if start > steps:
             return Plan(key, "ready", height=height, start=start, lead=steps)
-        # closed loop: after this step the fingertip should be where constant-speed travel passes
-        # the strike depth at the strike point of the onset's step, (start - 1 + point) steps on
+        # closed loop: after this step the fingertip should be on its constant-speed path
         tip_height = tip.height - self.layout.key_top[key]
         if start == 0:  # the onset's step: sound on time, faster (louder) only if a late start asks for it
             goal = tip_height - max(speed * self.dt, (tip_height + depth + self.overshoot(speed)) / point)
         else:
-            goal = -depth - self.overshoot(speed) + speed * self.dt * (start - 1 + point)
+            goal = self._path_height(run)
         floor = -depth - self.tuning.hold_depth_margin
         return Plan(
             key, "strike", height=height, goal=float(min(max(goal, floor), tip_height)), start=start, lead=steps

@@ -107,6 +107,12 @@ class PianistTuning:
     with its abduction). Fingers about to strike, not yet down, never limit it."""
     tilt_step: float = 0.15
     """Most change of the fingertip's tilt the inverse kinematics asks for in one step (rad per control step)."""
+    rise_before_repeat: bool = False
+    """Whether a finger that strikes again the key it has let go of, its tip still under the key's top and
+    under its strike's path (the repeat sooner than its strike from the ready height takes), rises before
+    it strikes (:meth:`~pianobot.pianist.strikes.StrikePlanner._approach`). Off, the default (the
+    Allegro-like hand's, whose figures stay as measured), such a strike goes down from where the tip is:
+    on a key that never rose, and the repeats do not sound."""
     let_up_height: float = math.inf
     """Under the hold guard (:class:`~pianobot.perform.guard.HoldGuard`): a holding finger whose tip has
     risen this far over its key's top let the key up, and its note ended; the guard's teacher leaves the

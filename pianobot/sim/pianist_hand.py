@@ -38,6 +38,7 @@ PIANIST = HandModel(
         ("strike_slide", 0.004),
         ("let_up_height", 0.008),
         ("travel_share", 0.75),
+        ("rise_before_repeat", True),
     ),
     passes=frozenset({(1, 2), (1, 3), (1, 4)}),
     written_fingering=True,
@@ -82,6 +83,8 @@ it stays up until its note ends (``let_up_height``): pressed again, it would sou
 planner counts on its fingertips covering three quarters of their longest positioning move a step
 (``travel_share``), so a held key is let go early enough for its finger's far move (from a black key
 across to a white one) to strike on time, and the fingering planner gives a finger that time between
-its notes."""
+its notes. A finger that strikes again the key it has let go of rises from it first
+(``rise_before_repeat``): pressed on from the bottom of a key that never rose, soft repeats written
+for one finger did not sound."""
 
 register_hand_model(PIANIST)
