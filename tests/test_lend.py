@@ -101,3 +101,24 @@ def test_a_file_with_tracks_named_for_hands_lends_and_says_so(tmp_path):
         "lent_by_other_hand": 1,
         "assigned_by_planner": 0,
     }
+
+
+def test_a_named_note_thinned_away_is_counted_for_neither_hand(tmp_path):
+    """Eleven notes at once, more than two hands of five fingers hold: the reading thins one inner
+    note away. Each hand's count is of the notes it plays: named, lent or assigned, nothing of the
+    thinned note (which, counted, made a hand's notes more than it plays)."""
+    midi = mido.MidiFile(type=1)
+    for name, notes in (("Right Hand", [60, 62, 64, 65, 67, 69]), ("Left Hand", [48, 50, 52, 53, 55])):
+        events = [mido.MetaMessage("track_name", name=name)]
+        events += [mido.Message("note_on", note=p, velocity=80) for p in notes]
+        events += [mido.Message("note_off", note=p, time=480 if i == 0 else 0) for i, p in enumerate(notes)]
+        midi.tracks.append(mido.MidiTrack(events))
+    midi.save(tmp_path / "eleven.mid")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", PianobotWarning)
+        reading = read_hands(tmp_path / "eleven.mid", LoadOptions(), FIVE)
+    assert len(reading.piece) == 10
+    for hand in ("right", "left"):
+        counts = reading.to_dict(hand)
+        assert counts["named_by_file"] + counts["lent_by_other_hand"] == counts["notes"]
+        assert counts["assigned_by_planner"] == 0
