@@ -69,8 +69,8 @@ class PianistTuning:
     what the wrist cannot reach in the time left."""
     thumb_stretch: float = 1.0
     """Share of the fingering planner's stretch cost the thumb pays (1: as much as any finger). A
-    pianist's thumb turns under the palm with ease, so it passes under in a scale rather than the
-    whole hand shifting after the fifth finger."""
+    pianist's thumb turns under the palm with ease: less, and the planner fingers a scale with the
+    thumb under (1 2 3 1) rather than the whole hand shifting after the fifth finger."""
     legato_cost: float = 2.0
     """The fingering planner's cost of a note let go before its written end, per share of its written
     length lost (in white keys of wrist travel: a whole note lost costs as much as a move of this many)."""

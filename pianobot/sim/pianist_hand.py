@@ -60,8 +60,8 @@ reaches under the palm); it passes under the index, middle and ring fingers and 
 (:attr:`HandModel.passes`: the fingering planner lets their fingertips cross; turned to its limit
 its tip reaches one white key past a held index, but not past a held middle finger, so a 1 2 3 1 in
 a scale shifts the hand: docs/simulator.md). Its planner holds
-notes to their written end as a pianist does (a higher ``legato_cost``): the thumb passes under
-in a scale rather than the hand jumping. Its fingers turn sideways less far than the
+notes to their written end as a pianist does (a higher ``legato_cost``), so it fingers a
+one-octave scale with the thumb under rather than after the fifth finger. Its fingers turn sideways less far than the
 Allegro-like hand's longer ones, so the wrist strays less from straight over a held or struck
 key (``hold_reach``, ``strike_reach``; the thumb's as far farther as it turns) and slides more
 slowly while a finger holds one (``hold_slide``); and its joints, at the Shadow hand's speed,
@@ -74,9 +74,9 @@ Allegro-like hand's 0.2 s) around a wrist move for its light fingers to lift and
 reduction gives the hands the quick hand shifts its scripted pianist plays; and its fingers take
 two control steps, not the Allegro-like hand's four, to lift, move over and settle before a strike
 (``prepare_steps``), so a key held before a hand move is let go that much nearer its written end. Its thumb pays half a
-finger's stretch cost in the planner (``thumb_stretch``), so a scale passes the thumb under (1 2 3
-1 2 3 4 5) at any tempo, as pianists finger it, rather than shifting the whole hand after the fifth
-finger. While a fingertip is on its way into its key the wrist slides at most 4 mm a control step
+finger's stretch cost in the planner (``thumb_stretch``), so a one-octave scale is fingered with the
+thumb under (1 2 3 1 2 3 4 5, 0.15-1 s a note), as pianists finger it, rather than shifting the whole
+hand after the fifth finger (over two octaves it still shifts after the fifth). While a fingertip is on its way into its key the wrist slides at most 4 mm a control step
 (``strike_slide``, as while a finger holds one): a thumb turned towards its key lags a quicker
 slide and was dragged off it. Under the hold guard, a held key whose fingertip has risen 8 mm over
 it stays up until its note ends (``let_up_height``): pressed again, it would sound twice. The strike
