@@ -28,7 +28,9 @@ from hand start 0, and the scripted pianist; figures against the file as written
 reduction left out (faster than the hand moves, chords wider than it reaches, more notes than it
 has fingers) count as missed. ``notes`` is the file as ``pianobot play`` reads it (a chord of
 more notes than two hands have fingers thinned), ``notes given`` how many of them the hands were
-given to play after that reduction: the most a player can strike. ``--apart`` plays each hand in a
+given to play after that reduction: the most a player can strike; ``as given``, the per-step F1 and
+note F1 with offsets of those notes as given (the reduction ends a note early where the hand cannot
+hold it), against the file: the most a player of them scores, beside the scripted pianist's. ``--apart`` plays each hand in a
 simulation of its own (``pianobot.perform.together.play_hands(..., together=False)``): what the
 hands lose by getting in each other's way. By default the Allegro-like hand plays (``pianobot play
 --hand-model allegro``; ``play`` alone gives two-hand files the pianist's hands), its fingers chosen
@@ -247,14 +249,15 @@ def table(rows: list[dict]) -> str:
     pianist's where the general policy did not play: ``--thumb``)."""
     lines = [
         "| piece | corpus path (measures) | fingers | notes | notes given | note F1, general policy | right | left | "
-        "per-step F1, general policy | note F1, scripted pianist | general / scripted |",
-        "| --- | --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |",
+        "per-step F1, general policy | note F1, scripted pianist | general / scripted | "
+        "per-step F1, offsets: scripted pianist | as given |",
+        "| --- | --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | --- | --- |",
     ]
     played = [r for r in rows if "refused" not in r]
     for r in rows:
         where = f"`{r['source']}` ({r['measures']})"
         if "refused" in r:
-            lines.append(f"| {r['piece']} | {where} | | | | refused: {r['refused']} | | | | | |")
+            lines.append(f"| {r['piece']} | {where} | | | | refused: {r['refused']} | | | | | | | |")
             continue
         g, s = r["sac"], r["scripted"]
         general = (
@@ -263,7 +266,8 @@ def table(rows: list[dict]) -> str:
         share = _share(g["f1"], s["f1"]) if g else "n/a"
         fingers = "-".join(str(f) for f in r["fingers"][:: len(r["fingers"]) - 1]) if r.get("fingers") else ""
         lines.append(
-            f"| {r['piece']} | {where} | {fingers} | {r['notes']} | {(g or s)['given']} | {general} | {s['f1']:.3f} | {share} |"
+            f"| {r['piece']} | {where} | {fingers} | {r['notes']} | {(g or s)['given']} | {general} | {s['f1']:.3f} | {share} "
+            f"| {_held(s)} | {_held(s['as_given'])} |"
         )
     if played:
         given = sum((r["sac"] or r["scripted"])["given"] for r in played) / sum(r["notes"] for r in played)
@@ -274,9 +278,21 @@ def table(rows: list[dict]) -> str:
         lines.append(
             f"| mean ({len(played)} played) | | | | {given:.0%} given | "
             + (f"{general:.3f} | | | {steps:.3f}" if general is not None else "n/a | | | n/a")
-            + f" | {scripted:.3f} | {_share(general, scripted) if general is not None else 'n/a'} |"
+            + f" | {scripted:.3f} | {_share(general, scripted) if general is not None else 'n/a'} "
+            + f"| {_held(_means([r['scripted'] for r in played]))} "
+            + f"| {_held(_means([r['scripted']['as_given'] for r in played]))} |"
         )
     return "\n".join(lines)
+
+
+def _means(figures: list[dict]) -> dict:
+    return {key: float(np.mean([f[key] for f in figures])) for key in ("step_f1", "f1_offsets")}
+
+
+def _held(figures: dict) -> str:
+    """Per-step F1 and note F1 with offsets: how long the notes were held (as given: how long the
+    reduction left them, the most a player of them scores)."""
+    return f"{figures['step_f1']:.3f}, {figures['f1_offsets']:.3f}"
 
 
 def _share(general: float, scripted: float) -> str:

@@ -88,13 +88,15 @@ def figures(
         performance = play_hands(
             piece, controller, models, seed=seed, together=together, keyboard=keyboard, hand=hand, **options
         )
-    whole = performance.report()
+    whole, given = performance.report(), performance.given_report()
     out = {
         "f1": whole.f1,
         "step_f1": whole.step_f1,
         "f1_offsets": whole.f1_with_offsets,
         "left_out": sum(h.left_out for h in performance.hands),
         "given": sum(len(h.part) for h in performance.hands),  # (what the reduction left the hands to play)
+        # the given notes as given, against the file: the most a player of them scores
+        "as_given": {"f1": given.f1, "step_f1": given.step_f1, "f1_offsets": given.f1_with_offsets},
         "fingers": list(performance.hands[0].performance.plan.config.world.hand.spec.fingers),
     }
     for hand in piece.hands:

@@ -93,13 +93,14 @@ def test_the_corpus_table_counts_what_was_given_and_what_was_refused():
 
     def row(name, notes, given, general, scripted):
         figures = {"f1": general, "f1_right": general, "f1_left": general, "step_f1": 0.5, "given": given}
+        held = {"step_f1": scripted / 2, "f1_offsets": scripted / 4}
         return {
             "piece": name,
             "source": f"x/{name}",
             "measures": "1-4",
             "notes": notes,
             "sac": figures,
-            "scripted": {**figures, "f1": scripted},
+            "scripted": {**figures, "f1": scripted, **held, "as_given": {"f1": 1.0, "step_f1": 0.9, "f1_offsets": 0.8}},
             "fingers": [1, 2, 3, 4] if name == "a" else [2, 3, 4],
         }
 
@@ -111,7 +112,10 @@ def test_the_corpus_table_counts_what_was_given_and_what_was_refused():
     text = corpus.table(rows)
     assert "| c | `x/c` (1-2) | | | | refused: read as one hand's file |" in text
     assert "| b | `x/b` (1-4) | 2-4 | 100 | 60 | 0.000 |" in text and "| n/a |" in text
-    assert "| mean (2 played) | | | | 75% given | 0.400 | | | 0.500 | 0.500 | 80% |" in text
+    assert (
+        "| mean (2 played) | | | | 75% given | 0.400 | | | 0.500 | 0.500 | 80% | 0.250, 0.125 | 0.900, 0.800 |" in text
+    )
+    assert "| a | `x/a` (1-4) | 1-4 | 100 | 90 | 0.800 | 0.800 | 0.800 | 0.500 | 1.000 | 80% | 0.500, 0.250 |" in text
     # --thumb: the scripted pianist alone played; what it was given counts
     thumbs = [{**r, "sac": None} for r in rows[:2]]
     text = corpus.table(thumbs)

@@ -38,7 +38,7 @@ from typing import Callable
 from pianobot.agent.general import parts_policy
 from pianobot.errors import PianobotError, PianobotWarning, SettingError
 from pianobot.music.instrument import THUMB, HandSpec, KeyboardSpec
-from pianobot.music.metrics import Report
+from pianobot.music.metrics import Report, compare
 from pianobot.music.pedal import Pedal
 from pianobot.music.per_hand import HandsReport, compare_hands
 from pianobot.music.piece import FINGER_NAMES, HANDS, Piece
@@ -99,6 +99,15 @@ class HandPerformance:
         notes = [
             replace(n, pitch=self.window.outward(n.pitch), hand=self.hand)
             for n in self.performance.played.shift(self.start).notes
+        ]
+        return Piece(tuple(notes), bpm=self.part.bpm)
+
+    @property
+    def given(self) -> Piece:
+        """What this hand was given to play (:attr:`part`), back at the written pitches and times, each
+        note with its hand: the notes and lengths a player who plays every one of them as given sounds."""
+        notes = [
+            replace(n, pitch=self.window.outward(n.pitch), hand=self.hand) for n in self.part.shift(self.start).notes
         ]
         return Piece(tuple(notes), bpm=self.part.bpm)
 
@@ -164,6 +173,12 @@ class HandsPerformance:
         """The figures for the whole piece, or for ``hand``'s part (against its written notes),
         as ``pianobot score`` computes them from the written file."""
         return self.scores.whole if hand is None else self.scores.hands[hand]
+
+    def given_report(self) -> Report:
+        """The figures of both hands' :attr:`~HandPerformance.given` notes against the piece as written:
+        what a player who plays every given note as given would score, the most the reduction leaves."""
+        given = Piece(tuple(n for h in self.hands for n in h.given.notes), self.piece.bpm)
+        return compare(self.piece, given)
 
     @property
     def performer(self) -> str:
