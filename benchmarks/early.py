@@ -1,11 +1,12 @@
 """Why the scripted pianist lets held notes go before their written end, on real two-hand music.
 
-    python -m benchmarks.early [--set validation|test] [--hand-model pianist] [--only NAME ...] [--json out.json]
+    python -m benchmarks.early [--set test|validation] [--hand-model pianist|allegro] [--only NAME ...] [--json out.json]
 
-Plays :mod:`benchmarks.corpus`' excerpts with the scripted pianist (both hands in one simulation,
-as ``pianobot play`` plays them) and counts every note the strike planner lets go while the score
-window still holds it (:meth:`~pianobot.pianist.strikes.StrikePlanner._let_go`), by the rule that
-let it go, with the control steps of it that were left:
+Plays :mod:`benchmarks.corpus`' excerpts (default the test set, as it) with the scripted pianist,
+both hands in one simulation and each hand's fingers as there (``pianobot play``'s), and counts every
+note the strike planner lets go while the score still holds it, by the rule it names
+(:meth:`~pianobot.pianist.strikes.StrikePlanner.released_for`), with the control steps of the note
+still written from then to its end:
 
 - **own next note**: its finger must lift, move over and strike its own next note;
 - **same key**: another finger strikes the same key next, and it must rise first;
@@ -14,8 +15,7 @@ let it go, with the control steps of it that were left:
 
 Beside them, the scripted pianist's per-step F1 and note F1 with offsets, and the same figures of
 the notes as the reduction gave them (``as given``: the most a player of them scores). A
-diagnostic: it wraps the strike planner's method to watch it, and changes nothing it does.
-"""
+diagnostic: it watches the strike planner (:func:`watch`) and changes nothing it does."""
 
 from __future__ import annotations
 
@@ -24,68 +24,69 @@ import json
 import tempfile
 import warnings
 from collections import Counter
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
 
 from benchmarks.corpus import SETS, write_excerpt
 from pianobot.errors import PianobotWarning
+from pianobot.music.instrument import HandSpec
 from pianobot.music.load import LoadOptions
-from pianobot.perform.together import play_hands, two_hands
-from pianobot.pianist.strikes import StrikePlanner, finger_runs
+from pianobot.music.tensor import FINGER, NOTE
+from pianobot.perform.together import fingers_for_file, play_hands, two_hands
+from pianobot.pianist.strikes import StrikePlanner
 from pianobot.sim.hand import HAND_MODELS, default_fingers
 
 RULES = ("own next note", "same key", "wrist move")
 
 
+@contextmanager
 def watch(counts: Counter, steps: Counter):
-    """Wrap :meth:`StrikePlanner.plan` so that each note let go while still written is counted in
-    ``counts`` by its rule, and the steps of it left in ``steps``; returns the original, to restore."""
-    original = StrikePlanner.plan
+    """While in the block, every note a strike planner lets go while the score still holds it is counted
+    in ``counts`` by its rule (:meth:`StrikePlanner.released_for`), and ``steps`` counts the control
+    steps of it still written from then on, step by step to its end (so past the score window too).
+    The planner's plans are not changed; its methods are restored on leaving the block."""
+    plan, released_for = StrikePlanner.plan, StrikePlanner.released_for
+    open_notes: dict[int, dict[tuple[int, int], str]] = {}  # planner -> (slot, key) let go -> rule
 
-    def plan(self, score, previous_row, tips, wrist=None, released=frozenset()):
-        watched = self._let_go
+    def watched_plan(self, score, *args, **kwargs):
+        notes = open_notes.setdefault(id(self), {})
+        row = score[0]
+        for (slot, key), rule in list(notes.items()):  # a note let go earlier: one more step of it written?
+            if row[key, NOTE] > 0.5 and row[key, FINGER + slot] > 0.5:
+                steps[rule] += 1
+            else:
+                del notes[slot, key]
+        return plan(self, score, *args, **kwargs)
 
-        def let_go(plans, tips_, wrist_):
-            holds = {f: p for f, p in plans.items() if p.phase == "hold"}
-            own = {f for f, p in holds.items() if p.next_note is not None and p.next_note.start - p.next_lead <= 0}
-            watched(plans, tips_, wrist_)
-            for finger, held in holds.items():
-                if finger in plans and plans[finger].phase == "hold":
-                    continue
-                others = any(p.key == held.key and f != finger and p.phase != "hold" for f, p in plans.items())
-                rule = "own next note" if finger in own else "same key" if others else "wrist move"
-                slot = self.fingers.index(finger)
-                runs = [r for r in finger_runs(score, slot) if r.start == 0 and r.key == held.key]
-                counts[rule] += 1
-                steps[rule] += runs[0].end if runs else 0
+    def watched_release(self, finger, held, rule):
+        counts[rule] += 1
+        steps[rule] += 1  # (this step)
+        open_notes[id(self)][self.fingers.index(finger), held.key] = rule
 
-        self._let_go = let_go
-        try:
-            return original(self, score, previous_row, tips, wrist, released)
-        finally:
-            del self._let_go
-
-    StrikePlanner.plan = plan
-    return original
+    StrikePlanner.plan, StrikePlanner.released_for = watched_plan, watched_release
+    try:
+        yield
+    finally:
+        StrikePlanner.plan, StrikePlanner.released_for = plan, released_for
 
 
-def early(excerpts, folder: Path, hand) -> list[dict]:
-    """A row per excerpt: the releases and steps by rule, and the held figures played and as given."""
+def early(excerpts, folder: Path, hand: HandSpec | None) -> list[dict]:
+    """A row per excerpt: the releases and steps by rule, and the held figures played and as given
+    (``hand``: each hand's fingers; None: chosen per file as ``pianobot play`` and
+    :mod:`benchmarks.corpus` choose them)."""
     folder.mkdir(parents=True, exist_ok=True)
     rows = []
     for name, path, parts, first in excerpts:
         file = folder / f"{name}.mid"
         write_excerpt(path, parts, first, file)
         counts, steps = Counter(), Counter()
-        original = watch(counts, steps)
-        try:
-            with warnings.catch_warnings(), tempfile.TemporaryDirectory() as models:
-                warnings.simplefilter("ignore", PianobotWarning)
-                reading = two_hands(file, LoadOptions(), hand)
-                performance = play_hands(reading.piece, "scripted", models, hand=hand)
-        finally:
-            StrikePlanner.plan = original
+        fingers = hand if hand is not None else fingers_for_file(file, LoadOptions())[0]  # (as benchmarks.corpus)
+        with watch(counts, steps), warnings.catch_warnings(), tempfile.TemporaryDirectory() as models:
+            warnings.simplefilter("ignore", PianobotWarning)
+            reading = two_hands(file, LoadOptions(), fingers)
+            performance = play_hands(reading.piece, "scripted", models, hand=fingers)
         played, given = performance.report(), performance.given_report()
         rows.append(
             {
@@ -123,7 +124,7 @@ def table(rows: list[dict]) -> str:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--set", choices=tuple(SETS), default="validation", help="the excerpts (default: validation)")
+    parser.add_argument("--set", choices=tuple(SETS), default="test", help="the excerpts (default: test)")
     parser.add_argument("--hand-model", choices=tuple(HAND_MODELS), default="pianist", help="the hand that plays")
     parser.add_argument("--only", nargs="+", default=(), help="only these excerpts (by name)")
     parser.add_argument("--out", type=Path, help="folder the excerpts are written to (default out/early-SET)")
@@ -134,7 +135,8 @@ def main() -> None:
     except ImportError:
         parser.error('music21 is not installed: pip install -e ".[corpus]"')
     excerpts = [e for e in SETS[args.set] if not args.only or e[0] in args.only]
-    rows = early(excerpts, args.out or Path(f"out/early-{args.set}"), default_fingers(args.hand_model))
+    hand = default_fingers(args.hand_model) if args.hand_model != HandSpec.model else None  # (None: as play chooses)
+    rows = early(excerpts, args.out or Path(f"out/early-{args.set}"), hand)
     print()
     print(table(rows))
     if args.json:

@@ -59,7 +59,8 @@ def test_the_scripted_pianist_plays_both_hands_of_a_duet_at_the_written_pitches(
 def test_what_each_hand_was_given_reads_back_at_the_written_pitches_and_scores_what_the_reduction_left():
     """The given notes (mirrored, moved and reduced for the hand) back at the written pitches and times:
     a duet the hands play as written is given whole; a note held under a two-octave leap is given
-    ending where the leap begins, which its note F1 keeps and its offsets and per-step F1 do not."""
+    ending where the leap begins, which its note F1 keeps and its offsets and per-step F1 do not; a
+    piece that begins after a rest is given at its own times."""
     (name, piece), *_ = [d for d in duet_set(0, 8) if "broken" in d[0]]
     performance = play_hands(piece, "scripted")
     given = {(n.pitch, round(n.onset, 6), n.hand) for h in performance.hands for n in h.given.notes}
@@ -67,18 +68,18 @@ def test_what_each_hand_was_given_reads_back_at_the_written_pitches_and_scores_w
     whole = performance.given_report()
     assert (whole.f1, whole.f1_with_offsets, whole.step_f1) == (1.0, 1.0, 1.0)
 
-    leap = Piece(
+    leap = Piece(  # (beginning after a rest: the hands' parts are moved to start at 0, and back)
         (
-            Note(0.0, 60, 2.0, hand="right"),
-            Note(0.5, 84, 1.0, hand="right"),
-            Note(0.0, 48, 1.0, hand="left"),
+            Note(1.0, 60, 3.0, hand="right"),
+            Note(1.5, 84, 2.0, hand="right"),
+            Note(1.0, 48, 2.0, hand="left"),
         )
     )
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", PianobotWarning)
         performance = play_hands(leap, "scripted")
     held = [n for n in performance.hands[0].given.notes if n.pitch == 60]
-    assert [(n.onset, n.offset) for n in held] == [(0.0, 0.5)]
+    assert [(n.onset, n.offset) for n in held] == [(1.0, 1.5)]
     whole = performance.given_report()
     assert whole.f1 == 1.0 and whole.f1_with_offsets < 1.0 and whole.step_f1 < 1.0
 

@@ -338,7 +338,8 @@ class StrikePlanner:
         """
         tuning, layout = self.tuning, self.layout
 
-        def release(finger: int) -> None:
+        def release(finger: int, rule: str) -> None:
+            self.released_for(finger, plans[finger], rule)
             upcoming = plans[finger].next_note
             if upcoming is None:
                 del plans[finger]
@@ -347,13 +348,13 @@ class StrikePlanner:
 
         for finger, plan in list(plans.items()):
             if plan.phase == "hold" and plan.next_note is not None and plan.next_note.start - plan.next_lead <= 0:
-                release(finger)
+                release(finger, "own next note")
         for finger, plan in list(plans.items()):  # another finger strikes the held key: it must rise first
             if plan.phase == "strike" or plan.phase == "ready":
                 for held, other in list(plans.items()):
                     if other.phase == "hold" and other.key == plan.key and held != finger:
                         if plan.start - plan.lead - tuning.repeat_prepare_steps <= 0:
-                            release(held)
+                            release(held, "same key")
         holds = {f: p for f, p in plans.items() if p.phase == "hold"}
         if not holds:
             return
@@ -377,8 +378,13 @@ class StrikePlanner:
             shift_steps = math.ceil(travel / (self.max_wrist_speed * self.dt))
             if travel > 0 and start - lead - extra - shift_steps <= 0:
                 for held in holds:
-                    release(held)
+                    release(held, "wrist move")
                 return
+
+    def released_for(self, finger: int, plan: Plan, rule: str) -> None:
+        """Called as :meth:`_let_go` lets ``finger`` go of its held key (``plan``, its hold) before the key's
+        written end, by ``rule``: 'own next note', 'same key' (another finger strikes it next) or 'wrist
+        move'. Does nothing; a diagnostic (benchmarks/early.py) watches it."""
 
     def _strike_while_holding(
         self, wanted: float, reach: float, low: float, high: float, steps: int, wrist: float | None
