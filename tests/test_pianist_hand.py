@@ -152,6 +152,36 @@ def test_a_file_s_own_five_finger_fingering_plays_as_written_on_the_pianist_s_ha
     assert_one_line_error(result, "fingered 1 (thumb)", "--refinger", "--hand-model pianist")
 
 
+def test_a_fully_fingered_file_the_pianist_s_hand_cannot_play_as_written_keeps_every_mark_it_can(tmp_path):
+    """C4 with the middle finger under E4 with the index (fingers that would cross): the planner fingers
+    that chord anew and keeps the file's other marks, in one line (played as written before, two of its
+    four notes sounded, note F1 0.571). A fingering it can play stays as written, and so do marks only its
+    speed is against; the Allegro-like hand, whose fingers are no human's, keeps a full fingering as it always has."""
+    from pianobot.music.pig import write_pig
+    from pianobot.pianist.fingering import ensure_fingering
+
+    crossed = Piece((Note(0.0, 60, 0.5, finger=3), Note(0.0, 64, 0.5, finger=2), Note(0.5, 67, 1.0, finger=5),
+                     Note(1.0, 72, 1.5, finger=5)))  # fmt: skip
+    fingered, plan = ensure_fingering(crossed, KeyboardSpec(), FIVE)
+    assert plan is not None and [n.finger for n in fingered.notes][2:] == [5, 5]
+    assert fingered.notes[0].finger < fingered.notes[1].finger  # (pitch order)
+    scale = _scale().with_fingers([1, 2, 3, 1, 2, 3, 4, 5, 4, 3, 2, 1, 3, 2, 1])
+    assert ensure_fingering(scale, KeyboardSpec(), FIVE) == (scale, None)
+    # soft repeats by one finger, faster than the planner times them: kept (the scripted pianist plays them)
+    repeats = Piece(tuple(Note(0.3 * i, 60, 0.3 * i + 0.25, 30, 2) for i in range(8)))
+    timed = Planner(KeyboardConfig(), hand_config(FIVE)).plan(repeats)  # (as a partly fingered part's marks are)
+    assert [n.finger for n in timed.piece.notes] != [2] * 8
+    assert ensure_fingering(repeats, KeyboardSpec(), FIVE) == (repeats, None)
+    assert ensure_fingering(crossed, KeyboardSpec(), HandSpec()) == (crossed, None)
+
+    song = write_pig(crossed, tmp_path / "crossed.txt")
+    out = tmp_path / "out.mid"
+    result = run("play", song, "-o", out, "--hand-model", "pianist", "--controller", "scripted")
+    assert result.exit_code == 0, result.output
+    assert "this hand cannot play all of its fingering; kept 3 of its 4 fingering marks" in result.output
+    assert json.loads(out.with_suffix(".report.json").read_text())["f1"] == 1.0
+
+
 def test_under_position_control_each_finger_is_commanded_within_its_own_limits():
     """The thumb turns farther than the fingers: position commands map each finger's angles to its
     own limits (on the thumb's scale an index at its limit would be commanded short of it)."""

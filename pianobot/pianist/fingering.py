@@ -208,8 +208,11 @@ class Planner:
         neither the wrist nor a finger can get there in the time between the onsets."""
         return self._follow(before, chord, in_time)[0]
 
-    def _follow(self, before: Reach, chord: Sequence[Note], in_time: bool) -> tuple[Reach, np.ndarray]:
-        """:meth:`follow`, and for each state the state before it on the cheapest way there."""
+    def _follow(
+        self, before: Reach, chord: Sequence[Note], in_time: bool, slow: float = _TOO_FAST
+    ) -> tuple[Reach, np.ndarray]:
+        """:meth:`follow`, and for each state the state before it on the cheapest way there (``slow``: the
+        cost of a move or hop too fast, where not ``in_time``)."""
         prev_chord, chord = before.chord, tuple(chord)
         p_assign, p_keys, _ = self._states(prev_chord)
         assignments, keys, local = self._states(chord)
@@ -217,7 +220,7 @@ class Planner:
         held = [n.offset > onset + 1e-6 for n in sorted(prev_chord, key=lambda n: n.pitch)]
         velocities = [n.velocity for n in sorted(chord, key=lambda n: n.pitch)]
         time = onset - prev_chord[0].onset
-        slow = _INFEASIBLE if in_time else _TOO_FAST
+        slow = _INFEASIBLE if in_time else slow
         too_fast = np.where(self._wrist_too_fast(self._distance, time, chord), slow, 0.0)
         # the slowest strike's lead from its ready height: a note out of reach is let go before it
         lead = max(self.strikes.ready(Run(key, 0, 1, v))[1] for key, v in zip(keys, velocities))
@@ -328,9 +331,13 @@ class Planner:
         return np.repeat(MARK_COST * np.array(off, float)[:, None], len(self.grid), axis=1)
 
     # -- the whole piece ---------------------------------------------------------------------
-    def plan(self, piece: Piece, room: Sequence[tuple[float, float]] | None = None) -> FingeringPlan:
+    def plan(
+        self, piece: Piece, room: Sequence[tuple[float, float]] | None = None, timing: bool = True
+    ) -> FingeringPlan:
         """The lowest-cost fingering of ``piece`` (the module's notes), keeping the fingers its notes
-        have where the hand can (:data:`MARK_COST`). ``room``: for each chord
+        have where the hand can (:data:`MARK_COST`); without ``timing``, a mark is kept where only the
+        hand's speed is against it (a move or hop too fast costs nothing, and is still said in
+        :attr:`FingeringPlan.problems`). ``room``: for each chord
         (as :meth:`~pianobot.music.piece.Piece.chords` gives them) the lowest and highest wrist
         position (m, ``-inf``/``inf`` for none) that keeps this hand clear of the other; a state
         whose wrist, or where its fingers put the scripted pianist's wrist (straight over their
@@ -359,7 +366,7 @@ class Planner:
             if i == 0:
                 reach = self.place(chord)
             else:
-                reach, best = self._follow(reaches[-1], chord, in_time=False)
+                reach, best = self._follow(reaches[-1], chord, in_time=False, slow=_TOO_FAST if timing else 0.0)
                 back.append(best)
             if room is not None:
                 reach = Reach(reach.chord, reach.cost + self._outside(chord, *room[i]).ravel())
@@ -419,26 +426,34 @@ def ensure_fingering(
     """``piece`` as it is when every note has a finger (and not ``refinger``), else fingered by
     the planner; the plan is returned too, or None when the piece kept its fingering. A hand
     model that plays written fingering (:attr:`~pianobot.sim.hand.HandModel.written_fingering`)
-    keeps a partly fingered piece's marks where it can; otherwise, and with ``refinger``, the
-    planner fingers every note anew."""
-    if piece.has_fingering and not refinger:
+    keeps a piece's marks where it can, a fully fingered piece's too: where the hand cannot play
+    one (a stretch beyond its reach, fingers that would cross), the planner fingers the piece,
+    keeping every other mark it can. Otherwise, and with ``refinger``, a fully fingered piece is
+    kept as it is and any other fingered anew."""
+    marked = not refinger and hand_model(hand.model).written_fingering
+    if piece.has_fingering and not refinger and not marked:
         return piece, None
     check_playable(piece.without_fingering(), keyboard, hand)  # on the keyboard, not too many notes at once
-    marked = not refinger and hand_model(hand.model).written_fingering
-    plan = _plan(piece if marked else piece.without_fingering(), piece.bpm, keyboard, hand)
+    full = (
+        marked and piece.has_fingering
+    )  # (keeps a mark only its speed is against: the pianist strikes late if it must)
+    plan = _plan(piece if marked else piece.without_fingering(), piece.bpm, keyboard, hand, not full)
+    if full and [n.finger for n in plan.piece.notes] == [n.finger for n in piece.notes]:
+        return piece, None  # (every mark playable: kept as written)
     return plan.piece, plan
 
 
 @lru_cache(maxsize=2)
-def _plan(piece: Piece, bpm: float, keyboard: KeyboardSpec, hand: HandSpec) -> FingeringPlan:
+def _plan(piece: Piece, bpm: float, keyboard: KeyboardSpec, hand: HandSpec, timing: bool = True) -> FingeringPlan:
     """:func:`plan_fingering`, kept for the last pieces asked (``bpm`` is in the key because a
     piece's equality leaves it out): ``pianobot play`` asks whether one hand plays a file, then
     plays it, and music objects are immutable, so the plan is the same both times."""
-    return plan_fingering(piece, KeyboardConfig(spec=keyboard), hand_config(hand))
+    return plan_fingering(piece, KeyboardConfig(spec=keyboard), hand_config(hand), timing)
 
 
 def plan_fingering(
-    piece: Piece, keyboard: KeyboardConfig = KeyboardConfig(), hand: HandConfig = HandConfig()
+    piece: Piece, keyboard: KeyboardConfig = KeyboardConfig(), hand: HandConfig = HandConfig(), timing: bool = True
 ) -> FingeringPlan:
-    """The lowest-cost fingering of ``piece`` for ``hand`` on ``keyboard`` (see the module's notes)."""
-    return Planner(keyboard, hand).plan(piece)
+    """The lowest-cost fingering of ``piece`` for ``hand`` on ``keyboard`` (see the module's notes;
+    ``timing``: as :meth:`Planner.plan`'s)."""
+    return Planner(keyboard, hand).plan(piece, timing=timing)

@@ -209,13 +209,14 @@ def finger_part(
     name: str,
     wording: Wording = Wording(),
 ) -> tuple[Piece, FingeringPlan | None]:
-    """One hand's part checked against ``keyboard`` and ``fingers`` (a refusal's hint counts the
-    whole transposition in), then fingered by the planner where it has no fingering (or
-    ``options.refinger``), said in one line with the plan's problems (``name``: the file's)."""
+    """One hand's part checked against ``keyboard`` and ``fingers`` (a refusal's hint counts the whole transposition
+    in), then fingered by the planner where it has no fingering, or fingering the hand cannot play, or with
+    ``options.refinger`` (:func:`ensure_fingering`), said in one line with the plan's problems (``name``: the file's)."""
     check_playable(part.without_fingering(), keyboard, fingers, options.transpose)
     piece, plan = ensure_fingering(part, keyboard, fingers, options.refinger)
     if plan is not None:
-        why = wording.refinger if options.refinger else "it has notes without fingering"
+        why = "this hand cannot play all of its fingering" if part.has_fingering else "it has notes without fingering"
+        why = wording.refinger if options.refinger else why
         marks = [(n.finger, p.finger) for n, p in zip(part.notes, piece.notes) if n.finger is not None]
         if marks and not options.refinger and hand_model(fingers.model).written_fingering:
             why += f"; kept {sum(a == b for a, b in marks)} of its {len(marks)} fingering marks"
@@ -445,10 +446,9 @@ def _warn_again(caught: list) -> None:
 def keeps_more(
     readings: list[tuple[HandSpec, Piece]], keyboard: KeyboardSpec | None = None
 ) -> tuple[int, tuple[int, int] | None]:
-    """Which of ``readings`` (a hand model's finger sets, each with the piece as read for it, in its
-    order of preference) both hands play with where none are named: the first, unless a later one
-    gives more notes (:func:`given_notes`), then the one giving most: (its index, (notes given with
-    the first, with it)), the counts None for the first."""
+    """Which of ``readings`` (a hand model's finger sets, each with the piece as read for it, in its order of
+    preference) both hands play with where none are named: the first, unless a later one gives more notes
+    (:func:`given_notes`), then the one giving most: (its index, (notes given with the first, with it)), else (0, None)."""
     (_, first), *others = readings
     given = given_notes(first, readings[0][0], keyboard)
     if given is None:
