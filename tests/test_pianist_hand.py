@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 from conftest import assert_one_line_error, run
 
+from pianobot.errors import PianobotWarning
 from pianobot.music.instrument import HandSpec, KeyboardSpec
 from pianobot.music.piece import Note, Piece
 from pianobot.perform.plan import perform_plan, plan_performance
@@ -173,6 +174,15 @@ def test_a_fully_fingered_file_the_pianist_s_hand_cannot_play_as_written_keeps_e
     assert [n.finger for n in timed.piece.notes] != [2] * 8
     assert ensure_fingering(repeats, KeyboardSpec(), FIVE) == (repeats, None)
     assert ensure_fingering(crossed, KeyboardSpec(), HandSpec()) == (crossed, None)
+
+    from pianobot.perform.together import play_hands
+
+    both = Piece.of([*(replace(n, hand="right") for n in crossed.notes), Note(0.0, 48, 1.0, 80, 5, "left")])
+    with pytest.warns(
+        PianobotWarning, match="the right hand's part: this hand cannot play all of its fingering; kept 3"
+    ):
+        played = play_hands(both, "scripted", hand=FIVE, seed=0)
+    assert played.report().f1 == 1.0 and [n.finger for n in played.hands[1].part.notes] == [5]
 
     song = write_pig(crossed, tmp_path / "crossed.txt")
     out = tmp_path / "out.mid"
