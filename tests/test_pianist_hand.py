@@ -174,6 +174,9 @@ def test_a_fully_fingered_file_the_pianist_s_hand_cannot_play_as_written_keeps_e
     assert [n.finger for n in timed.piece.notes] != [2] * 8
     assert ensure_fingering(repeats, KeyboardSpec(), FIVE) == (repeats, None)
     assert ensure_fingering(crossed, KeyboardSpec(), HandSpec()) == (crossed, None)
+    # C4 held under A5, two octaves up: no fingering of the planner's plays it, so it plays as written, as before
+    held = Piece((Note(0.0, 60, 0.7, finger=2), Note(0.5, 81, 1.0, finger=5), Note(0.7, 60, 1.0, finger=3)))
+    assert ensure_fingering(held, KeyboardSpec(), FIVE) == (held, None)
 
     from pianobot.perform.together import play_hands
 

@@ -428,16 +428,21 @@ def ensure_fingering(
     model that plays written fingering (:attr:`~pianobot.sim.hand.HandModel.written_fingering`)
     keeps a piece's marks where it can, a fully fingered piece's too: where the hand cannot play
     one (a stretch beyond its reach, fingers that would cross), the planner fingers the piece,
-    keeping every other mark it can. Otherwise, and with ``refinger``, a fully fingered piece is
-    kept as it is and any other fingered anew."""
+    keeping every other mark it can, and a mark only the hand's speed is against (the scripted
+    pianist strikes late if it must); where the planner finds no fingering at all, the piece is kept
+    as written. Another hand model keeps a fully fingered piece as it is and fingers any other anew;
+    with ``refinger``, every piece is fingered anew."""
     marked = not refinger and hand_model(hand.model).written_fingering
     if piece.has_fingering and not refinger and not marked:
         return piece, None
     check_playable(piece.without_fingering(), keyboard, hand)  # on the keyboard, not too many notes at once
-    full = (
-        marked and piece.has_fingering
-    )  # (keeps a mark only its speed is against: the pianist strikes late if it must)
-    plan = _plan(piece if marked else piece.without_fingering(), piece.bpm, keyboard, hand, not full)
+    full = marked and piece.has_fingering
+    try:
+        plan = _plan(piece if marked else piece.without_fingering(), piece.bpm, keyboard, hand, not full)
+    except PianobotError:
+        if full:
+            return piece, None  # (the planner finds no fingering: played as written, as before)
+        raise
     if full and [n.finger for n in plan.piece.notes] == [n.finger for n in piece.notes]:
         return piece, None  # (every mark playable: kept as written)
     return plan.piece, plan
