@@ -174,6 +174,9 @@ def test_a_fully_fingered_file_the_pianist_s_hand_cannot_play_as_written_keeps_e
     assert [n.finger for n in timed.piece.notes] != [2] * 8
     assert ensure_fingering(repeats, KeyboardSpec(), FIVE) == (repeats, None)
     assert ensure_fingering(crossed, KeyboardSpec(), HandSpec()) == (crossed, None)
+    # the notes fingered anew are fingered in time: the thumb, D4's own at 0.1 s, is not given C4 too
+    quick = Piece((Note(0.0, 60, 0.1, finger=3), Note(0.0, 64, 0.1, finger=2), Note(0.1, 62, 0.3, finger=1)))
+    assert [n.finger for n in ensure_fingering(quick, KeyboardSpec(), FIVE)[0].notes][0] != 1
     # C4 held under A5, two octaves up: no fingering of the planner's plays it, so it plays as written, as before
     held = Piece((Note(0.0, 60, 0.7, finger=2), Note(0.5, 81, 1.0, finger=5), Note(0.7, 60, 1.0, finger=3)))
     assert ensure_fingering(held, KeyboardSpec(), FIVE) == (held, None)
@@ -186,6 +189,11 @@ def test_a_fully_fingered_file_the_pianist_s_hand_cannot_play_as_written_keeps_e
     ):
         played = play_hands(both, "scripted", hand=FIVE, seed=0)
     assert played.report().f1 == 1.0 and [n.finger for n in played.hands[1].part.notes] == [5]
+    partly = Piece.of([replace(n, finger=None) if n.pitch == 67 else n for n in both.notes])  # (one mark less)
+    with pytest.warns(
+        PianobotWarning, match="the right hand's part: this hand cannot play all of its fingering; kept 2 of"
+    ):
+        play_hands(partly, "scripted", hand=FIVE, seed=0)
 
     song = write_pig(crossed, tmp_path / "crossed.txt")
     out = tmp_path / "out.mid"

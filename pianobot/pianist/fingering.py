@@ -80,11 +80,15 @@ ROOM_COST = 5.0
 """Cost of each white key the wrist stands outside its room (:meth:`Planner.plan`'s ``room``: where
 the other hand leaves this one space)."""
 MARK_COST = 50.0
-"""Cost of each note given another finger than the file marks it with (a partly fingered part's
-marks, :meth:`Planner.plan`): far above any move, stretch or legato cost, so a mark is kept
-wherever the hand can play it, and given up only where it cannot reach or is too slow."""
+"""Cost of each note given another finger than the file marks it with (:meth:`Planner.plan`): far
+above any move, stretch or legato cost, so a mark is kept wherever the hand can play it, and given
+up only where it cannot reach or (in a partly fingered part) is too slow."""
 _INFEASIBLE = 1e9
 _TOO_FAST = 1e3
+_SLOW_MARK = MARK_COST / 4
+"""A move or hop too fast, where a mark may be kept though only the hand's speed is against it
+(``Planner.plan(timing=False)``): less than a mark, so the mark stays, but not free, so the notes
+fingered anew are still fingered in time where they can be."""
 
 
 @dataclass(frozen=True)
@@ -335,9 +339,9 @@ class Planner:
         self, piece: Piece, room: Sequence[tuple[float, float]] | None = None, timing: bool = True
     ) -> FingeringPlan:
         """The lowest-cost fingering of ``piece`` (the module's notes), keeping the fingers its notes
-        have where the hand can (:data:`MARK_COST`); without ``timing``, a mark is kept where only the
-        hand's speed is against it (a move or hop too fast costs nothing, and is still said in
-        :attr:`FingeringPlan.problems`). ``room``: for each chord
+        have where the hand can (:data:`MARK_COST`); without ``timing``, a move or hop too fast costs
+        less than a mark (:data:`_SLOW_MARK`), so a mark only the hand's speed is against is kept (and the
+        speed is not said in :attr:`FingeringPlan.problems`: its caller keeps a file's fingering as written). ``room``: for each chord
         (as :meth:`~pianobot.music.piece.Piece.chords` gives them) the lowest and highest wrist
         position (m, ``-inf``/``inf`` for none) that keeps this hand clear of the other; a state
         whose wrist, or where its fingers put the scripted pianist's wrist (straight over their
@@ -366,7 +370,7 @@ class Planner:
             if i == 0:
                 reach = self.place(chord)
             else:
-                reach, best = self._follow(reaches[-1], chord, in_time=False, slow=_TOO_FAST if timing else 0.0)
+                reach, best = self._follow(reaches[-1], chord, in_time=False, slow=_TOO_FAST if timing else _SLOW_MARK)
                 back.append(best)
             if room is not None:
                 reach = Reach(reach.chord, reach.cost + self._outside(chord, *room[i]).ravel())
@@ -404,7 +408,7 @@ class Planner:
             distance = abs(wrist[i] - wrist[i - 1])
             velocities = [n.velocity for n in sorted(chords[i], key=lambda n: n.pitch)]
             hop = self._fast_hop(*chosen[i - 1], *chosen[i], time, velocities)
-            if self._wrist_too_fast(distance, time, chords[i]) or hop:
+            if timing and (self._wrist_too_fast(distance, time, chords[i]) or hop):
                 what = (
                     f"{hop} in {time:.3f} s" if hop else f"the wrist must move {distance * 100:.1f} cm in {time:.3f} s"
                 )
@@ -423,8 +427,9 @@ class Planner:
 def ensure_fingering(
     piece: Piece, keyboard: KeyboardSpec, hand: HandSpec, refinger: bool = False
 ) -> tuple[Piece, FingeringPlan | None]:
-    """``piece`` as it is when every note has a finger (and not ``refinger``), else fingered by
-    the planner; the plan is returned too, or None when the piece kept its fingering. A hand
+    """``piece`` as it is when every note has a finger (and not ``refinger``; for a hand model that
+    plays written fingering, where the hand can play every mark), else fingered by the planner; the
+    plan is returned too, or None when the piece kept its fingering. A hand
     model that plays written fingering (:attr:`~pianobot.sim.hand.HandModel.written_fingering`)
     keeps a piece's marks where it can, a fully fingered piece's too: where the hand cannot play
     one (a stretch beyond its reach, fingers that would cross), the planner fingers the piece,

@@ -28,17 +28,17 @@ def prepare_part(
     """``hand``'s part of ``piece`` as the simulated hand is given it: (window, part, start, notes
     left out), the part moved ``start`` seconds earlier (default: to its first note); ``grow``: a
     part wider than ``keyboard`` is given its own range instead (:func:`~pianobot.music.window.window_for`).
-    Each kind of change is one :class:`PianobotWarning`, worded for the written part (a part fingered
-    throughout whose fingering the hand cannot play all of too: :func:`ensure_fingering`)."""
+    Each kind of change is one :class:`PianobotWarning`, worded for the written part (the file's
+    fingering marks the hand cannot play all of too: :func:`ensure_fingering`)."""
     window, reduced, start, left_out = _reduced_part(piece, hand, keyboard, fingers, start, grow)
     written = hand_model(fingers.model).written_fingering  # (the file's marks kept where the hand can)
-    fingered, plan = ensure_fingering(reduced, window.keyboard, fingers, refinger=not written)
-    if written and plan is not None and reduced.has_fingering:  # (fingered throughout, not all of it playable)
-        kept = sum(a.finger == b.finger for a, b in zip(reduced.notes, fingered.notes))
+    fingered, _ = ensure_fingering(reduced, window.keyboard, fingers, refinger=not written)
+    marks = [(a.finger, b.finger) for a, b in zip(reduced.notes, fingered.notes) if a.finger is not None]
+    if written and any(a != b for a, b in marks):  # (the file's marks the hand cannot play all of)
         warnings.warn(
             PianobotWarning(
                 f"the {hand} hand's part: this hand cannot play all of its fingering; "
-                f"kept {kept} of its {len(reduced)} fingering marks"
+                f"kept {sum(a == b for a, b in marks)} of its {len(marks)} fingering marks"
             )
         )
     return window, fingered, start, left_out
