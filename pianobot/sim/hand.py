@@ -94,8 +94,9 @@ class HandModel:
     (the palm's pose over the keys, its motors), as :func:`hand_config` applies them."""
     written_fingering: bool = False
     """Whether a file's 1-5 fingering, written for a human hand, is this hand's: its marks are kept
-    where the hand can play them, in a partly fingered part and in both hands' parts (else a part
-    not wholly fingered, and both hands' parts, are fingered anew for this hand)."""
+    where the hand can play them, in a part fingered throughout or in part and in both hands' parts
+    (:func:`~pianobot.pianist.fingering.ensure_fingering`; else a part fingered throughout is played
+    as written, and any other, and both hands' parts, are fingered anew for this hand)."""
     lends_notes: bool = False
     """Whether a note of a chord one hand cannot reach goes to the other hand where that one can take
     it, as pianists do, in a file that names each note's hand too (:mod:`pianobot.pianist.lend`;
