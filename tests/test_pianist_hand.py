@@ -200,6 +200,7 @@ def test_a_fully_fingered_file_the_pianist_s_hand_cannot_play_as_written_keeps_e
     result = run("play", song, "-o", out, "--hand-model", "pianist", "--controller", "scripted")
     assert result.exit_code == 0, result.output
     assert "this hand cannot play all of its fingering; kept 3 of its 4 fingering marks" in result.output
+    assert "pianobot finger" not in result.output  # (it would write the planner's own fingering, marks aside)
     assert json.loads(out.with_suffix(".report.json").read_text())["f1"] == 1.0
 
 

@@ -218,12 +218,12 @@ def finger_part(
         why = "this hand cannot play all of its fingering" if part.has_fingering else "it has notes without fingering"
         why = wording.refinger if options.refinger else why
         marks = [(n.finger, p.finger) for n, p in zip(part.notes, piece.notes) if n.finger is not None]
-        if marks and not options.refinger and hand_model(fingers.model).written_fingering:
-            why += f"; kept {sum(a == b for a, b in marks)} of its {len(marks)} fingering marks"
+        kept = bool(marks) and not options.refinger and hand_model(fingers.model).written_fingering
+        why += f"; kept {sum(a == b for a, b in marks)} of its {len(marks)} fingering marks" if kept else ""
         warnings.warn(
             PianobotWarning(
                 f"{name}: fingering planned for fingers {', '.join(map(str, fingers.fingers))} ({why}): "
-                f"wrist travel {plan.travel * 100:.1f} cm in {plan.moves} moves; {wording.written}"
+                f"wrist travel {plan.travel * 100:.1f} cm in {plan.moves} moves{'' if kept else '; ' + wording.written}"
             )
         )
         for problem in plan.problems:
