@@ -130,6 +130,12 @@ def main() -> None:
     parser.add_argument("--out", type=Path, help="folder the excerpts are written to (default out/early-SET)")
     parser.add_argument("--json", type=Path, help="write every figure to this file")
     args = parser.parse_args()
+    names = [e[0] for e in SETS[args.set]]
+    unknown = [name for name in args.only if name not in names]
+    if unknown:
+        parser.error(
+            f"--only {' '.join(unknown)}: no such excerpt in the {args.set} set; its excerpts: {', '.join(names)}"
+        )
     try:
         import music21  # noqa: F401 (the corpus's scores)
     except ImportError:

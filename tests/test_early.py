@@ -77,3 +77,33 @@ def test_the_table_sums_every_excerpt():
     other = {**row, "piece": "y", "as_given": {"f1": 1.0, "step_f1": 1.0, "f1_offsets": 1.0}}
     lines = early.table([row, other]).splitlines()
     assert lines[-1] == "| all (2) | 2 (6) | 0 (0) | 4 (16) | 0.500, 0.250 | 1.000, 0.875 |"
+
+
+def test_an_excerpt_the_set_lacks_is_one_clear_line(monkeypatch, capsys):
+    import sys
+
+    monkeypatch.setattr(sys, "argv", ["early", "--set", "validation", "--only", "nosuch"])
+    with pytest.raises(SystemExit) as exit:
+        early.main()
+    assert exit.value.code == 2
+    assert "--only nosuch: no such excerpt in the validation set" in capsys.readouterr().err
+
+
+def test_each_hand_s_fingers_are_the_named_model_s_or_chosen_per_file_as_the_corpus_chooses(monkeypatch, tmp_path):
+    """--hand-model pianist plays the pianist's five fingers; --hand-model allegro (no fingers given) the
+    fingers chosen per file, as benchmarks.corpus and play choose them (music21 and the run stood in for)."""
+    import types
+
+    from pianobot.music.instrument import THUMB
+
+    used = []
+    figures = types.SimpleNamespace(f1=1.0, step_f1=1.0, f1_with_offsets=1.0)
+    performance = types.SimpleNamespace(report=lambda: figures, given_report=lambda: figures)
+    monkeypatch.setattr(early, "write_excerpt", lambda *args: None)
+    monkeypatch.setattr(early, "fingers_for_file", lambda file, options: (THUMB, None))
+    monkeypatch.setattr(early, "two_hands", lambda file, options, fingers: types.SimpleNamespace(piece=None))
+    monkeypatch.setattr(early, "play_hands", lambda piece, who, models, hand: used.append(hand) or performance)
+    excerpt = early.SETS["test"][:1]
+    early.early(excerpt, tmp_path, None)
+    early.early(excerpt, tmp_path, default_fingers("pianist"))
+    assert used == [THUMB, default_fingers("pianist")]

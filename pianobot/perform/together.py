@@ -94,21 +94,17 @@ class HandPerformance:
     @property
     def played(self) -> Piece:
         """What this hand sounded, back at the written pitches and times, each note with its hand."""
-        if self.sounded is not None:
-            return self.sounded
-        notes = [
-            replace(n, pitch=self.window.outward(n.pitch), hand=self.hand)
-            for n in self.performance.played.shift(self.start).notes
-        ]
-        return Piece(tuple(notes), bpm=self.part.bpm)
+        return self.sounded if self.sounded is not None else self._written(self.performance.played)
 
     @property
     def given(self) -> Piece:
         """What this hand was given to play (:attr:`part`), back at the written pitches and times, each
         note with its hand: the notes and lengths a player who plays every one of them as given sounds."""
-        notes = [
-            replace(n, pitch=self.window.outward(n.pitch), hand=self.hand) for n in self.part.shift(self.start).notes
-        ]
+        return self._written(self.part)
+
+    def _written(self, piece: Piece) -> Piece:
+        """``piece``, in the simulated hand's keys and times, back at the written ones, each note with its hand."""
+        notes = [replace(n, pitch=self.window.outward(n.pitch), hand=self.hand) for n in piece.shift(self.start).notes]
         return Piece(tuple(notes), bpm=self.part.bpm)
 
     @property
