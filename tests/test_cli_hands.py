@@ -330,8 +330,10 @@ def test_a_two_hand_example_plays_both_hands_end_to_end(tmp_path):
 @pytest.mark.parametrize(
     "name", ["chorale-performed", "prelude-performed", "minuet-performed", "twinkle-performed", "nocturne-performed"]
 )
-def test_every_two_hand_example_plays_both_hands_at_note_f1_090(name, tmp_path):
-    assert _play_example_with_both_hands(name, tmp_path) >= 0.9
+def test_the_scripted_pianist_plays_every_two_hand_example_nearly_whole(name, tmp_path):
+    """With the pianist's hands (a two-hand file's default): 0.990-1.000 when written (issue 57 asks
+    0.99); two notes more missed on any of them fail."""
+    assert _play_example_with_both_hands(name, tmp_path) >= 0.985
 
 
 def test_the_keyboard_options_name_the_keys_each_hand_plays_on(tmp_path):

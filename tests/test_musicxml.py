@@ -318,3 +318,38 @@ def test_a_finger_the_hand_lacks_is_said_in_one_line(tmp_path):
     path = write(tmp_path / "five.musicxml", score([melody], names=["Right Hand"]))
     result = run("play", path, "-o", tmp_path / "out.mid", "--controller", "scripted")
     assert_one_line_error(result, "fingered 5", "--hand-model pianist")
+
+
+def _one_staff(pitches, extra=""):
+    attributes = (
+        "<attributes><divisions>2</divisions><time><beats>4</beats><beat-type>4</beat-type></time></attributes>"
+    )
+    return [attributes + extra + "".join(note(p, 2) for p in pitches)]
+
+
+def test_parts_of_one_name_are_parts_of_their_own_not_one_pianos_staves(tmp_path):
+    """Four parts all named "Voice" (music21 gives them their name as their id) were read as one
+    piano's staves: the soprano named the right hand, the alto the left, the rest staves 3 and 4."""
+    satb = [_one_staff(p) for p in (["E5", "F5"], ["C5", "D5"], ["G4", "A4"], ["C3", "D3"])]
+    source, piece, _ = read(write(tmp_path / "satb.musicxml", score(*satb, names=["Voice"] * 4)))
+    assert [(t.name, t.notes) for t in describe_tracks(source) if t.notes] == [("Voice", 2)] * 4
+    assert piece.hands == ()
+    # a piano's two staves are still its hands beside them
+    both = score(_one_staff(["G5", "A5"]), PIANO, names=["Piano", "Piano"])
+    tracks = [t.name for t in describe_tracks(read(write(tmp_path / "both.musicxml", both))[0]) if t.notes]
+    assert tracks == ["Piano", "Right Hand", "Left Hand"]
+
+
+def test_a_transposing_instruments_part_sounds_where_it_sounds(tmp_path):
+    """A B-flat clarinet's written D5 sounds C5 (it was read at the written pitch, a tone high)."""
+    clarinet = "<transpose><diatonic>-1</diatonic><chromatic>-2</chromatic></transpose>"
+    part = _one_staff(["D5", "E5"])
+    part[0] = part[0].replace("</attributes>", clarinet + "</attributes>")
+    _, piece, _ = read(write(tmp_path / "clarinet.musicxml", score(part, names=["Clarinet in Bb"])))
+    assert [n.pitch for n in piece] == [72, 74]
+
+
+def test_a_one_staff_parts_pedal_is_read_whatever_music21_calls_the_part(tmp_path):
+    part = _one_staff(["C4", "D4"], extra=pedal("start", staff=1))
+    source, _, _ = read(write(tmp_path / "pedal.musicxml", score(part, names=["Piano"])))
+    assert read_pedal(source).spans[:1] == ((0.0, 1.0),)  # down from the start to the end of the notes

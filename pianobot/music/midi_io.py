@@ -4,7 +4,9 @@ Fingering convention (see docs/fingering.md): at the tick where notes start, a l
 meta event in the same track holds one finger number per note starting there, lowest pitch
 first, separated by spaces or commas: ``"3"`` for a melody note, ``"2 4"`` for a two-note chord.
 A substitution written ``3_1`` counts as its first finger (the one that strikes); ``-`` marks
-a note without a finger. Texts that are not finger lists (ordinary lyrics) are ignored.
+a note without a finger. Texts that are not finger lists (ordinary lyrics) are ignored, and so is
+every number in a track whose texts hold one that is no finger 1-5 (a continuo's figured bass:
+"6", "7"), said in one warning.
 
 Hands: in a type 1 file, a track whose name says it holds a hand's part ('Right Hand', 'RH',
 'Treble', 'Left Hand', 'Bass'...; :func:`track_hand`) gives its notes that hand; other tracks'
@@ -41,10 +43,11 @@ from pianobot.music.piece import HANDS, MAX_SECONDS, Note, Piece, pitch_name
 _FINGER_TOKEN = r"(?:[0-9](?:_[0-9])?|-)"
 _FINGER_TEXT = re.compile(rf"^\s*{_FINGER_TOKEN}(?:[\s,]+{_FINGER_TOKEN})*\s*$")
 HAND_NAMES = {
-    "right": re.compile(r"right|\brh\b|\br\.h\.|treble|upper|melody", re.IGNORECASE),
-    "left": re.compile(r"left|\blh\b|\bl\.h\.|bass|lower|accomp", re.IGNORECASE),
+    "right": re.compile(r"\bright|\brh\b|\br\.h\.|\btreble|\bupper|\bmelod", re.IGNORECASE),
+    "left": re.compile(r"\bleft|\blh\b|\bl\.h\.|\bbass(?!oon)|\blower|\baccomp", re.IGNORECASE),
 }
-"""What a track's name says when it holds one hand's part."""
+"""What a track's name says when it holds one hand's part: words, not parts of words (General MIDI's
+"Bright Acoustic Piano", "Upright", a copyright line, a bassoon hold no hand)."""
 TRACK_NAMES = {"right": "Right Hand", "left": "Left Hand"}
 """The names pianobot gives the hands' tracks when it writes a piece with hands."""
 UNASSIGNED_TRACK = "Unassigned"
@@ -73,21 +76,16 @@ class TrackInfo:
 
 
 def parse_finger_text(text: str) -> list[int | None] | None:
-    """Finger numbers in a lyric/text event, or None when the text is not a finger list."""
+    """Finger numbers in a lyric/text event, or None when the text is not a list of numbers. A
+    number may be no finger 1-5 (a figured bass's "6"): :func:`is_fingering` tells."""
     if not _FINGER_TEXT.match(text):
         return None
-    fingers: list[int | None] = []
-    for token in re.split(r"[\s,]+", text.strip()):
-        if token == "-":
-            fingers.append(None)
-            continue
-        finger = int(token.split("_")[0])
-        if not 1 <= finger <= 5:
-            raise PianobotError(
-                f"fingering text '{quote(text)}' holds finger {finger}: fingers are 1 (thumb) to 5 (little finger)"
-            )
-        fingers.append(finger)
-    return fingers
+    return [None if token == "-" else int(token.split("_")[0]) for token in re.split(r"[\s,]+", text.strip())]
+
+
+def is_fingering(fingers: list[int | None]) -> bool:
+    """Whether every number of a :func:`parse_finger_text` list is a finger, 1 (thumb) to 5 (little)."""
+    return all(f is None or 1 <= f <= 5 for f in fingers)
 
 
 def finger_text(fingers: list[int | None]) -> str:
@@ -235,30 +233,60 @@ def _track_notes(
 ) -> tuple[list[tuple[int, int, int, int]], dict[int, list[int | None]]]:
     """Notes as (on tick, off tick, pitch, velocity) and finger lists by tick, for one track.
 
-    A key struck again while it still sounds (a player's legato on a repeated note) opens a
-    second note; a note-off ends the earliest sounding one (first in, first out), and
-    :func:`_resolve_overlaps` then ends the first where the second starts.
+    Messages are read in the file's order. A key struck again while it still sounds (a player's
+    legato on a repeated note) opens a second note; a note-off ends the earliest one that began
+    before it (first in, first out), so a repeated key's note-off and note-on at one tick end one
+    note and begin the next in either order, and :func:`_resolve_overlaps` ends a first note where
+    a second starts. A note-off that finds only a note begun at its own tick ends a note of no
+    length (some programs write grace notes and chord symbols so): it is left out, said in one
+    warning. A track whose texts hold a number that is no finger (a figured bass) has no fingering.
     """
     open_notes: dict[tuple[int, int], list[tuple[int, int]]] = defaultdict(list)
     notes: list[tuple[int, int, int, int]] = []
     fingering: dict[int, list[int | None]] = defaultdict(list)
-    end = 0
-    for tick, msg in _absolute(track):
-        end = tick
+    figures: list[str] = []  # texts with numbers that are no fingers
+    empty: list[tuple[int, int]] = []  # (tick, pitch) of notes of no length
+    tick = 0
+    for msg in track:
+        tick += msg.time
         if msg.type in ("lyrics", "text"):
             fingers = parse_finger_text(msg.text)
-            if fingers is not None:
+            if fingers is not None and is_fingering(fingers):
                 fingering[tick].extend(fingers)
+            elif fingers is not None:
+                figures.append(msg.text)
         elif msg.type in ("note_on", "note_off") and msg.channel == PERCUSSION:
             continue  # (drums: read_midi says how many it left out)
         elif msg.type == "note_on" and msg.velocity > 0:
             open_notes[(msg.channel, msg.note)].append((tick, msg.velocity))
         elif msg.type in ("note_off", "note_on"):
-            sounding = open_notes.get((msg.channel, msg.note))
-            if sounding:
-                on, vel = sounding.pop(0)
-                if tick > on:
-                    notes.append((on, tick, msg.note, vel))
+            sounding = open_notes.get((msg.channel, msg.note), [])
+            earlier = next((i for i, (on, _) in enumerate(sounding) if on < tick), None)
+            if earlier is not None:
+                on, vel = sounding.pop(earlier)
+                notes.append((on, tick, msg.note, vel))
+            elif sounding:
+                sounding.pop(0)
+                empty.append((tick, msg.note))
+    end = tick
+    if empty:
+        tick, pitch = empty[0]
+        warnings.warn(
+            PianobotWarning(
+                f"track {index}: left out {len(empty)} note(s) of no length, their note-on and note-off at one tick "
+                f"(the first: {pitch_name(pitch)} at {seconds(tick):.3f} s; grace notes or chord symbols, as some "
+                "programs write them)"
+            )
+        )
+    if figures and fingering:
+        warnings.warn(
+            PianobotWarning(
+                f"track {index}: its lyrics hold '{quote(figures[0])}', a number that is no finger 1-5 (a figured "
+                f"bass?), so none of its {sum(map(len, fingering.values()))} numbers is read as fingering"
+            )
+        )
+    if figures:
+        fingering.clear()
     for (_, pitch), sounding in open_notes.items():
         for on, vel in sounding:
             warnings.warn(PianobotWarning(f"track {index}: {pitch_name(pitch)} never ends; it ends with the track"))
@@ -394,10 +422,19 @@ def _parts(midi: mido.MidiFile, chosen: list[int], seconds, path: Path) -> list[
     if any(fingering for _, raw, fingering in parts if raw):
         return parts
     lyrics: dict[int, list[int]] = {}
+    read = {index: (raw, fingering) for index, raw, fingering in parts}
     for index, track in enumerate(midi.tracks):
-        raw, fingering = _track_notes(track, index, seconds, path)
-        if not raw:
+        if index in read:  # (read above, and said)
+            raw, fingering = read[index]
+            said = []
+        else:
+            with warnings.catch_warnings(record=True) as said:
+                warnings.simplefilter("always")
+                raw, fingering = _track_notes(track, index, seconds, path)
+        if not raw:  # (of a track of notes not chosen, nothing is said)
             lyrics.update(fingering)
+            for warning in said:
+                warnings.warn(warning.message)
     if not lyrics:
         return parts
     noted = [(index, raw) for index, raw, _ in parts if raw]

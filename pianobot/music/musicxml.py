@@ -72,6 +72,7 @@ def open_musicxml(path: str | Path) -> MidiSource:
         importer = m21.musicxml.xmlToM21.MusicXMLImporter()
         importer.xmlRootToScore(tree.root, importer.stream)
         score = importer.stream
+        score.toSoundingPitch(inPlace=True)  # a clarinet's or horn's part is written transposed
     except Exception as e:  # music21 raises many types on odd scores
         reason = quote(str(e).strip().splitlines()[0] if str(e).strip() else type(e).__name__)
         raise PianobotError(f"{path} is not a score pianobot can read ({reason}): re-export it as MusicXML") from None
@@ -83,7 +84,7 @@ def _render(score, tree: Score, path: Path) -> mido.MidiFile:
     m21 = music21()
     said: dict[str, int] = defaultdict(int)
     tracks: list[mido.MidiTrack] = []
-    for name, part in _staves(score):
+    for name, part in _staves(_score_parts(m21, score, tree)):
         unpitched = said["unpitched"]
         events = _part_events(m21, part, said)
         if events:
@@ -97,33 +98,47 @@ def _render(score, tree: Score, path: Path) -> mido.MidiFile:
     midi = mido.MidiFile(type=1, ticks_per_beat=TICKS_PER_BEAT)
     midi.tracks.append(_tempo_track(score))
     pedal_track = next((t for t in tracks if t.name == TRACK_NAMES["right"]), tracks[0])
-    _add_pedal(pedal_track, _pedal_times(score, tree))
+    _add_pedal(pedal_track, _pedal_times(_score_parts(m21, score, tree), tree))
     midi.tracks.extend(tracks)
     return midi
 
 
-def _staves(score) -> list[tuple[str, object]]:
-    """(track name, music21 part) for each staff of the score: see the module's text."""
-    parts = list(score.parts)
-    staves: dict[str, list] = defaultdict(list)
-    for part in parts:
-        staves[_group(part)].append(part)
-    named = []
-    for part in parts:
-        group = staves[_group(part)]
-        title = (part.partName or "").strip() or f"Part {parts.index(part) + 1}"
-        if len(group) == 1:
-            named.append((title, part))
-        elif group.index(part) < 2:
-            named.append((TRACK_NAMES["right" if group.index(part) == 0 else "left"], part))
+def _score_parts(m21, score, tree: Score) -> list[tuple[str, list]]:
+    """(the XML part's id, its staves as music21 parts) for each part of the score, in order. A part
+    of several staves is music21's run of PartStaffs of one id ('P1-Staff1', 'P1-Staff2'); any other
+    music21 part is a part of its own, whatever its name (music21 may give a part its name as its id,
+    so four parts named "Voice" share one)."""
+    groups: list[list] = []
+    last = None
+    for part in score.parts:
+        staff = str(part.id).rsplit("-Staff", 1)[0] if isinstance(part, m21.stream.PartStaff) else None
+        if staff is not None and staff == last:
+            groups[-1].append(part)
         else:
-            named.append((f"{title} staff {group.index(part) + 1}", part))
+            groups.append([part])
+        last = staff
+    ids = [element.get("id", "") for element in tree.root.iter("part")]
+    if len(ids) != len(groups):  # (not expected: then music21's ids)
+        ids = [str(group[0].id).rsplit("-Staff", 1)[0] for group in groups]
+    return list(zip(ids, groups))
+
+
+def _staves(parts: list[tuple[str, list]]) -> list[tuple[str, object]]:
+    """(track name, music21 part) for each staff of the score's ``parts`` (:func:`_score_parts`): see
+    the module's text."""
+    named = []
+    number = 0
+    for _, staves in parts:
+        for index, part in enumerate(staves):
+            number += 1
+            title = (part.partName or "").strip() or f"Part {number}"
+            if len(staves) == 1:
+                named.append((title, part))
+            elif index < 2:
+                named.append((TRACK_NAMES["right" if index == 0 else "left"], part))
+            else:
+                named.append((f"{title} staff {index + 1}", part))
     return named
-
-
-def _group(part) -> str:
-    """The score part a music21 part (a staff of it) comes from: its id without music21's '-Staff2'."""
-    return str(part.id).rsplit("-Staff", 1)[0]
 
 
 def _unpitched(m21, element) -> bool:
@@ -244,11 +259,10 @@ def _tempo_track(score) -> mido.MidiTrack:
     return _timed(mido.MidiTrack([mido.MetaMessage("track_name", name="Tempo")]), timed)
 
 
-def _pedal_times(score, tree: Score) -> list[tuple[Fraction, bool]]:
-    """The score's sustain pedal changes as (quarter notes from the start, down), placed by music21's measures."""
-    starts: dict[str, list] = {}
-    for part in score.parts:
-        starts.setdefault(_group(part), [m.offset for m in part.getElementsByClass("Measure")])
+def _pedal_times(parts: list[tuple[str, list]], tree: Score) -> list[tuple[Fraction, bool]]:
+    """The score's sustain pedal changes as (quarter notes from the start, down), placed by music21's
+    measures (``parts``: :func:`_score_parts`)."""
+    starts = {name: [m.offset for m in staves[0].getElementsByClass("Measure")] for name, staves in parts}
     times = []
     for mark in tree.pedal:
         measures = starts.get(mark.part, [])
