@@ -45,6 +45,18 @@ def test_the_window_keeps_the_most_notes_on_the_keyboard_the_player_knows():
     assert (own.keyboard.lowest, own.keyboard.highest, own.octaves) == (48, 95, 0)
 
 
+def test_parts_down_to_a0_and_up_to_c8_are_played_on_the_pianos_keys_in_one_simulation():
+    """Rounded out to octaves past A0 and C8, the windows spanned 103 keys together, and the hands
+    were played apart, each in a simulation of its own."""
+    from pianobot.env.two_hands import world_keyboard
+
+    right = Piece((Note(0, 71, 1, hand="right"), Note(1, 108, 2, hand="right")))  # B4, C8
+    left = Piece((Note(0, 21, 1, hand="left"), Note(1, 67, 2, hand="left")))  # A0, G4
+    windows = [window_for(right, "right", None), window_for(left, "left", None)]
+    assert world_keyboard(windows) == KeyboardSpec(21, 88)
+    assert [w.keyboard.describe() for w in windows] == ["C4-C8 (49 keys)", "C3-G7 (56 keys)"]  # the left's mirrored
+
+
 def test_the_scripted_pianist_plays_both_hands_of_a_duet_at_the_written_pitches():
     (name, piece), *_ = [d for d in duet_set(0, 8) if "broken" in d[0]]
     performance = play_hands(piece, "scripted")
@@ -97,12 +109,14 @@ def test_both_hands_share_one_simulation_unless_asked_apart_and_play_alike_there
 
 
 def test_parts_too_far_apart_for_one_keyboard_play_apart_and_say_so():
-    """The scripted pianist's windows are the parts' ranges rounded out to octaves: A0 and C8 need
-    keys from C0 (mirrored) to B8, more than 88, so each hand plays in a simulation of its own."""
+    """A general policy's window is the keys it knows (C4-B5 here) moved by octaves: C8 on them
+    stands for written keys up to B8, A0 (mirrored) for keys down to F-1, more than 88 together, so
+    each hand plays in a simulation of its own. (The scripted pianist's windows, the parts' own
+    ranges, stay on the piano's keys: the test above.)"""
     piece = Piece((Note(0.0, 108, 0.5, hand="right"), Note(0.0, 21, 0.5, hand="left")))
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        performance = play_hands(piece, "scripted")
+        performance = play_hands(piece, "sac", keyboard=KeyboardSpec())
     said = [str(w.message) for w in caught if issubclass(w.category, PianobotWarning)]
     assert any("more than a piano's 88" in line and "simulation of its own" in line for line in said), said
     assert not performance.together and performance.report().f1 == 1.0

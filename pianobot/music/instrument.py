@@ -63,11 +63,15 @@ PIANO = KeyboardSpec(21, 88)
 """The piano's 88 keys, A0 to C8."""
 
 
-def keyboard_for(piece: Piece) -> KeyboardSpec:
-    """The keys ``piece`` needs, rounded out to whole octaves (C to B) within MIDI's range; where
-    that would pass 88 keys, just the piece's own range (at most 88 keys, from its lowest note)."""
+def keyboard_for(piece: Piece, within: KeyboardSpec | None = None) -> KeyboardSpec:
+    """The keys ``piece`` needs, rounded out to whole octaves (C to B) within MIDI's range and within
+    ``within`` where every note lies on it (the piano's 88 keys, say: a part down to A0 does not
+    reach below it); where that would pass 88 keys, just the piece's own range (at most 88 keys,
+    from its lowest note)."""
     lowest, highest = min(n.pitch for n in piece.notes), max(n.pitch for n in piece.notes)
     low, high = lowest // 12 * 12, min(127, highest // 12 * 12 + 11)
+    if within is not None and lowest in within and highest in within:
+        low, high = max(low, within.lowest), min(high, within.highest)
     if high - low + 1 > 88:
         return KeyboardSpec(lowest, min(88, highest - lowest + 1))
     return KeyboardSpec(low, high - low + 1)

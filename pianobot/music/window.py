@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from pianobot.music.instrument import KeyboardSpec, keyboard_for
+from pianobot.music.instrument import PIANO, KeyboardSpec, keyboard_for
 from pianobot.music.piece import Piece, mirror_pitch
 
 OCTAVE = 12
@@ -41,7 +41,8 @@ def window_for(part: Piece, hand: str, keyboard: KeyboardSpec | None, grow: bool
     ``grow``: a part that does not fit on ``keyboard`` gets its own range instead, for a player
     that plays any keyboard of at least its own keys
     (:func:`~pianobot.agent.general.plays_keyboard`)."""
-    own = Window(hand, keyboard_for(part.mirror() if hand == "left" else part), 0)
+    piano = KeyboardSpec(mirror_pitch(PIANO.highest), PIANO.count) if hand == "left" else PIANO  # (as the hand sees it)
+    own = Window(hand, keyboard_for(part.mirror() if hand == "left" else part, piano), 0)
     if keyboard is None:
         return own
     plain = Window(hand, KeyboardSpec(), 0)
