@@ -42,6 +42,27 @@ def _one_track(path, *notes):
     return path
 
 
+def test_a_two_hand_file_whose_tracks_all_name_one_hand_plays_both_hands(tmp_path):
+    """Both hands' notes in tracks all named for the right hand ("Piano RH" holding everything, or two
+    tracks both "Right Hand") were refused: one hand's reading, "the chord C3 C5 ... more than this
+    hand reaches". Where the named hand cannot reach a chord, the planner gives the hands."""
+    song = _duet(tmp_path / "both-right.mid", names=("Right Hand", "Right Hand"), left=_track((48, 0, 2), (55, 2, 4)))
+    args = ("play", song, "-o", tmp_path / "out.mid", "--controller", "scripted", "--json", tmp_path / "r.json")
+    result = run(*args)
+    assert result.exit_code == 0, result.output
+    assert "its tracks name every note for the right hand, which cannot reach all of its chords" in " ".join(
+        result.stderr.split()
+    )
+    text = " ".join(result.stdout.split())
+    assert "left hand: 2 notes, C3-G3, assigned by the fingering planner" in text
+    assert json.loads((tmp_path / "r.json").read_text())["f1"] == 1.0
+    # a part the named hand reaches stays that hand's: one hand, as before
+    melody = midi_file(tmp_path / "melody.mid", [("Right Hand", RIGHT)])
+    result = run("play", melody, "-o", tmp_path / "m.mid", "--controller", "scripted")
+    assert result.exit_code == 0 and "cannot reach all of its chords" not in result.output
+    assert "left hand" not in result.stdout
+
+
 def test_a_file_with_tracks_named_for_hands_plays_both_hands_one_track_each(tmp_path):
     song = _duet(tmp_path / "duet.mid")
     files = ("--html", tmp_path / "r.html", "--wav", tmp_path / "both.wav", "--video", tmp_path / "both.mp4")

@@ -1,3 +1,4 @@
+import io
 import warnings
 
 import mido
@@ -448,3 +449,27 @@ def test_of_two_tempos_at_one_tick_the_later_holds_for_the_timing_and_for_what_i
     assert tempi(path) == [80.0]
     other = midi_file(tmp_path / "other.mid", [("Piano", notes)], tempo_events=((0, 750_000), (0, 600_000)))
     assert read_midi(other).bpm == 100 and tempi(other) == [100.0]
+
+
+def test_a_key_signature_that_names_no_key_is_no_reason_to_refuse_the_file(tmp_path):
+    """Eight sharps, or mode 2, were refused as a corrupt file (mido cannot decode them); pianobot
+    reads no key signature, so the notes are read, and mido reads other files as before."""
+    for data in (b"\x08\x00", b"\x00\x02"):
+        path = midi_file(tmp_path / "k.mid", [("m", [(0, on(60)), (480, off(60))])])
+        raw = path.read_bytes()
+        meta = b"\x00\xff\x59\x02" + data  # a key signature at tick 0, at the start of the last track
+        start = raw.rindex(b"MTrk")
+        size = int.from_bytes(raw[start + 4 : start + 8], "big") + len(meta)
+        path.write_bytes(raw[:start] + b"MTrk" + size.to_bytes(4, "big") + meta + raw[start + 8 :])
+        assert [n.pitch for n in read_midi(path)] == [60]
+    with pytest.raises(Exception, match="sharps"):
+        mido.MidiFile(file=io.BytesIO(path.read_bytes().replace(b"\x59\x02\x00\x02", b"\x59\x02\x08\x00")))
+
+
+def test_a_digital_pianos_stream_of_pedal_values_counts_each_press_once(tmp_path):
+    """inspect said "pressed 474 times" of a recording with 79 presses: every value of 64 or more counted."""
+    values = [0, 70, 90, 127, 100, 30, 0, 80, 127, 64]
+    pedal = [(i * 10, mido.Message("control_change", control=64, value=v)) for i, v in enumerate(values)]
+    path = midi_file(tmp_path / "p.mid", [("Piano", [(0, on(60)), *pedal, (480, off(60))])])
+    (track,) = [t for t in describe_tracks(path) if t.notes]
+    assert track.pedal == 2

@@ -181,15 +181,17 @@ def test_a_percussion_part_is_left_out_in_one_line_and_a_score_of_only_percussio
         open_midi(write(tmp_path / "drums.musicxml", score([drum])))
 
 
-def test_a_compressed_score_is_read(tmp_path):
+@pytest.mark.parametrize("named", ["inner/score.xml", "./inner/score.xml"])  # (the second was refused)
+def test_a_compressed_score_is_read(tmp_path, named):
     text = score(PIANO, names=["Piano"])
     path = tmp_path / "piano.mxl"
     with zipfile.ZipFile(path, "w") as archive:
         archive.writestr(
             "META-INF/container.xml",
-            '<container><rootfiles><rootfile full-path="inner/score.xml"/></rootfiles></container>',
+            f'<container><rootfiles><rootfile full-path="{named}"/></rootfiles></container>',
         )
         archive.writestr("inner/score.xml", text)
+        archive.writestr("inner/other.xml", "<not-this/>")  # (more than one: the container decides)
     _, piece, _ = read(path)
     _, plain, _ = read(piano_score(tmp_path))
     assert piece.notes == plain.notes
@@ -353,3 +355,35 @@ def test_a_one_staff_parts_pedal_is_read_whatever_music21_calls_the_part(tmp_pat
     part = _one_staff(["C4", "D4"], extra=pedal("start", staff=1))
     source, _, _ = read(write(tmp_path / "pedal.musicxml", score(part, names=["Piano"])))
     assert read_pedal(source).spans[:1] == ((0.0, 1.0),)  # down from the start to the end of the notes
+
+
+def test_a_tempo_mark_beyond_what_midi_holds_is_read_at_the_nearest_and_said(tmp_path):
+    """A mark of 1 quarter a minute (a "rit." written as a tempo) raised a traceback: MIDI's tempo
+    field holds no beat that long. Marks outside 10-1000 are read at the nearest end, said once."""
+    attributes = (
+        "<attributes><divisions>2</divisions><time><beats>2</beats><beat-type>4</beat-type></time></attributes>"
+    )
+    part = [attributes + tempo(1) + note("C4", 2) + note("D4", 2), tempo(100000) + note("E4", 2) + note("F4", 2)]
+    _, piece, said = read(write(tmp_path / "slow.musicxml", score(part, names=["Piano"])))
+    assert [round(n.onset, 3) for n in piece] == [0.0, 6.0, 12.0, 12.06]  # 10 bpm, then 1000
+    (line,) = [line for line in said if "tempo" in line]
+    assert "read 2 tempo mark(s) outside 10-1000" in line and "(such as 1)" in line
+
+
+def test_cue_notes_are_silent_and_keep_the_others_in_time(tmp_path):
+    """A <cue/> note (another part's, printed small) was read as a note to play."""
+    cue = note("G5", 2, extra="<cue/>")
+    part = _one_staff(["C5"])
+    part[0] += cue + note("D5", 2) + note("E5", 2, chord=True, extra="<cue/>") + note("F5", 2)
+    _, piece, said = read(write(tmp_path / "cue.musicxml", score(part, names=["Piano"])))
+    assert [(n.pitch, round(n.onset, 3)) for n in piece] == [(72, 0.0), (74, 1.0), (77, 1.5)]
+    assert any("left out 2 cue note(s)" in line for line in said)
+
+
+def test_a_da_capo_is_said_not_taken(tmp_path):
+    part = _one_staff(
+        ["C5", "D5"],
+        extra='<direction><direction-type><words>D.C.</words></direction-type><sound dacapo="yes"/></direction>',
+    )
+    _, piece, said = read(write(tmp_path / "dc.musicxml", score(part, names=["Piano"])))
+    assert len(piece) == 2 and any("are not expanded" in line for line in said)

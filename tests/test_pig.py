@@ -1,3 +1,5 @@
+import warnings
+
 import pytest
 
 from pianobot.errors import PianobotError, PianobotWarning
@@ -176,3 +178,24 @@ def test_pig_with_both_hands_reads_and_writes_each_notes_hand(tmp_path):
     assert [(c[3], c[6], c[7]) for c in columns] == [("C3", "1", "-5"), ("A#4", "0", "3"), ("C#5", "0", "4")]
     assert read_pig(written, hand=None) == both
     assert read_pig(written, hand="left") == both.part("left").with_hands(None)  # one hand's part, as before
+
+
+def test_a_key_written_twice_at_once_sounds_once_as_in_a_midi_file(tmp_path):
+    """Both hands' G3 at one onset, and C5 struck again while it sounds, were kept as written: a
+    reference no player can sound (note F1 at most 7/9)."""
+    rows = [
+        (0.0, 1.0, "C5", 0, "1"),
+        (0.5, 1.0, "C5", 0, "2"),
+        (1.0, 1.5, "G3", 0, "1"),
+        (1.0, 1.5, "G3", 1, "-1"),
+    ]
+    text = "//Version: PianoFingering_v170101\n" + "".join(
+        f"{i}\t{a}\t{b}\t{p}\t64\t80\t{c}\t{f}\n" for i, (a, b, p, c, f) in enumerate(rows)
+    )
+    (tmp_path / "twice.txt").write_text(text)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        piece = read_pig(tmp_path / "twice.txt", hand=None)
+    assert [(n.pitch, n.onset, n.offset) for n in piece] == [(72, 0.0, 0.5), (72, 0.5, 1.0), (55, 1.0, 1.5)]
+    said = " ".join(str(w.message) for w in caught)
+    assert "G3 at 1.000 s appears twice at once" in said and "C5 starts again at 0.500 s" in said

@@ -6,16 +6,38 @@ from __future__ import annotations
 
 import io
 import warnings
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import mido
+from mido.midifiles.meta import KeySignatureError, MetaSpec_key_signature, add_meta_spec
 
 from pianobot.errors import PianobotError, PianobotWarning
 from pianobot.files import read_input
 
 MAX_FILE_BYTES = 50_000_000
 """The largest .mid file read."""
+
+
+class _AnyKey(MetaSpec_key_signature):
+    """A key signature as mido reads it, a key no signature names (8 sharps, mode 2) read as C major."""
+
+    def decode(self, message, data):
+        try:
+            super().decode(message, data)
+        except KeySignatureError:
+            message.key = "C"
+
+
+@contextmanager
+def _any_key():
+    """mido reading every key signature (:class:`_AnyKey`) while inside, as before after."""
+    add_meta_spec(_AnyKey)
+    try:
+        yield
+    finally:
+        add_meta_spec(MetaSpec_key_signature)
 
 
 def _track_chunks(data: bytes) -> tuple[int, bool]:
@@ -64,7 +86,11 @@ def _load(path: Path) -> mido.MidiFile:
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            midi = mido.MidiFile(file=io.BytesIO(data))
+            try:
+                midi = mido.MidiFile(file=io.BytesIO(data))
+            except KeySignatureError:  # (a key no signature names: pianobot reads no key signature)
+                with _any_key():
+                    midi = mido.MidiFile(file=io.BytesIO(data))
     except Exception as e:  # mido raises many types on corrupt data
         reason = str(e) or type(e).__name__
         raise PianobotError(

@@ -24,7 +24,7 @@ import bisect
 import re
 import warnings
 from collections import defaultdict
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from pathlib import Path
 
 import mido
@@ -38,7 +38,7 @@ from pianobot.music.midi_file import (  # noqa: F401 (by their old address too)
     source_path,
 )
 from pianobot.music.pedal import DOWN_AT, RING, Pedal
-from pianobot.music.piece import HANDS, MAX_SECONDS, Note, Piece, pitch_name
+from pianobot.music.piece import HANDS, MAX_SECONDS, Note, Piece, pitch_name, resolve_overlaps
 
 _FINGER_TOKEN = r"(?:[0-9](?:_[0-9])?|-)"
 _FINGER_TEXT = re.compile(rf"^\s*{_FINGER_TOKEN}(?:[\s,]+{_FINGER_TOKEN})*\s*$")
@@ -151,13 +151,23 @@ PERCUSSION = 9
 """MIDI channel 10 (9 counted from 0): General MIDI's drums, whose notes are no piano keys."""
 
 
+def _presses(down) -> int:
+    """How many times the pedal goes down, of its states in order (a digital piano sends a stream of
+    values while the foot moves: each one down is no new press)."""
+    count, before = 0, False
+    for now in down:
+        count += now and not before
+        before = now
+    return count
+
+
 def list_tracks(midi: mido.MidiFile) -> list[TrackInfo]:
     """Each track's name and notes (the drums' on channel 10 left out, as the reading leaves them)."""
     infos = []
     for i, track in enumerate(midi.tracks):
         name = _text(next((m.name for m in track if m.type == "track_name"), ""))
         ons = [m for m in track if m.type == "note_on" and m.velocity > 0 and m.channel != PERCUSSION]
-        pedal = sum(1 for m in track if m.type == "control_change" and m.control == SUSTAIN and m.value >= DOWN_AT)
+        pedal = _presses(m.value >= DOWN_AT for m in track if m.type == "control_change" and m.control == SUSTAIN)
         pitches = [m.note for m in ons]
         infos.append(
             TrackInfo(
@@ -236,7 +246,7 @@ def _track_notes(
     Messages are read in the file's order. A key struck again while it still sounds (a player's
     legato on a repeated note) opens a second note; a note-off ends the earliest one that began
     before it (first in, first out), so a repeated key's note-off and note-on at one tick end one
-    note and begin the next in either order, and :func:`_resolve_overlaps` ends a first note where
+    note and begin the next in either order, and :func:`resolve_overlaps` ends a first note where
     a second starts. A note-off that finds only a note begun at its own tick ends a note of no
     length (some programs write grace notes and chord symbols so): it is left out, said in one
     warning. A track whose texts hold a number that is no finger (a figured bass) has no fingering.
@@ -376,7 +386,7 @@ def read_midi(
                 warnings.warn(PianobotWarning(f"{pitch_name(pitch)} at {onset:.3f} s lasts under 1 ms; dropped"))
                 continue
             notes.append(Note(onset=onset, pitch=pitch, offset=offset, velocity=vel, finger=finger, hand=hand))
-    return Piece(tuple(_resolve_overlaps(notes)), bpm=nominal)
+    return Piece(tuple(resolve_overlaps(notes)), bpm=nominal)
 
 
 def _clock(midi: mido.MidiFile, path: Path, bpm: float | None):
@@ -440,45 +450,6 @@ def _parts(midi: mido.MidiFile, chosen: list[int], seconds, path: Path) -> list[
     noted = [(index, raw) for index, raw, _ in parts if raw]
     merged = [item for _, raw in noted for item in raw]
     return [(noted[0][0] if len(noted) == 1 else None, merged, lyrics)] if noted else parts
-
-
-def _resolve_overlaps(notes: list[Note]) -> list[Note]:
-    """One key cannot sound twice at once: cut an earlier note where the same pitch starts again.
-    Said in one warning per kind, with the first of them (a file may hold hundreds)."""
-    by_pitch: dict[int, list[Note]] = defaultdict(list)
-    doubled: list[Note] = []
-    cut: list[tuple[Note, Note]] = []
-    for note in sorted(notes, key=lambda n: (n.onset, n.pitch, -n.velocity)):
-        previous = by_pitch[note.pitch][-1] if by_pitch[note.pitch] else None
-        if previous is not None and note.onset < previous.offset:
-            if note.onset == previous.onset:
-                doubled.append(note)
-                if note.offset > previous.offset:
-                    by_pitch[note.pitch][-1] = replace(previous, offset=note.offset)
-                continue
-            cut.append((previous, note))
-            by_pitch[note.pitch][-1] = replace(previous, offset=note.onset)
-        by_pitch[note.pitch].append(note)
-    if doubled:
-        first = doubled[0].describe()
-        warnings.warn(
-            PianobotWarning(
-                f"{first} appears twice at once; the louder one is kept"
-                if len(doubled) == 1
-                else f"{len(doubled)} notes appear twice at once (the first: {first}); the louder of each is kept"
-            )
-        )
-    if cut:
-        previous, note = cut[0]
-        first = f"{previous.describe()} still sounds when {note.name} starts again at {note.onset:.3f} s"
-        warnings.warn(
-            PianobotWarning(
-                f"{first}; the earlier note now ends there"
-                if len(cut) == 1
-                else f"{len(cut)} notes still sound when their key starts again (the first: {first}); each now ends there"
-            )
-        )
-    return [n for group in by_pitch.values() for n in group]
 
 
 def tempi(path: str | Path | MidiSource) -> list[float]:

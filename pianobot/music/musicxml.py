@@ -84,7 +84,8 @@ def _render(score, tree: Score, path: Path) -> mido.MidiFile:
     m21 = music21()
     said: dict[str, int] = defaultdict(int)
     tracks: list[mido.MidiTrack] = []
-    for name, part in _staves(_score_parts(m21, score, tree)):
+    parts = _score_parts(m21, score, tree)
+    for name, part in _staves(parts):
         unpitched = said["unpitched"]
         events = _part_events(m21, part, said)
         if events:
@@ -94,11 +95,12 @@ def _render(score, tree: Score, path: Path) -> mido.MidiFile:
     if not tracks:
         what = " (only percussion)" if said["percussion"] else ""
         raise PianobotError(f"{path} holds no pitched notes{what}: give a score with notes for the piano")
+    tempo = _tempo_track(score, said)
     _say(path, said, tree)
     midi = mido.MidiFile(type=1, ticks_per_beat=TICKS_PER_BEAT)
-    midi.tracks.append(_tempo_track(score))
+    midi.tracks.append(tempo)
     pedal_track = next((t for t in tracks if t.name == TRACK_NAMES["right"]), tracks[0])
-    _add_pedal(pedal_track, _pedal_times(_score_parts(m21, score, tree), tree))
+    _add_pedal(pedal_track, _pedal_times(parts, tree))
     midi.tracks.extend(tracks)
     return midi
 
@@ -247,12 +249,22 @@ def _timed(track: mido.MidiTrack, timed: list[tuple[int, int, object]]) -> mido.
     return track
 
 
-def _tempo_track(score) -> mido.MidiTrack:
+TEMPO_RANGE = (10.0, 1000.0)
+"""The tempos (quarter notes a minute) a mark is read at: one outside is read as the nearest of these
+(a "rit." written as a tempo of 1 is beyond what a MIDI tempo holds), said; as ``--tempo`` allows."""
+
+
+def _tempo_track(score, said: dict[str, int]) -> mido.MidiTrack:
     """The tempo marks of ``score`` as set_tempo events (120 bpm where it has none; a mark that
-    each staff repeats, once)."""
+    each staff repeats, once; one outside :data:`TEMPO_RANGE` at the nearest end, counted in ``said``)."""
     timed, now = [], None
+    low, high = TEMPO_RANGE
     for start, _, mark in score.metronomeMarkBoundaries():
         bpm = mark.getQuarterBPM()
+        if bpm and bpm > 0 and not low <= bpm <= high:
+            said["tempo"] += 1
+            said.setdefault("tempo example", f"{bpm:g}")
+            bpm = min(max(bpm, low), high)
         if bpm and bpm > 0 and (tempo := mido.bpm2tempo(bpm)) != now:
             timed.append((_tick(start), 0, mido.MetaMessage("set_tempo", tempo=tempo)))
             now = tempo
@@ -301,10 +313,21 @@ def _say(path: Path, said: dict[str, int], tree: Score) -> None:
         "substitution": "{n} fingering mark(s) naming two fingers (a substitution) read as their first finger",
         "not a finger": "dropped {n} fingering mark(s) that name no finger 1-5 (such as '{example}')",
         "ambiguous": "dropped the fingering of {n} chord(s) whose marks cannot be matched to their notes",
+        "tempo": "read {n} tempo mark(s) outside 10-1000 quarter notes a minute (such as {tempo}) as the nearest of those",
     }
     for kind, line in lines.items():
         if said.get(kind):
-            text = line.format(n=said[kind], example=quote(str(said.get("example", "")), 20))
+            text = line.format(
+                n=said[kind], example=quote(str(said.get("example", "")), 20), tempo=said.get("tempo example")
+            )
             warnings.warn(PianobotWarning(f"{path.name}: {text}"))
+    if tree.cues:
+        warnings.warn(
+            PianobotWarning(f"{path.name}: left out {tree.cues} cue note(s) (another part's notes, not played)")
+        )
     if tree.repeats:
-        warnings.warn(PianobotWarning(f"{path.name}: its repeats are not expanded: it is played once, as written"))
+        warnings.warn(
+            PianobotWarning(
+                f"{path.name}: its repeats (or its da capo, dal segno) are not expanded: it is played once, as written"
+            )
+        )

@@ -10,6 +10,7 @@ does not keep. Every problem is one line (:class:`~pianobot.errors.PianobotError
 from __future__ import annotations
 
 import io
+import posixpath
 import xml.etree.ElementTree as ET
 import zipfile
 from dataclasses import dataclass, field
@@ -46,7 +47,9 @@ class Score:
     root: ET.Element
     pedal: list[PedalMark] = field(default_factory=list)
     repeats: bool = False
-    """Whether it has repeat signs or endings (not expanded)."""
+    """Whether it has repeat signs, endings or jumps (:data:`JUMPS`; not expanded)."""
+    cues: int = 0
+    """Cue notes left out (:func:`_silence_cues`)."""
 
 
 def read_tree(path: Path) -> Score:
@@ -63,11 +66,14 @@ def read_tree(path: Path) -> Score:
         raise PianobotError(f"{path} holds no notes: give a score with notes for the piano")
     if notes > MAX_NOTES:
         raise PianobotError(f"{path} holds {notes:,} notes, more than {MAX_NOTES:,}: that is not a piano piece; cut it")
+    cues = 0
     for part in root.iter("part"):
         for measure in part.iter("measure"):
+            cues += _silence_cues(measure)
             _fix_fingering(measure)
     repeats = any(True for _ in root.iter("repeat")) or any(True for _ in root.iter("ending"))
-    return Score(root, _pedal(root), repeats)
+    repeats = repeats or any(sound.get(jump) for sound in root.iter("sound") for jump in JUMPS)
+    return Score(root, _pedal(root), repeats, cues)
 
 
 def _xml_bytes(path: Path) -> bytes:
@@ -100,8 +106,9 @@ def _root_file(archive: zipfile.ZipFile, path: Path) -> str:
     if "META-INF/container.xml" in names:
         container = _parse(archive.read("META-INF/container.xml")[:1_000_000], path)
         for rootfile in container.iter():
-            if rootfile.tag.endswith("rootfile") and rootfile.get("full-path") in names:
-                return rootfile.get("full-path")
+            named = posixpath.normpath(rootfile.get("full-path") or ".")  # ("./score.xml" is "score.xml")
+            if rootfile.tag.endswith("rootfile") and named in names:
+                return named
     scores = [n for n in names if not n.startswith("META-INF/") and n.lower().endswith((".xml", ".musicxml"))]
     if len(scores) != 1:
         raise PianobotError(f"{path} is a zip file without one MusicXML score in it: give a {KIND}")
@@ -114,6 +121,32 @@ def _parse(data: bytes, path: Path) -> ET.Element:
         return ET.fromstring(data)
     except ET.ParseError as e:
         raise PianobotError(f"{path} is not well-formed XML ({quote(str(e), 50)}): give a {KIND}") from None
+
+
+JUMPS = ("dacapo", "dalsegno", "tocoda")
+"""The ``<sound>`` attributes of a jump (da capo, dal segno, to coda), which is not taken."""
+
+
+def _silence_cues(measure: ET.Element) -> int:
+    """Cue notes (``<cue/>``: another part's notes printed small, not played) left out of
+    ``measure``, each in time as a ``<forward>`` of its length (music21 would read them as notes);
+    how many."""
+    count = 0
+    for note in list(measure):
+        if note.tag != "note" or note.find("cue") is None:
+            continue
+        count += 1
+        forward = None
+        if note.find("chord") is None and note.find("grace") is None and note.find("duration") is not None:
+            forward = ET.Element("forward")
+            for tag in ("duration", "voice", "staff"):
+                if note.find(tag) is not None:
+                    forward.append(note.find(tag))
+        position = list(measure).index(note)
+        measure.remove(note)
+        if forward is not None:
+            measure.insert(position, forward)
+    return count
 
 
 def _fix_fingering(measure: ET.Element) -> None:

@@ -16,10 +16,12 @@ from __future__ import annotations
 import math
 import numbers
 import re
+import warnings
+from collections import defaultdict
 from dataclasses import dataclass, field, replace
 from typing import Iterable, Sequence
 
-from pianobot.errors import PianobotError, SettingError, quote
+from pianobot.errors import PianobotError, PianobotWarning, SettingError, quote
 
 FINGER_NAMES = {1: "thumb", 2: "index", 3: "middle", 4: "ring", 5: "little"}
 HANDS = ("right", "left")
@@ -284,3 +286,42 @@ class Piece:
     @staticmethod
     def of(notes: Iterable[Note], bpm: float = 120.0) -> "Piece":
         return Piece(tuple(notes), bpm=bpm)
+
+
+def resolve_overlaps(notes: list[Note]) -> list[Note]:
+    """One key cannot sound twice at once: cut an earlier note where the same pitch starts again.
+    Said in one warning per kind, with the first of them (a file may hold hundreds)."""
+    by_pitch: dict[int, list[Note]] = defaultdict(list)
+    doubled: list[Note] = []
+    cut: list[tuple[Note, Note]] = []
+    for note in sorted(notes, key=lambda n: (n.onset, n.pitch, -n.velocity)):
+        previous = by_pitch[note.pitch][-1] if by_pitch[note.pitch] else None
+        if previous is not None and note.onset < previous.offset:
+            if note.onset == previous.onset:
+                doubled.append(note)
+                if note.offset > previous.offset:
+                    by_pitch[note.pitch][-1] = replace(previous, offset=note.offset)
+                continue
+            cut.append((previous, note))
+            by_pitch[note.pitch][-1] = replace(previous, offset=note.onset)
+        by_pitch[note.pitch].append(note)
+    if doubled:
+        first = doubled[0].describe()
+        warnings.warn(
+            PianobotWarning(
+                f"{first} appears twice at once; the louder one is kept"
+                if len(doubled) == 1
+                else f"{len(doubled)} notes appear twice at once (the first: {first}); the louder of each is kept"
+            )
+        )
+    if cut:
+        previous, note = cut[0]
+        first = f"{previous.describe()} still sounds when {note.name} starts again at {note.onset:.3f} s"
+        warnings.warn(
+            PianobotWarning(
+                f"{first}; the earlier note now ends there"
+                if len(cut) == 1
+                else f"{len(cut)} notes still sound when their key starts again (the first: {first}); each now ends there"
+            )
+        )
+    return [n for group in by_pitch.values() for n in group]

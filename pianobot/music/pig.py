@@ -18,7 +18,7 @@ from pathlib import Path
 
 from pianobot.errors import PianobotError, quote
 from pianobot.files import atomic_write, read_input
-from pianobot.music.piece import HANDS, Note, Piece, parse_pitch, pitch_name
+from pianobot.music.piece import HANDS, Note, Piece, parse_pitch, pitch_name, resolve_overlaps
 
 HEADER = "//Version: PianoFingering_v170101"
 SIDECAR_SUFFIX = "_fingering.txt"
@@ -93,10 +93,10 @@ def read_pig(path: str | Path, *, hand: str | None = "right") -> Piece:
     """A PIG file's notes for one hand as a piece (fingers stored as 1-5, no hand: a one-hand part),
     or with ``hand=None`` both hands' notes, each with its hand (channel 0 right, 1 left)."""
     rows = read_pig_rows(path)
-    if hand is None:
-        return Piece(tuple(replace(note, hand=HANDS[channel]) for note, channel in rows))
+    if hand is None:  # (a key sounds once at a time: an earlier note ends where its key starts again)
+        return Piece(tuple(resolve_overlaps([replace(note, hand=HANDS[channel]) for note, channel in rows])))
     channel = CHANNELS[hand]
-    notes = [note for note, ch in rows if ch == channel]
+    notes = resolve_overlaps([note for note, ch in rows if ch == channel])
     if not notes:
         other = "left" if hand == "right" else "right"
         raise PianobotError(

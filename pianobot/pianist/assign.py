@@ -52,7 +52,7 @@ from pianobot.music import midi_io
 from pianobot.music import window as windows
 from pianobot.music.instrument import HandSpec, KeyboardSpec, keyboard_for
 from pianobot.music.load import CHORD_SPREAD, LEGATO_OVERLAP, LoadOptions, load_hands, thin_hand
-from pianobot.music.piece import Note, Piece, mirror_pitch
+from pianobot.music.piece import Note, Piece, mirror_pitch, pitch_name
 from pianobot.pianist.fingering import FingeringPlan, Planner, ensure_fingering
 from pianobot.pianist.reduce import reduce_part
 from pianobot.pianist.tuning import tuning_for
@@ -308,6 +308,18 @@ def load_two_hands(
                 f"dropped {dropped} inner note(s)"
             )
         )
+    if len(named := {n.hand for n in piece.notes}) == 1 and None not in named:  # the names give one hand every note
+        out = next((g for g in group_chords(piece) if not reaches([piece.notes[i].pitch for i in g], *named, spec)), [])
+        if out:
+            chord = " ".join(pitch_name(piece.notes[i].pitch) for i in out)
+            warnings.warn(
+                PianobotWarning(
+                    f"{midi_io.source_path(path).name}: its tracks name every note for the {min(named)} hand, which "
+                    f"cannot reach all of its chords (the first: {chord} at {piece.notes[out[0]].onset:.3f} s): the "
+                    "fingering planner gives every note a hand instead"
+                )
+            )
+            piece = piece.with_hands(None)
     if any(n.hand is None for n in piece.notes):
         piece = assign_hands(piece, spec).piece
     from pianobot.pianist.lend import lend_if_more  # (lend.py builds on this module)

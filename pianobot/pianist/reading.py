@@ -334,15 +334,15 @@ def read_hands(
         warnings.simplefilter("ignore", PianobotWarning)  # said by load_two_hands
         given = load_hands(source := open_song(path), options)
     piece = load_two_hands(source, options, spec)
-    written = {(n.pitch, n.onset): n.hand for n in given.notes if n.hand is not None}
+    dropped = len(given.hands) == 1 < len(piece.hands) and all(n.hand for n in given.notes)  # (one hand named: dropped)
+    written = {} if dropped else {(n.pitch, n.onset): n.hand for n in given.notes if n.hand is not None}
     named, lent = {hand: 0 for hand in HANDS}, {hand: 0 for hand in HANDS}
     for note in piece.notes:  # (notes the reading thinned away count for neither)
         hand = written.get((note.pitch, note.onset))
         if hand is not None:
             (named if hand == note.hand else lent)[note.hand] += 1
-    return HandsReading(
-        piece, named, "the PIG channel" if source_path(path).suffix.lower() == ".txt" else "its track", lent
-    )
+    said = "the PIG channel" if source_path(path).suffix.lower() == ".txt" else "its track"
+    return HandsReading(piece, named, said, lent)
 
 
 def names_hands(path: str | Path | MidiSource, track: str | None = None) -> bool:
