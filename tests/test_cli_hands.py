@@ -7,11 +7,14 @@ from pathlib import Path
 
 import mido
 import pytest
-from conftest import assert_one_line_error, midi_file, off, on, run
+from conftest import assert_one_line_error, lyric, midi_file, off, on, run
 
-from pianobot.music.load import load_hands
+from pianobot.errors import PianobotWarning
+from pianobot.music.instrument import HandSpec
+from pianobot.music.load import LoadOptions, load_hands
 from pianobot.music.metrics import compare
 from pianobot.music.midi_io import read_midi
+from pianobot.pianist.assign import load_two_hands
 
 EXAMPLES = Path(__file__).parent.parent / "examples" / "midi"
 
@@ -56,6 +59,12 @@ def test_a_two_hand_file_whose_tracks_all_name_one_hand_plays_both_hands(tmp_pat
     text = " ".join(result.stdout.split())
     assert "left hand: 2 notes, C3-G3, assigned by the fingering planner" in text
     assert json.loads((tmp_path / "r.json").read_text())["f1"] == 1.0
+    # the fingering written for that one hand is not the other hand's
+    fingered = [(0, lyric("3")), *RIGHT[:2], (0, lyric("1")), (0, on(48)), (960, off(48))]
+    song = midi_file(tmp_path / "fingered.mid", [("Right Hand", fingered)])
+    with pytest.warns(PianobotWarning, match="gives every note a hand and a finger"):
+        piece = load_two_hands(song, LoadOptions(), HandSpec(fingers=(1, 2, 3, 4, 5), model="pianist"))
+    assert piece.hands == ("right", "left") and all(n.finger is None for n in piece.notes)
     # a part the named hand reaches stays that hand's: one hand, as before
     melody = midi_file(tmp_path / "melody.mid", [("Right Hand", RIGHT)])
     result = run("play", melody, "-o", tmp_path / "m.mid", "--controller", "scripted")

@@ -6,6 +6,7 @@ import pytest
 from conftest import lyric, midi_file, off, on
 
 from pianobot.errors import PianobotError, PianobotWarning
+from pianobot.music.midi_file import open_midi
 from pianobot.music.midi_io import (
     describe_tracks,
     is_fingering,
@@ -91,12 +92,18 @@ def test_fingering_from_lyrics_with_chord_rule(tmp_path):
     assert [(n.pitch, n.finger) for n in piece] == [(60, 4), (67, 2), (62, None)]
 
 
-def test_fingering_count_must_match_the_chord(tmp_path):
-    path = midi_file(
-        tmp_path / "f.mid", [("m", [(0, lyric("2 3 4")), (0, on(60)), (0, on(64)), (480, off(60)), (480, off(64))])]
-    )
-    with pytest.raises(PianobotError, match="3 finger\\(s\\) for 2 note\\(s\\).*lowest pitch first"):
-        read_midi(path)
+def test_a_fingering_that_does_not_count_the_chords_notes_leaves_its_track_unfingered(tmp_path):
+    """A figured bass of figures 1-5 ("5 3" over one note) refused the file; a list that does not
+    give one finger per note is no fingering: the track's numbers are not read, said in one line."""
+    events = [(0, lyric("2 3 4")), (0, on(60)), (0, on(64)), (480, off(60)), (480, off(64))]
+    events += [(480, lyric("3")), (480, on(65)), (960, off(65))]
+    path = midi_file(tmp_path / "f.mid", [("m", events)])
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        piece = read_midi(path)
+    assert [n.finger for n in piece] == [None, None, None]
+    (said,) = [str(w.message) for w in caught]
+    assert "3 finger(s) for 2 note(s)" in said and "none of the track's numbers is read as fingering" in said
 
 
 def test_numbers_outside_fingers_1_to_5_are_no_fingering(tmp_path):
@@ -324,7 +331,7 @@ def test_a_figured_bass_in_a_tracks_lyrics_is_no_fingering(tmp_path):
         piece = read_midi(path)
     assert [(n.pitch, n.finger) for n in piece] == [(48, None), (72, 2), (50, None), (74, 3)]
     (said,) = [str(w.message) for w in caught]
-    assert said.startswith("track 2: its lyrics hold '6', a number that is no finger 1-5") and "none of its 1" in said
+    assert said.startswith("track 2: its texts hold '6', a number that is no finger 1-5") and "none of its numbers" in said
     assert parse_finger_text("6 5") == [6, 5] and not is_fingering([6, 5]) and is_fingering([1, None, 5])
 
 
@@ -339,6 +346,12 @@ def test_a_note_of_no_length_is_left_out_in_one_line_and_a_repeated_key_reads_in
     assert [(n.onset, n.pitch, n.offset) for n in piece] == [(0.0, 64, 0.5)]
     (said,) = [str(w.message) for w in caught]
     assert said.startswith("track 1: left out 2 note(s) of no length") and "D4 at 0.000 s" in said
+    # a second note-off after the key's note-off and its next note-on at one tick ends no note
+    stray = [(0, on(60)), (480, off(60)), (480, on(60)), (480, off(60)), (960, off(60))]
+    path = midi_file(tmp_path / "stray.mid", [("m", stray)])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert [(n.onset, n.offset) for n in read_midi(path)] == [(0.0, 0.5), (0.5, 1.0)]
     # a key struck again at the tick its first note ends: two notes, whichever message comes first
     for order in ([(480, off(60)), (480, on(60))], [(480, on(60)), (480, off(60))]):
         path = midi_file(tmp_path / "again.mid", [("m", [(0, on(60)), *order, (960, off(60))])])
@@ -357,6 +370,10 @@ def test_a_note_of_no_length_is_left_out_in_one_line_and_a_repeated_key_reads_in
         ("Flower", None),
         ("Piano RH", "right"),
         ("RightHand", "right"),
+        ("PianoRight", "right"),
+        ("Piano_Right", "right"),
+        ("UprightPiano", None),
+        ("piano_left", "left"),
         ("Right Hand", "right"),
         ("Treble", "right"),
         ("L.H.", "left"),
@@ -462,6 +479,7 @@ def test_a_key_signature_that_names_no_key_is_no_reason_to_refuse_the_file(tmp_p
         size = int.from_bytes(raw[start + 4 : start + 8], "big") + len(meta)
         path.write_bytes(raw[:start] + b"MTrk" + size.to_bytes(4, "big") + meta + raw[start + 8 :])
         assert [n.pitch for n in read_midi(path)] == [60]
+        assert "key_signature" in [m.type for m in open_midi(path).midi.tracks[-1]]
     with pytest.raises(Exception, match="sharps"):
         mido.MidiFile(file=io.BytesIO(path.read_bytes().replace(b"\x59\x02\x00\x02", b"\x59\x02\x08\x00")))
 

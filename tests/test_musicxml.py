@@ -368,6 +368,16 @@ def test_a_tempo_mark_beyond_what_midi_holds_is_read_at_the_nearest_and_said(tmp
     assert [round(n.onset, 3) for n in piece] == [0.0, 6.0, 12.0, 12.06]  # 10 bpm, then 1000
     (line,) = [line for line in said if "tempo" in line]
     assert "read 2 tempo mark(s) outside 10-1000" in line and "(such as 1)" in line
+    # a two-staff part's one mark (each staff repeats it to music21) is one
+    piano = [
+        PIANO_ATTRIBUTES
+        + tempo(1)
+        + note("C5", 2, staff=1)
+        + "<backup><duration>2</duration></backup>"
+        + note("C3", 2, staff=2)
+    ]
+    _, _, said = read(write(tmp_path / "piano.musicxml", score(piano, names=["Piano"])))
+    assert any("read 1 tempo mark(s)" in line for line in said), said
 
 
 def test_cue_notes_are_silent_and_keep_the_others_in_time(tmp_path):

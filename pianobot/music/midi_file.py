@@ -23,6 +23,8 @@ MAX_FILE_BYTES = 50_000_000
 class _AnyKey(MetaSpec_key_signature):
     """A key signature as mido reads it, a key no signature names (8 sharps, mode 2) read as C major."""
 
+    type = "key_signature"  # (mido names a spec without one by its class)
+
     def decode(self, message, data):
         try:
             super().decode(message, data)

@@ -56,7 +56,8 @@ UNASSIGNED_TRACK = "Unassigned"
 
 def track_hand(name: str) -> str | None:
     """The hand a track's name says it holds ('right' for 'Right Hand', 'RH', 'Treble'...), or None."""
-    said = [hand for hand in HANDS if HAND_NAMES[hand].search(name)]
+    words = re.sub(r"(?<=[a-z])(?=[A-Z])", " ", name).replace("_", " ")  # ("PianoRight", "piano_right": two words)
+    said = [hand for hand in HANDS if HAND_NAMES[hand].search(words)]
     return said[0] if len(said) == 1 else None
 
 
@@ -256,6 +257,7 @@ def _track_notes(
     fingering: dict[int, list[int | None]] = defaultdict(list)
     figures: list[str] = []  # texts with numbers that are no fingers
     empty: list[tuple[int, int]] = []  # (tick, pitch) of notes of no length
+    ended: dict[tuple[int, int], int] = {}  # (channel, pitch): the tick its last note ended
     tick = 0
     for msg in track:
         tick += msg.time
@@ -275,7 +277,8 @@ def _track_notes(
             if earlier is not None:
                 on, vel = sounding.pop(earlier)
                 notes.append((on, tick, msg.note, vel))
-            elif sounding:
+                ended[(msg.channel, msg.note)] = tick
+            elif sounding and ended.get((msg.channel, msg.note)) != tick:  # (else a second note-off: no note's)
                 sounding.pop(0)
                 empty.append((tick, msg.note))
     end = tick
@@ -291,8 +294,8 @@ def _track_notes(
     if figures and fingering:
         warnings.warn(
             PianobotWarning(
-                f"track {index}: its lyrics hold '{quote(figures[0])}', a number that is no finger 1-5 (a figured "
-                f"bass?), so none of its {sum(map(len, fingering.values()))} numbers is read as fingering"
+                f"track {index}: its texts hold '{quote(figures[0])}', a number that is no finger 1-5 (a figured "
+                "bass?), so none of its numbers is read as fingering"
             )
         )
     if figures:
@@ -370,13 +373,17 @@ def read_midi(
                         "note starting there; ignored"
                     )
                 )
-                continue
-            if len(fingers) != len(starting):
-                raise PianobotError(
-                    f"{path} track {index} at {seconds(tick):.3f} s: fingering '{quote(finger_text(fingers))}' gives "
-                    f"{len(fingers)} finger(s) for {len(starting)} note(s) starting there "
-                    f"({', '.join(pitch_name(s[2]) for s in starting)}): give one finger per note, lowest pitch first"
+            elif len(fingers) != len(starting):  # (a figured bass's "5 3" over one note, say)
+                warnings.warn(
+                    PianobotWarning(
+                        f"{path.name} track {index} at {seconds(tick):.3f} s: fingering '{quote(finger_text(fingers))}' "
+                        f"gives {len(fingers)} finger(s) for {len(starting)} note(s) starting there "
+                        f"({', '.join(pitch_name(s[2]) for s in starting)}), so none of the track's numbers is read as "
+                        "fingering (a figured bass?); to finger it, give one finger per note, lowest pitch first"
+                    )
                 )
+                fingering = {}
+                break
         for on, off, pitch, vel in raw:
             starting = sorted(by_tick[on], key=lambda item: item[2])
             fingers = fingering.get(on)

@@ -257,17 +257,18 @@ TEMPO_RANGE = (10.0, 1000.0)
 def _tempo_track(score, said: dict[str, int]) -> mido.MidiTrack:
     """The tempo marks of ``score`` as set_tempo events (120 bpm where it has none; a mark that
     each staff repeats, once; one outside :data:`TEMPO_RANGE` at the nearest end, counted in ``said``)."""
-    timed, now = [], None
+    timed, now, beyond = [], None, set()
     low, high = TEMPO_RANGE
     for start, _, mark in score.metronomeMarkBoundaries():
         bpm = mark.getQuarterBPM()
         if bpm and bpm > 0 and not low <= bpm <= high:
-            said["tempo"] += 1
+            beyond.add((start, bpm))  # (a mark each staff repeats is one)
             said.setdefault("tempo example", f"{bpm:g}")
             bpm = min(max(bpm, low), high)
         if bpm and bpm > 0 and (tempo := mido.bpm2tempo(bpm)) != now:
             timed.append((_tick(start), 0, mido.MetaMessage("set_tempo", tempo=tempo)))
             now = tempo
+    said["tempo"] = len(beyond)
     return _timed(mido.MidiTrack([mido.MetaMessage("track_name", name="Tempo")]), timed)
 
 

@@ -310,16 +310,17 @@ def load_two_hands(
         )
     if len(named := {n.hand for n in piece.notes}) == 1 and None not in named:  # the names give one hand every note
         out = next((g for g in group_chords(piece) if not reaches([piece.notes[i].pitch for i in g], *named, spec)), [])
-        if out:
-            chord = " ".join(pitch_name(piece.notes[i].pitch) for i in out)
+        if out:  # (the names and the fingering written for that one hand are not taken)
+            chord, file = " ".join(pitch_name(piece.notes[i].pitch) for i in out), midi_io.source_path(path)
             warnings.warn(
                 PianobotWarning(
-                    f"{midi_io.source_path(path).name}: its tracks name every note for the {min(named)} hand, which "
-                    f"cannot reach all of its chords (the first: {chord} at {piece.notes[out[0]].onset:.3f} s): the "
-                    "fingering planner gives every note a hand instead"
+                    f"{file.name}: its {'channel' if file.suffix.lower() == '.txt' else 'tracks'} name every note for "
+                    f"the {min(named)} hand, which cannot reach all of its chords (the first: {chord} at "
+                    f"{piece.notes[out[0]].onset:.3f} s): the fingering planner gives every note a hand"
+                    + (" and a finger" if any(n.finger is not None for n in piece.notes) else "")
                 )
             )
-            piece = piece.with_hands(None)
+            piece = piece.with_hands(None).without_fingering()
     if any(n.hand is None for n in piece.notes):
         piece = assign_hands(piece, spec).piece
     from pianobot.pianist.lend import lend_if_more  # (lend.py builds on this module)
