@@ -331,7 +331,9 @@ def test_a_figured_bass_in_a_tracks_lyrics_is_no_fingering(tmp_path):
         piece = read_midi(path)
     assert [(n.pitch, n.finger) for n in piece] == [(48, None), (72, 2), (50, None), (74, 3)]
     (said,) = [str(w.message) for w in caught]
-    assert said.startswith("track 2: its texts hold '6', a number that is no finger 1-5") and "none of its numbers" in said
+    assert (
+        said.startswith("track 2: its texts hold '6', a number that is no finger 1-5") and "none of its numbers" in said
+    )
     assert parse_finger_text("6 5") == [6, 5] and not is_fingering([6, 5]) and is_fingering([1, None, 5])
 
 
