@@ -89,8 +89,9 @@ def test_inspect_with_transpose_tempo_and_keyboard_options(tmp_path):
 
 def test_thumb_option_enables_finger_one(tmp_path):
     path = write_midi(Piece((Note(0, 60, 1, 80, 1),)), tmp_path / "thumb.mid")
-    assert_one_line_error(run("inspect", path), "--thumb")
+    assert_one_line_error(run("inspect", path, "--hand-model", "allegro"), "--thumb")
     assert run("inspect", path, "--thumb").exit_code == 0
+    assert run("inspect", path).exit_code == 0  # (no hand named: the pianist's, for a fingering with the thumb)
 
 
 def test_track_option(tmp_path):
@@ -159,7 +160,11 @@ def test_polyphony_and_missing_fingers(tmp_path):
     assert "c.mid: one hand cannot play it (4 notes sound at once at 0.000 s" in " ".join(allegro.stderr.split())
     assert re.search(r"right hand: [123] notes?, .* left hand: [123] notes?, ", " ".join(allegro.stdout.split()))
     little = write_midi(Piece((Note(0, 60, 1, 80, 5),)), tmp_path / "l.mid")
-    assert_one_line_error(run("inspect", little), "fingered 5 (little)")
+    assert_one_line_error(run("inspect", little, "--hand-model", "allegro"), "fingered 5 (little)")
+    # (no hand model named: a fingering with a finger the Allegro-like hand lacks is the pianist's hand's)
+    assert "with fingers 1 (thumb), 2 (index), 3 (middle), 4 (ring), 5 (little)" in " ".join(
+        run("inspect", little).stdout.split()
+    )
 
 
 def test_sidecar_problems(tmp_path, scale):

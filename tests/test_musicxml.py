@@ -318,8 +318,13 @@ def test_a_two_staff_score_with_a_few_marks_plays_both_hands_with_them(tmp_path)
 def test_a_finger_the_hand_lacks_is_said_in_one_line(tmp_path):
     melody = "<attributes><divisions>1</divisions></attributes>" + note("C4", 1, finger=2) + note("D4", 1, finger=5)
     path = write(tmp_path / "five.musicxml", score([melody], names=["Right Hand"]))
-    result = run("play", path, "-o", tmp_path / "out.mid", "--controller", "scripted")
+    result = run("play", path, "-o", tmp_path / "out.mid", "--controller", "scripted", "--hand-model", "allegro")
     assert_one_line_error(result, "fingered 5", "--hand-model pianist")
+    # no hand model named: the pianist's hand plays the file's fingering as written
+    result = run("play", path, "-o", tmp_path / "out.mid", "--controller", "scripted", "--json", tmp_path / "r.json")
+    assert result.exit_code == 0, result.output
+    report = json.loads((tmp_path / "r.json").read_text())
+    assert report["f1"] == 1.0 and report["fingering_accuracy"] == 1.0
 
 
 def _one_staff(pitches, extra=""):

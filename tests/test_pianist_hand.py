@@ -149,8 +149,12 @@ def test_a_file_s_own_five_finger_fingering_plays_as_written_on_the_pianist_s_ha
     report = json.loads(out.with_suffix(".report.json").read_text())
     assert report["f1"] == 1.0 and report["fingering_accuracy"] == 1.0
     assert [row["played_finger"] for row in report["notes"]] == written
-    result = run("play", song, "-o", tmp_path / "allegro.mid", "--controller", "scripted")
+    result = run("play", song, "-o", tmp_path / "allegro.mid", "--controller", "scripted", "--hand-model", "allegro")
     assert_one_line_error(result, "fingered 1 (thumb)", "--refinger", "--hand-model pianist")
+    # no hand model named: a fingering for five fingers is the pianist's hand's, played as written (it was refused)
+    result = run("play", song, "-o", out, "--controller", "scripted", "--notes", "0")
+    assert result.exit_code == 0, result.output
+    assert [row["played_finger"] for row in json.loads(out.with_suffix(".report.json").read_text())["notes"]] == written
 
 
 def test_a_fully_fingered_file_the_pianist_s_hand_cannot_play_as_written_keeps_every_mark_it_can(tmp_path):

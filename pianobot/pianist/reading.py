@@ -3,12 +3,11 @@
 Every command that reads a piece (``play``, ``score``, ``inspect``, ``finger``, ``train``) and
 :func:`pianobot.play`'s callers read it here, in steps, each a function:
 
-1. :func:`open_song`: the file read and parsed, once (a PIG .txt file is read as text where
-   needed); every later step derives what it needs from what was read;
+1. :func:`open_song`: the file read and parsed, once (a PIG .txt file as text where needed);
 2. :func:`choose_model`: where no hand model is named, the pianist's hands for a file they play
-   with both hands, else the Allegro-like hand; :func:`choose_fingers`: the hand model's finger set
-   both hands play with where none is named (:func:`keeps_more`: the Allegro-like hand's thumbs
-   where they keep notes three fingers leave out);
+   with both hands or fingered with fingers the Allegro-like hand lacks, else that hand;
+   :func:`choose_fingers`: the model's finger set both hands play with where none is named
+   (:func:`keeps_more`: the Allegro-like hand's thumbs where they keep notes three fingers leave out);
 3. :func:`read_both_hands`: whether the file plays both hands (:func:`two_hands`), and then every
    note with its hand (:class:`HandsReading`);
 4. otherwise one hand's part: :func:`choose_keys` (the keys it needs where none are named) and
@@ -135,21 +134,22 @@ def choose_model(
 ) -> tuple[str, HandsReading | None]:
     """The hand model a file is played with where none is named, and its both hands' reading: the
     Allegro-like hand (``HandSpec.model``) where its one hand plays the file, as its melody policy
-    plays one hand's melodies better; else the pianist's hands (:data:`PIANIST`), as the
-    validation sets favour them for two-hand music (docs/benchmarks.md, "The pianist's hand"):
-    both of them where they play the file with both hands (:func:`two_hands`: tracks named for
-    hands, or notes one of their hands cannot play; their reading then), else one (a chordal part
-    the Allegro-like hand would give to both hands). Where the pianist's reading refuses the file,
-    the Allegro-like hand's reads it, and says why where it refuses it too."""
+    plays one hand's melodies better; else the pianist's hands (:data:`PIANIST`), as the validation
+    sets favour them for two-hand music (docs/benchmarks.md, "The pianist's hand"): both where they
+    play it with both hands (:func:`two_hands`: tracks named for hands, or notes one of their hands
+    cannot play; their reading then), else one (a chordal part the Allegro-like hand would give to
+    both hands; a fingering with a finger it lacks, 1 or 5, played as written). Where the pianist's
+    reading refuses the file, the Allegro-like hand's reads it, and says why where it refuses it too."""
     keys = keyboard or KeyboardSpec()
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         try:
             hands = two_hands(source, options, default_fingers(PIANIST), keys)
+            written = {n.finger for n in load_piece(source, options).notes} - {None, *HandSpec().fingers}
         except PianobotError:
             return HandSpec.model, None
-    if hands is not None:
-        _warn_again(caught)
+    if hands is not None or written:
+        _warn_again(caught if hands is not None else [])  # (a one-hand reading says its own)
         return PIANIST, hands
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # (the chosen hand's reading says what it finds)
