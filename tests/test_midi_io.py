@@ -454,6 +454,10 @@ def test_drums_on_channel_10_are_left_out_in_one_line(tmp_path):
     ]
     drums = next(t for t in describe_tracks(path) if t.name == "Drums")
     assert drums.notes == 0 and drums.channels == ()  # (inspect lists the track with no piano notes)
+    # a file of nothing but drums says so (it said "has no notes" after the line that left them out)
+    only = midi_file(tmp_path / "kit.mid", [("Drums", kit)])
+    with pytest.raises(PianobotError, match="holds only drum notes .* no piano keys"):
+        read_midi(only)
 
 
 def test_of_two_tempos_at_one_tick_the_later_holds_for_the_timing_and_for_what_inspect_says(tmp_path):

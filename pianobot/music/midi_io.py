@@ -393,6 +393,11 @@ def read_midi(
                 warnings.warn(PianobotWarning(f"{pitch_name(pitch)} at {onset:.3f} s lasts under 1 ms; dropped"))
                 continue
             notes.append(Note(onset=onset, pitch=pitch, offset=offset, velocity=vel, finger=finger, hand=hand))
+    if drums and not notes:
+        raise PianobotError(
+            f"{path} holds only drum notes (MIDI channel 10, General MIDI's percussion), no piano keys: "
+            "give a file with piano notes"
+        )
     return Piece(tuple(resolve_overlaps(notes)), bpm=nominal)
 
 
