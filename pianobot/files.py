@@ -155,3 +155,22 @@ def read_input(path: str | os.PathLike, *, limit: int, kind: str, missing: str |
     if len(data) > limit:
         raise too_large
     return data
+
+
+_KINDS = (
+    (lambda head: head.startswith(b"MThd"), "a MIDI file", (".mid", ".midi")),
+    (lambda head: head.startswith(b"PK\x03\x04"), "a zip file, as a compressed MusicXML score is", (".mxl",)),
+    (lambda head: head.startswith(b"<") and b"<score-" in head, "a MusicXML score", (".musicxml", ".xml")),
+)
+"""What a file's first bytes say it is, and the names that kind of file has."""
+
+
+def misnamed(path: Path, data: bytes) -> str:
+    """Where ``data``, read from ``path``, is a kind of file pianobot reads that ``path``'s suffix
+    does not name, the one line that says so and how to name it; else ''."""
+    head = data[:4096].lstrip(b"\xef\xbb\xbf \t\r\n")
+    for test, kind, suffixes in _KINDS:
+        if test(head) and path.suffix.lower() not in suffixes:
+            named = f"its name's {path.suffix}" if path.suffix else "its name, without a suffix,"
+            return f"{path} holds {kind}, not what {named} says: name it {path.stem}{suffixes[0]}"
+    return ""

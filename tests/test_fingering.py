@@ -112,6 +112,20 @@ def test_too_fast_a_leap_is_reported_with_its_notes():
     assert not plan_fingering(melody("C4 B5 C4", beat=1.0)).problems
 
 
+def test_a_part_too_fast_throughout_says_its_first_places_and_how_many_more(tmp_path):
+    """32 repeats of one key at 8 a second: each too fast for the Allegro-like hand's finger, said as
+    the first three places and a count, not a line per note."""
+    plan = plan_fingering(melody(" ".join(["G4"] * 32), beat=0.125))
+    assert len(plan.problems) == 31
+    said = plan.said()
+    assert said[:3] == list(plan.problems[:3]) and len(said) == 4 and said[3].startswith("and 28 more place(s)")
+    song = write_midi(melody(" ".join(["G4"] * 32), beat=0.125), tmp_path / "repeats.mid")
+    out = CliRunner().invoke(app, ["play", str(song), "-o", str(tmp_path / "o.mid"), "--controller", "scripted", "-q"])
+    assert out.exit_code == 0, out.output
+    assert out.output.count("faster than this hand can") == 4 and "and 28 more place(s)" in out.output
+    assert "--tempo" in out.output and "load.tempo" not in out.output
+
+
 def test_the_planner_answers_what_the_hand_can_reach_and_how_fast():
     """The queries the reduction of a part (pianobot/pianist/reduce.py) asks."""
     planner = Planner()

@@ -127,6 +127,23 @@ def test_a_chordal_part_the_allegro_hand_would_give_to_both_hands_is_the_pianist
     assert read_piece(song, model="allegro").both  # (the Allegro-like hand needs both)
 
 
+def test_a_legato_line_the_allegro_hand_s_one_hand_refuses_is_the_pianist_s_one_hand(tmp_path):
+    """An arpeggio, each note held into the next (C4 E4 G4 C5 ...): the Allegro-like hand's three
+    fingers cannot hold one note and strike the next past it, so its one hand refuses the file (and
+    its planner gives every note to one hand); the pianist's one hand plays it, as written."""
+    pitches = (60, 64, 67, 72, 67, 64, 60)
+    song = midi_file(tmp_path / "legato.mid", [("Piano", _track(*[(p, i, i + 2) for i, p in enumerate(pitches)]))])
+    assert choose_model(open_song(song), make_reading().options) == ("pianist", None)
+    assert _played_by(tmp_path, song) == ("pianist", [1, 2, 3, 4, 5])
+    out = tmp_path / "out.mid"
+    assert json.loads(out.with_suffix(".report.json").read_text())["f1"] == 1.0
+    refused = run("play", song, "-o", tmp_path / "a.mid", "--controller", "scripted", "--hand-model", "allegro")
+    assert refused.exit_code == 2 and "no fingering lets this hand go from G4 to C5" in " ".join(refused.output.split())
+    # a line its one hand plays stays the Allegro-like hand's
+    melody = _melody(tmp_path / "melody.mid")
+    assert choose_model(open_song(melody), make_reading().options) == ("allegro", None)
+
+
 def test_a_general_policy_named_plays_the_hand_it_was_trained_for(tmp_path):
     duet = _duet(tmp_path / "duet.mid")
     out = tmp_path / "out.mid"

@@ -381,7 +381,8 @@ def test_the_finger_set_is_chosen_among_the_model_s_sets_in_its_order_of_prefere
     gives the most, the earlier on a tie); a hand model with one set plays it, nothing compared."""
     from pianobot.music.instrument import THUMB
     from pianobot.music.load import LoadOptions
-    from pianobot.pianist.reading import fingers_for_file, keeps_more
+    from pianobot.pianist.parts import keeps_more
+    from pianobot.pianist.reading import fingers_for_file
     from pianobot.sim.hand import default_fingers
 
     chord = [Note(0.0, p, 2.0, 80, hand="right") for p in (72, 76, 79, 84)]

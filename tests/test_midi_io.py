@@ -6,15 +6,9 @@ import pytest
 from conftest import lyric, midi_file, off, on
 
 from pianobot.errors import PianobotError, PianobotWarning
+from pianobot.music.finger_text import is_fingering, looks_like_fingering, parse_finger_text
 from pianobot.music.midi_file import open_midi
-from pianobot.music.midi_io import (
-    describe_tracks,
-    is_fingering,
-    parse_finger_text,
-    read_midi,
-    track_hand,
-    write_midi,
-)
+from pianobot.music.midi_io import describe_tracks, read_midi, track_hand, write_midi
 from pianobot.music.piece import Note, Piece
 
 
@@ -116,8 +110,26 @@ def test_finger_text_parsing():
     assert parse_finger_text("3") == [3]
     assert parse_finger_text(" 2, 4 ") == [2, 4]
     assert parse_finger_text("3_1 -") == [3, None]
+    # a substitution as a MusicXML score writes it: its first finger, the one that strikes
+    assert parse_finger_text("3-1") == [3] and parse_finger_text("1/2 4") == [1, 4]
     assert parse_finger_text("twin-kle") is None
     assert parse_finger_text("") is None
+    # fingering written otherwise, said; lyrics, verse numbers and figures are not
+    assert looks_like_fingering("(2)") and looks_like_fingering("1-3-5") and looks_like_fingering("[1] 3")
+    for lyric_text in ("twin-", "Ah", "1.", "12", "6", "3", "2 4", ""):
+        assert not looks_like_fingering(lyric_text), lyric_text
+
+
+def test_fingering_written_otherwise_is_said_once_and_a_substitution_read(tmp_path):
+    events = [(0, lyric("(2)")), (0, on(60)), (480, off(60)), (480, lyric("1-3-5")), (480, on(62)), (960, off(62))]
+    events += [(960, lyric("3-1")), (960, on(64)), (1440, off(64))]
+    path = midi_file(tmp_path / "f.mid", [("m", events)])
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        piece = read_midi(path)
+    assert [n.finger for n in piece] == [None, None, 3]
+    (said,) = [str(w.message) for w in caught if "written like fingering" in str(w.message)]
+    assert "2 text(s)" in said and "'(2)' at 0.000 s" in said
 
 
 def test_overlapping_notes_of_one_pitch_are_resolved_with_a_warning(tmp_path):

@@ -212,6 +212,29 @@ def test_a_bad_score_is_one_line_and_exit_2(tmp_path, name, content, words):
     assert_one_line_error(run("inspect", tmp_path / name), *words)
 
 
+def test_a_file_named_for_another_kind_says_what_it_holds_and_how_to_name_it(tmp_path):
+    """A MIDI file named .xml or .txt, a MusicXML score named .mid, .mxl or with no suffix: one line
+    that says what the file holds and the name to give it, which then reads."""
+    xml = piano_score(tmp_path).read_bytes()
+    midi = (Path(__file__).parent.parent / "examples" / "midi" / "one-note.mid").read_bytes()
+    cases = [
+        ("song.xml", midi, "holds a MIDI file", "name it song.mid"),
+        ("song.txt", midi, "holds a MIDI file", "name it song.mid"),
+        ("score.mid", xml, "holds a MusicXML score", "name it score.musicxml"),
+        ("score.mxl", xml, "holds a MusicXML score", "name it score.musicxml"),
+        ("score", xml, "holds a MusicXML score", "without a suffix", "name it score.musicxml"),
+    ]
+    for name, data, *words in cases:
+        (tmp_path / name).write_bytes(data)
+        assert_one_line_error(run("inspect", tmp_path / name), name, *words)
+        renamed = tmp_path / words[-1].removeprefix("name it ")
+        renamed.write_bytes(data)
+        assert run("inspect", renamed).exit_code == 0
+    # a file that is none of them keeps its own reason
+    (tmp_path / "notes.mid").write_bytes(b"just some words")
+    assert_one_line_error(run("inspect", tmp_path / "notes.mid"), "is not a MIDI file", "MThd")
+
+
 def test_a_zip_without_a_score_is_one_line(tmp_path):
     path = tmp_path / "photos.mxl"
     with zipfile.ZipFile(path, "w") as archive:

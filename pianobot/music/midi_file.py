@@ -14,7 +14,7 @@ import mido
 from mido.midifiles.meta import KeySignatureError, MetaSpec_key_signature, add_meta_spec
 
 from pianobot.errors import PianobotError, PianobotWarning
-from pianobot.files import read_input
+from pianobot.files import misnamed, read_input
 
 MAX_FILE_BYTES = 50_000_000
 """The largest .mid file read."""
@@ -58,7 +58,10 @@ def _track_chunks(data: bytes) -> tuple[int, bool]:
 def _load(path: Path) -> mido.MidiFile:
     data = read_input(path, limit=MAX_FILE_BYTES, kind=".mid file")
     if not data.startswith(b"MThd"):
-        raise PianobotError(f"{path} is not a MIDI file (it does not start with 'MThd'): give a standard .mid file")
+        raise PianobotError(
+            misnamed(path, data)
+            or f"{path} is not a MIDI file (it does not start with 'MThd'): give a standard .mid file"
+        )
     if len(data) < 14:
         raise PianobotError(
             f"{path} is not a readable MIDI file (its header is cut short): it may be truncated or corrupt; re-export it"

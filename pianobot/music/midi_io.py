@@ -1,12 +1,10 @@
 """Standard MIDI files in and out, with fingering carried in lyric or text meta events.
 
-Fingering convention (see docs/fingering.md): at the tick where notes start, a lyric (or text)
-meta event in the same track holds one finger number per note starting there, lowest pitch
-first, separated by spaces or commas: ``"3"`` for a melody note, ``"2 4"`` for a two-note chord.
-A substitution written ``3_1`` counts as its first finger (the one that strikes); ``-`` marks
-a note without a finger. Texts that are not finger lists (ordinary lyrics) are ignored, and so is
-every number in a track whose texts hold one that is no finger 1-5 (a continuo's figured bass:
-"6", "7"), said in one warning.
+Fingering (:mod:`pianobot.music.finger_text`, docs/fingering.md): at the tick where notes start,
+a lyric (or text) meta event in the same track holds one finger number per note starting there,
+lowest pitch first (``"3"``, ``"2 4"``). Texts that are not finger lists (ordinary lyrics) are
+ignored, those written like fingering otherwise (``"(2)"``) said in one warning, and so is every
+number in a track whose texts hold one that is no finger 1-5 (a continuo's figured bass: "6", "7").
 
 Hands: in a type 1 file, a track whose name says it holds a hand's part ('Right Hand', 'RH',
 'Treble', 'Left Hand', 'Bass'...; :func:`track_hand`) gives its notes that hand; other tracks'
@@ -30,6 +28,7 @@ from pathlib import Path
 import mido
 
 from pianobot.errors import PianobotError, PianobotWarning, SettingError, quote
+from pianobot.music.finger_text import finger_text, is_fingering, looks_like_fingering, parse_finger_text
 from pianobot.music.midi_file import (  # noqa: F401 (by their old address too)
     MAX_FILE_BYTES,
     MidiSource,
@@ -40,8 +39,6 @@ from pianobot.music.midi_file import (  # noqa: F401 (by their old address too)
 from pianobot.music.pedal import DOWN_AT, RING, Pedal
 from pianobot.music.piece import HANDS, MAX_SECONDS, Note, Piece, pitch_name, resolve_overlaps
 
-_FINGER_TOKEN = r"(?:[0-9](?:_[0-9])?|-)"
-_FINGER_TEXT = re.compile(rf"^\s*{_FINGER_TOKEN}(?:[\s,]+{_FINGER_TOKEN})*\s*$")
 HAND_NAMES = {
     "right": re.compile(r"\bright|\brh\b|\br\.h\.|\btreble|\bupper|\bmelod", re.IGNORECASE),
     "left": re.compile(r"\bleft|\blh\b|\bl\.h\.|\bbass(?!oon)|\blower|\baccomp", re.IGNORECASE),
@@ -74,24 +71,6 @@ class TrackInfo:
     low: int | None = None
     """Lowest and highest pitch played."""
     high: int | None = None
-
-
-def parse_finger_text(text: str) -> list[int | None] | None:
-    """Finger numbers in a lyric/text event, or None when the text is not a list of numbers. A
-    number may be no finger 1-5 (a figured bass's "6"): :func:`is_fingering` tells."""
-    if not _FINGER_TEXT.match(text):
-        return None
-    return [None if token == "-" else int(token.split("_")[0]) for token in re.split(r"[\s,]+", text.strip())]
-
-
-def is_fingering(fingers: list[int | None]) -> bool:
-    """Whether every number of a :func:`parse_finger_text` list is a finger, 1 (thumb) to 5 (little)."""
-    return all(f is None or 1 <= f <= 5 for f in fingers)
-
-
-def finger_text(fingers: list[int | None]) -> str:
-    """The inverse of :func:`parse_finger_text`."""
-    return " ".join("-" if f is None else str(f) for f in fingers)
 
 
 def _absolute(track: mido.MidiTrack) -> list[tuple[int, mido.Message]]:
@@ -256,6 +235,7 @@ def _track_notes(
     notes: list[tuple[int, int, int, int]] = []
     fingering: dict[int, list[int | None]] = defaultdict(list)
     figures: list[str] = []  # texts with numbers that are no fingers
+    unread: list[tuple[int, str]] = []  # texts written like fingering that are none
     empty: list[tuple[int, int]] = []  # (tick, pitch) of notes of no length
     ended: dict[tuple[int, int], int] = {}  # (channel, pitch): the tick its last note ended
     tick = 0
@@ -267,6 +247,8 @@ def _track_notes(
                 fingering[tick].extend(fingers)
             elif fingers is not None:
                 figures.append(msg.text)
+            elif looks_like_fingering(msg.text):
+                unread.append((tick, msg.text))
         elif msg.type in ("note_on", "note_off") and msg.channel == PERCUSSION:
             continue  # (drums: read_midi says how many it left out)
         elif msg.type == "note_on" and msg.velocity > 0:
@@ -289,6 +271,14 @@ def _track_notes(
                 f"track {index}: left out {len(empty)} note(s) of no length, their note-on and note-off at one tick "
                 f"(the first: {pitch_name(pitch)} at {seconds(tick):.3f} s; grace notes or chord symbols, as some "
                 "programs write them)"
+            )
+        )
+    if unread:
+        tick, text = unread[0]
+        warnings.warn(
+            PianobotWarning(
+                f"track {index}: {len(unread)} text(s) written like fingering are not read as fingers (the first: "
+                f"'{quote(text)}' at {seconds(tick):.3f} s): write one finger per note, lowest first ('2', '1 3 5')"
             )
         )
     if figures and fingering:

@@ -9,7 +9,8 @@ from pathlib import Path
 import mido
 
 from pianobot.files import atomic_write
-from pianobot.music.midi_io import SUSTAIN, TRACK_NAMES, UNASSIGNED_TRACK, finger_text
+from pianobot.music.finger_text import finger_text
+from pianobot.music.midi_io import SUSTAIN, TRACK_NAMES, UNASSIGNED_TRACK
 from pianobot.music.pedal import Pedal
 from pianobot.music.piece import Piece
 

@@ -33,8 +33,9 @@ from pathlib import Path
 import mido
 
 from pianobot.errors import PianobotError, PianobotWarning, quote
+from pianobot.music.finger_text import finger_text
 from pianobot.music.midi_file import MidiSource
-from pianobot.music.midi_io import TRACK_NAMES, finger_text
+from pianobot.music.midi_io import TRACK_NAMES
 from pianobot.music.musicxml_tree import Score, read_tree
 
 SUFFIXES = (".musicxml", ".xml", ".mxl")

@@ -18,7 +18,7 @@ from fractions import Fraction
 from pathlib import Path
 
 from pianobot.errors import PianobotError, quote
-from pianobot.files import read_input
+from pianobot.files import misnamed, read_input
 
 MAX_FILE_BYTES = 50_000_000
 """The largest score read, as a file and unpacked from an .mxl."""
@@ -94,7 +94,7 @@ def _xml_bytes(path: Path) -> bytes:
     except (zipfile.BadZipFile, zipfile.LargeZipFile, NotImplementedError, RuntimeError, EOFError, OSError) as e:
         what = "not a compressed MusicXML file (no zip archive)" if not data.startswith(b"PK") else "a damaged .mxl"
         reason = quote(str(e) or type(e).__name__, 40)
-        raise PianobotError(f"{path} is {what} ({reason}): give a {KIND}") from None
+        raise PianobotError(misnamed(path, data) or f"{path} is {what} ({reason}): give a {KIND}") from None
     if len(xml) > MAX_FILE_BYTES:
         raise PianobotError(f"{path} unpacks to more than {MAX_FILE_BYTES / 1e6:g} MB: that is not a piano piece")
     return xml
@@ -120,7 +120,8 @@ def _parse(data: bytes, path: Path) -> ET.Element:
     try:
         return ET.fromstring(data)
     except ET.ParseError as e:
-        raise PianobotError(f"{path} is not well-formed XML ({quote(str(e), 50)}): give a {KIND}") from None
+        said = misnamed(path, data) if path.suffix.lower() != ".mxl" else ""  # (not the score packed inside)
+        raise PianobotError(said or f"{path} is not well-formed XML ({quote(str(e), 50)}): give a {KIND}") from None
 
 
 JUMPS = ("dacapo", "dalsegno", "tocoda")

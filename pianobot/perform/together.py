@@ -48,7 +48,7 @@ from pianobot.perform.judge import play_one_hand
 from pianobot.perform.plan import Performance
 from pianobot.perform.rollout import Rollout
 from pianobot.pianist.assign import finger_apart
-from pianobot.pianist.parts import prepare_part
+from pianobot.pianist.parts import prepare_part, thumbs_keep_more
 from pianobot.pianist.reading import (  # noqa: F401 (the reading, pianist/reading.py's: these names kept here too)
     THUMBS_CHOSEN,
     HandsReading,
@@ -57,7 +57,6 @@ from pianobot.pianist.reading import (  # noqa: F401 (the reading, pianist/readi
     names_hands,
     one_hand_refusal,
     read_hands,
-    thumbs_keep_more,
     two_hands,
 )
 from pianobot.sim.hand import hand_model

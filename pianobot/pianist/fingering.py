@@ -91,6 +91,10 @@ _SLOW_MARK = MARK_COST / 4
 fingered anew are still fingered in time where they can be."""
 
 
+SAID_PROBLEMS = 3
+"""How many of a plan's places too fast for the hand are said one by one (then how many more)."""
+
+
 @dataclass(frozen=True)
 class FingeringPlan:
     """The planner's result: the fingered piece, the wrist's path and what could not be met."""
@@ -104,6 +108,16 @@ class FingeringPlan:
     """Number of wrist moves."""
     problems: tuple[str, ...] = field(default=())
     """Notes this hand cannot play as written at this tempo, and why."""
+
+    def said(self, most: int = SAID_PROBLEMS) -> list[str]:
+        """:attr:`problems` as lines to say: the first ``most``, then how many more there are."""
+        if len(self.problems) <= most:
+            return list(self.problems)
+        rest = len(self.problems) - most
+        return [
+            *self.problems[:most],
+            f"and {rest} more place(s) faster than this hand can (slow down with load.tempo)",
+        ]
 
 
 @dataclass(frozen=True, eq=False)

@@ -1,6 +1,7 @@
 """Each hand's part of a two-hand piece as its simulated hand is given it: moved onto the keys its
 player knows, thinned and reduced to what the hand can play, and fingered (:func:`prepare_part`);
-how many notes that leaves (:func:`given_notes`, by which the reading chooses fingers)."""
+how many notes that leaves (:func:`given_notes`), and so which finger set leaves most (:func:`keeps_more`,
+by which the reading chooses fingers)."""
 
 from __future__ import annotations
 
@@ -8,7 +9,7 @@ import warnings
 from dataclasses import replace
 
 from pianobot.errors import PianobotError, PianobotWarning
-from pianobot.music.instrument import HandSpec, KeyboardSpec
+from pianobot.music.instrument import THUMB, HandSpec, KeyboardSpec
 from pianobot.music.load import thin_hand
 from pianobot.music.piece import Piece
 from pianobot.music.window import Window, window_for
@@ -82,3 +83,31 @@ def given_notes(piece: Piece, fingers: HandSpec, keyboard: KeyboardSpec | None =
             )
         except PianobotError:
             return None
+
+
+def keeps_more(
+    readings: list[tuple[HandSpec, Piece]], keyboard: KeyboardSpec | None = None
+) -> tuple[int, tuple[int, int] | None]:
+    """Which of ``readings`` (a hand model's finger sets, each with the piece as read for it, in its order of
+    preference) both hands play with where none are named: the first, unless a later one gives more notes
+    (:func:`given_notes`), then the one giving most: (its index, (notes given with the first, with it)), else (0, None)."""
+    (_, first), *others = readings
+    given = given_notes(first, readings[0][0], keyboard)
+    if given is None:
+        return 0, None
+    best, most = 0, given
+    for index, (fingers, piece) in enumerate(others, start=1):
+        if most >= len(piece):  # (a later set's reading may keep notes of a chord the first thins)
+            continue
+        more = given_notes(piece, fingers, keyboard)
+        if more is not None and more > most:
+            best, most = index, more
+    return (best, (given, most)) if best else (0, None)
+
+
+def thumbs_keep_more(
+    three: Piece, thumbs: Piece | None = None, keyboard: KeyboardSpec | None = None
+) -> tuple[int, int] | None:
+    """(notes both hands are given with three fingers, with thumbs) where the thumbs keep more, else None:
+    :func:`keeps_more` of the Allegro-like hand's sets, ``three``/``thumbs`` (default: the same) as read for each."""
+    return keeps_more([(HandSpec(), three), (THUMB, three if thumbs is None else thumbs)], keyboard)[1]

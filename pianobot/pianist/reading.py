@@ -7,7 +7,7 @@ Every command that reads a piece (``play``, ``score``, ``inspect``, ``finger``, 
 2. :func:`choose_model`: where no hand model is named, the pianist's hands for a file they play
    with both hands or fingered with fingers the Allegro-like hand lacks, else that hand;
    :func:`choose_fingers`: the model's finger set both hands play with where none is named
-   (:func:`keeps_more`: the Allegro-like hand's thumbs where they keep notes three fingers leave out);
+   (:func:`~pianobot.pianist.parts.keeps_more`: the Allegro-like hand's thumbs where they keep notes three fingers leave out);
 3. :func:`read_both_hands`: whether the file plays both hands (:func:`two_hands`), and then every
    note with its hand (:class:`HandsReading`);
 4. otherwise one hand's part: :func:`choose_keys` (the keys it needs where none are named) and
@@ -31,14 +31,14 @@ from pathlib import Path
 
 from pianobot.errors import PianobotError, PianobotWarning
 from pianobot.music import midi_io
-from pianobot.music.instrument import THUMB, HandSpec, KeyboardSpec, check_playable, keys_for, suggest_transpose
+from pianobot.music.instrument import HandSpec, KeyboardSpec, check_playable, keys_for, suggest_transpose
 from pianobot.music.load import LoadOptions, end_legato, load_hands, load_part, load_pedal, load_piece
 from pianobot.music.midi_io import MidiSource, TrackInfo, source_path
 from pianobot.music.pedal import Pedal
 from pianobot.music.piece import HANDS, Piece, pitch_name
 from pianobot.pianist.assign import load_two_hands
 from pianobot.pianist.fingering import FingeringPlan, ensure_fingering
-from pianobot.pianist.parts import given_notes
+from pianobot.pianist.parts import keeps_more
 from pianobot.pianist.reduce import load_for_hand
 from pianobot.sim.hand import default_fingers, hand_model
 
@@ -154,10 +154,21 @@ def choose_model(
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # (the chosen hand's reading says what it finds)
         try:
-            allegro_both = two_hands(source, options, HandSpec(), keys) is not None
+            pianist = two_hands(source, options, HandSpec(), keys) is not None or _only_pianist(source, options, keys)
         except PianobotError:
-            allegro_both = True  # (refused for it, and the pianist's one hand plays it)
-    return (PIANIST if allegro_both else HandSpec.model), None
+            pianist = True  # (refused for it, and the pianist's one hand plays it)
+    return (PIANIST if pianist else HandSpec.model), None
+
+
+def _only_pianist(source: Source, options: LoadOptions, keys: KeyboardSpec) -> bool:
+    """Whether the pianist's one hand plays an unfingered one-hand file that the Allegro-like hand's
+    one hand refuses (its notes held into the next ones, say, past its three fingers)."""
+    piece = end_legato(load_piece(source, options))
+    if options.hand is not None or any(n.finger is not None for n in piece.notes):
+        return False
+    if not one_hand_refusal(piece, HandSpec(), keys, options.refinger):
+        return False
+    return not one_hand_refusal(piece, default_fingers(PIANIST), keys, options.refinger)
 
 
 def read_both_hands(
@@ -226,7 +237,7 @@ def finger_part(
                 f"wrist travel {plan.travel * 100:.1f} cm in {plan.moves} moves{'' if kept else '; ' + wording.written}"
             )
         )
-        for problem in plan.problems:
+        for problem in plan.said():
             warnings.warn(PianobotWarning(problem))
     check_playable(piece, keyboard, fingers)
     return piece, plan
@@ -443,34 +454,6 @@ def _warn_again(caught: list) -> None:
         warnings.warn(warning.message)
 
 
-def keeps_more(
-    readings: list[tuple[HandSpec, Piece]], keyboard: KeyboardSpec | None = None
-) -> tuple[int, tuple[int, int] | None]:
-    """Which of ``readings`` (a hand model's finger sets, each with the piece as read for it, in its order of
-    preference) both hands play with where none are named: the first, unless a later one gives more notes
-    (:func:`given_notes`), then the one giving most: (its index, (notes given with the first, with it)), else (0, None)."""
-    (_, first), *others = readings
-    given = given_notes(first, readings[0][0], keyboard)
-    if given is None:
-        return 0, None
-    best, most = 0, given
-    for index, (fingers, piece) in enumerate(others, start=1):
-        if most >= len(piece):  # (a later set's reading may keep notes of a chord the first thins)
-            continue
-        more = given_notes(piece, fingers, keyboard)
-        if more is not None and more > most:
-            best, most = index, more
-    return (best, (given, most)) if best else (0, None)
-
-
-def thumbs_keep_more(
-    three: Piece, thumbs: Piece | None = None, keyboard: KeyboardSpec | None = None
-) -> tuple[int, int] | None:
-    """(notes both hands are given with three fingers, with thumbs) where the thumbs keep more, else None:
-    :func:`keeps_more` of the Allegro-like hand's sets, ``three``/``thumbs`` (default: the same) as read for each."""
-    return keeps_more([(HandSpec(), three), (THUMB, three if thumbs is None else thumbs)], keyboard)[1]
-
-
 def fingers_for_file(
     path: str | Path | MidiSource, options: LoadOptions, model: str = HandSpec.model
 ) -> tuple[HandSpec, tuple[int, int] | None]:
@@ -497,4 +480,4 @@ def fingers_for_file(
 
 
 THUMBS_CHOSEN = "both hands play with their thumbs too: they are given {more} of the notes, three fingers {given}"
-"""The line said where :func:`thumbs_keep_more` gives both hands their thumbs (with how to choose three)."""
+"""The line said where :func:`~pianobot.pianist.parts.thumbs_keep_more` gives both hands their thumbs (with how to choose three)."""

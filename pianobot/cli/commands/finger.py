@@ -65,7 +65,7 @@ def finger(
                 else "as the file had it"
             )
             out.print(f"{hand} hand, fingers {hand_spec.describe()}: {travel} over {count} notes", soft_wrap=True)
-            for problem in plan.problems if plan else ():
+            for problem in plan.said() if plan else ():
                 out.print(f"[yellow]cannot be played at this tempo:[/yellow] {said(phrase(problem))}")
         kept = len(fingered.piece)
         less = (
@@ -86,7 +86,7 @@ def finger(
         f"fingering for fingers {hand_spec.describe()} written to {said(output)}: wrist travel {plan.travel * 100:.1f} cm "
         f"in {plan.moves} move{'s' * (plan.moves != 1)} over {len(piece)} notes"
     )
-    for problem in plan.problems:
+    for problem in plan.said():
         out.print(f"[yellow]cannot be played at this tempo:[/yellow] {said(phrase(problem))}")
     if had:
         out.print(

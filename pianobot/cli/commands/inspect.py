@@ -97,7 +97,7 @@ def inspect(
         console.print(
             f"fingering planned for fingers {hand_spec.describe()}: wrist travel {plan.travel * 100:.1f} cm in {plan.moves} move{'s' * (plan.moves != 1)}"
         )
-        for problem in plan.problems:
+        for problem in plan.said():
             console.print(f"[yellow]{said(phrase(problem))}[/yellow]")
     phrases = trained_split(models, piece, phrase_notes)
     rows = None if all_rows else display.ROWS
