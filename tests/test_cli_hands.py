@@ -255,6 +255,13 @@ def test_notes_beyond_the_pianos_keys_are_one_line_named_or_not(tmp_path):
     for song in (named, unnamed):
         result = run("play", song, "-o", tmp_path / "out.mid", "--controller", "scripted")
         assert_one_line_error(result, "beyond the piano's 88 keys", "--transpose -12")
+    # inspect says the same, whatever keyboard is named: no keyboard widens past the piano
+    lowest_and_highest = _one_track(tmp_path / "ends.mid", (0, 0, 1), (127, 1, 2))
+    for keys in ((), ("--lowest-note", "A0", "--keys", "88")):
+        line = assert_one_line_error(
+            run("inspect", lowest_and_highest, *keys), "beyond the piano's 88 keys", "cut notes"
+        )
+        assert "widen the keyboard" not in line
 
 
 def test_more_notes_at_once_than_two_hands_have_fingers_are_thinned_in_one_line(tmp_path):
@@ -654,3 +661,45 @@ def test_score_reads_the_hands_with_the_fingers_play_chose_whatever_keys_play_na
     assert figures["f1"] == report["f1"]
     for hand in ("right", "left"):
         assert figures["hands"][hand]["f1"] == report["hands"][hand]["f1"], hand
+
+
+def test_a_file_fingered_for_one_hand_that_no_hand_spans_is_both_hands_fingered_anew(tmp_path):
+    """An octave chord marked 1 2 3 5 for one hand, as a score marks it for a human hand: the
+    pianist's hand spans a sixth, so no fingering of one hand plays it. It was played as written by
+    one hand (the little finger striking beside C5, nothing said); both hands now play it, their
+    fingering planned anew (the file's is one hand's), said in one line."""
+    events = [
+        (0, lyric("1 3 5")),
+        (0, on(60)),
+        (0, on(64)),
+        (0, on(67)),
+        (480, off(60)),
+        (480, off(64)),
+        (480, off(67)),
+    ]
+    events += [
+        (480, lyric("1 2 3 5")),
+        *((480, on(p)) for p in (60, 64, 67, 72)),
+        *((960, off(p)) for p in (60, 64, 67, 72)),
+    ]
+    song = midi_file(tmp_path / "octave.mid", [("Piano", events)])
+    result = run("play", song, "-o", tmp_path / "out.mid", "--controller", "scripted")
+    assert result.exit_code == 0, result.output
+    said = " ".join(result.stderr.split())
+    assert "one hand cannot play it (the chord C4 E4 G4 C5 at 0.500 s spans" in said, said
+    assert "given to both hands and fingered anew (its fingering is one hand's)" in said, said
+    report = json.loads((tmp_path / "out.report.json").read_text())
+    assert set(report["hands"]) == {"right", "left"} and report["f1"] == 1.0
+    # a chord one hand spans keeps its marks and its one hand
+    inside = [
+        (0, lyric("1 3 5")),
+        (0, on(60)),
+        (0, on(64)),
+        (0, on(67)),
+        (480, off(60)),
+        (480, off(64)),
+        (480, off(67)),
+    ]
+    one = run("inspect", midi_file(tmp_path / "fifth.mid", [("Piano", inside)]))
+    assert one.exit_code == 0 and "`pianobot play` plays both" not in " ".join(one.stdout.split())
+    assert "3/3 notes fingered in the file" in " ".join(one.stdout.split())

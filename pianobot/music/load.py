@@ -8,7 +8,7 @@ from pathlib import Path
 
 from pianobot.errors import PianobotError, PianobotWarning, SettingError, quote
 from pianobot.music import midi_io, pig
-from pianobot.music.instrument import PIANO, HandSpec
+from pianobot.music.instrument import HandSpec, beyond_piano
 from pianobot.music.pedal import Pedal
 from pianobot.music.piece import HANDS, Note, Piece, pitch_name
 
@@ -282,17 +282,8 @@ def load_hands(path: str | Path | midi_io.MidiSource, options: LoadOptions = Loa
 
 def _check_keys(piece: Piece, path: Path) -> None:
     """Refuse notes beyond the piano's 88 keys, suggesting the octave shift that fits them, if any."""
-    outside = [n for n in piece.notes if n.pitch not in PIANO]
-    if not outside:
-        return
-    names = ", ".join(n.describe() for n in outside[:3]) + (" ..." if len(outside) > 3 else "")
-    low, high = min(n.pitch for n in piece.notes), max(n.pitch for n in piece.notes)
-    shifts = [s for s in range(-120, 121, 12) if PIANO.lowest <= low + s and high + s <= PIANO.highest]
-    fix = f"use load.transpose {min(shifts, key=abs)}" if shifts else "the piece spans more than the piano: cut notes"
-    raise SettingError(
-        f"{path.name} has {len(outside)} note(s) beyond the piano's 88 keys {PIANO.describe()}: {names}; {fix}",
-        "load.transpose",
-    )
+    if said := beyond_piano(piece):
+        raise SettingError(f"{path.name} has {said}", "load.transpose")
 
 
 def _crossing(piece: Piece) -> str:

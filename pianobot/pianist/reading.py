@@ -396,16 +396,17 @@ def two_hands(
             return None  # (one track: one hand's part, as before two hands)
     if path.suffix.lower() == ".txt" and (options.tempo or options.fingering or options.quantize):
         return None  # (one hand's reading refuses them in its own words)
-    one_hand_refuses = ""
+    one_hand_refuses, fingered = "", False
     if not names_hands(source, options.track):
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # said when the piece is read
             piece = end_legato(load_piece(source, options))  # (as one hand's reading reads it)
         pitches = [n.pitch for n in piece.notes]
         if max(pitches) - min(pitches) < keyboard.count:
-            if any(n.finger is not None for n in piece.notes):
-                return None  # (a fingered file is one hand's: its fingers say so)
-            one_hand_refuses = one_hand_refusal(piece, spec, keyboard, options.refinger)
+            fingered = any(
+                n.finger is not None for n in piece.notes
+            )  # (one hand's, as its fingers say, where it plays)
+            one_hand_refuses = one_hand_refusal(piece.without_fingering(), spec, keyboard, options.refinger)
             if not one_hand_refuses:
                 return None
     try:
@@ -421,12 +422,13 @@ def two_hands(
         return None
     _warn_again(caught)
     if one_hand_refuses:
+        anew = " and fingered anew (its fingering is one hand's)" if fingered else ""
         warnings.warn(
             PianobotWarning(
-                f"{path.name}: one hand cannot play it ({one_hand_refuses}): its notes are given to both hands"
+                f"{path.name}: one hand cannot play it ({one_hand_refuses}): its notes are given to both hands{anew}"
             )
         )
-    return hands
+    return replace(hands, piece=hands.piece.without_fingering()) if fingered and one_hand_refuses else hands
 
 
 def one_hand_refusal(piece: Piece, spec: HandSpec, keyboard: KeyboardSpec, refinger: bool = False) -> str:
