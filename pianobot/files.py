@@ -158,19 +158,30 @@ def read_input(path: str | os.PathLike, *, limit: int, kind: str, missing: str |
 
 
 _KINDS = (
-    (lambda head: head.startswith(b"MThd"), "a MIDI file", (".mid", ".midi")),
-    (lambda head: head.startswith(b"PK\x03\x04"), "a zip file, as a compressed MusicXML score is", (".mxl",)),
-    (lambda head: head.startswith(b"<") and b"<score-" in head, "a MusicXML score", (".musicxml", ".xml")),
+    (lambda data: data.startswith(b"MThd"), "a MIDI file", (".mid", ".midi")),
+    (lambda data: data.startswith(b"PK\x03\x04"), "a zip file, as a compressed MusicXML score is", (".mxl",)),
+    (lambda data: data.startswith(b"<") and b"<score-" in data[:65536], "a MusicXML score", (".musicxml", ".xml")),
 )
-"""What a file's first bytes say it is, and the names that kind of file has."""
+"""What a file's first bytes say it is (after a byte order mark), and the names that kind of file has."""
+
+
+def content_kind(data: bytes) -> tuple[str, tuple[str, ...]] | None:
+    """What kind of file pianobot reads ``data`` is, by its first bytes, and that kind's suffixes; None for none."""
+    data = data.removeprefix(b"\xef\xbb\xbf")
+    return next(((kind, suffixes) for test, kind, suffixes in _KINDS if test(data)), None)
+
+
+def renamed(path: Path, suffixes: tuple[str, ...]) -> str:
+    """``path``'s name with the first of ``suffixes`` ('song.mid.xml' -> 'song.mid', 'song.xml' -> 'song.mid')."""
+    stem = Path(path.stem)
+    return stem.name if stem.suffix.lower() in suffixes else f"{stem.name}{suffixes[0]}"
 
 
 def misnamed(path: Path, data: bytes) -> str:
     """Where ``data``, read from ``path``, is a kind of file pianobot reads that ``path``'s suffix
     does not name, the one line that says so and how to name it; else ''."""
-    head = data[:4096].lstrip(b"\xef\xbb\xbf \t\r\n")
-    for test, kind, suffixes in _KINDS:
-        if test(head) and path.suffix.lower() not in suffixes:
-            named = f"its name's {path.suffix}" if path.suffix else "its name, without a suffix,"
-            return f"{path} holds {kind}, not what {named} says: name it {path.stem}{suffixes[0]}"
-    return ""
+    found = content_kind(data)
+    if found is None or path.suffix.lower() in found[1]:
+        return ""
+    named = f"its name's {path.suffix}" if path.suffix else "its name, without a suffix,"
+    return f"{path} holds {found[0]}, not what {named} says: name it {renamed(path, found[1])}"

@@ -255,6 +255,9 @@ def test_notes_beyond_the_pianos_keys_are_one_line_named_or_not(tmp_path):
     for song in (named, unnamed):
         result = run("play", song, "-o", tmp_path / "out.mid", "--controller", "scripted")
         assert_one_line_error(result, "beyond the piano's 88 keys", "--transpose -12")
+    # the octaves it suggests count a transposition already given in
+    low = _one_track(tmp_path / "low.mid", (21, 0, 1), (33, 1, 2))
+    assert_one_line_error(run("inspect", low, "--transpose", "-12"), "beyond the piano's 88 keys", "--transpose 0")
     # inspect says the same, whatever keyboard is named: no keyboard widens past the piano
     lowest_and_highest = _one_track(tmp_path / "ends.mid", (0, 0, 1), (127, 1, 2))
     for keys in ((), ("--lowest-note", "A0", "--keys", "88")):
@@ -690,6 +693,20 @@ def test_a_file_fingered_for_one_hand_that_no_hand_spans_is_both_hands_fingered_
     assert "given to both hands and fingered anew (its fingering is one hand's)" in said, said
     report = json.loads((tmp_path / "out.report.json").read_text())
     assert set(report["hands"]) == {"right", "left"} and report["f1"] == 1.0
+    # a fingering with a finger twice in one chord is both hands': kept where they play it
+    both = [(0, lyric("5 3 1 1 3 5")), *((0, on(p)) for p in (60, 64, 67, 69, 72, 76))]
+    both += [(480, off(p)) for p in (60, 64, 67, 69, 72, 76)]
+    result = run(
+        "play",
+        midi_file(tmp_path / "two.mid", [("Piano", both)]),
+        "-o",
+        tmp_path / "two_out.mid",
+        "--controller",
+        "scripted",
+    )
+    assert result.exit_code == 0 and "fingered anew" not in result.stderr, result.output
+    notes = json.loads((tmp_path / "two_out.report.json").read_text())["notes"]
+    assert {n["pitch"]: n["played_finger"] for n in notes} == {"C4": 5, "E4": 3, "G4": 1, "A4": 1, "C5": 3, "E5": 5}
     # a chord one hand spans keeps its marks and its one hand
     inside = [
         (0, lyric("1 3 5")),

@@ -109,7 +109,7 @@ def test_warnings_come_before_the_error_that_stopped_the_command(tmp_path):
     result = run("inspect", tmp_path / "low.mid")
     assert result.exit_code == 2
     lines = result.stderr.strip().splitlines()
-    assert lines[-1].startswith("error: ") and "outside the keyboard" in lines[-1], lines
+    assert lines[-1].startswith("error: ") and "beyond the piano's 88 keys" in lines[-1], lines
     assert lines[:-1] and all(line.startswith("warning: ") for line in lines[:-1]), lines
 
 

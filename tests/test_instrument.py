@@ -1,6 +1,6 @@
 import pytest
 
-from pianobot.errors import PianobotError
+from pianobot.errors import PianobotError, SettingError
 from pianobot.music.instrument import HandSpec, KeyboardSpec, check_playable, suggest_transpose
 from pianobot.music.piece import Note, Piece
 
@@ -87,3 +87,13 @@ def test_a_one_hand_piece_off_the_default_keys_gets_its_own_octaves_of_at_least_
     assert keys_for(piece(103, 108)) == KeyboardSpec(85, 24)  # at the top: 24 keys ending at C8
     assert keys_for(piece(12, 60)) == KeyboardSpec()  # a note beyond the piano: left for the reading to refuse
     assert keys_for(piece(48), KeyboardSpec(60, 36)) == KeyboardSpec(48, 36)  # as many keys as the default asked
+
+
+def test_a_keyboard_past_the_piano_s_end_holds_its_notes_and_a_piano_s_refuses_them_as_the_piano_s():
+    """A drill's keyboard may lie past C8 (KeyboardSpec allows it): its notes play there; notes off
+    a piano keyboard that lie past the piano too are said as the piano's, not 'widen the keyboard'."""
+    high = Piece((Note(0.0, 110, 1.0, 80, 2),))
+    check_playable(high, KeyboardSpec(100, 24), HandSpec())
+    with pytest.raises(SettingError, match=r"beyond the piano's 88 keys") as refused:
+        check_playable(high, KeyboardSpec(), HandSpec())
+    assert "widen the keyboard" not in str(refused.value)

@@ -110,26 +110,29 @@ def test_finger_text_parsing():
     assert parse_finger_text("3") == [3]
     assert parse_finger_text(" 2, 4 ") == [2, 4]
     assert parse_finger_text("3_1 -") == [3, None]
-    # a substitution as a MusicXML score writes it: its first finger, the one that strikes
-    assert parse_finger_text("3-1") == [3] and parse_finger_text("1/2 4") == [1, 4]
     assert parse_finger_text("twin-kle") is None
     assert parse_finger_text("") is None
-    # fingering written otherwise, said; lyrics, verse numbers and figures are not
-    assert looks_like_fingering("(2)") and looks_like_fingering("1-3-5") and looks_like_fingering("[1] 3")
-    for lyric_text in ("twin-", "Ah", "1.", "12", "6", "3", "2 4", ""):
+    # a dash or a slash is no substitution here: "2-4" may be a chord's, "6/8" a meter
+    for text in ("3-1", "2-4", "1/2", "6/8"):
+        assert parse_finger_text(text) is None, text
+    # fingering written otherwise, said; lyrics, verse numbers, meters and figures are not
+    assert looks_like_fingering("(2)") and looks_like_fingering("1-3-5") and looks_like_fingering("3–1")
+    for lyric_text in ("twin-", "Ah", "1.", "12", "6", "3", "2 4", "", "3/4", "6/8", "C7"):
         assert not looks_like_fingering(lyric_text), lyric_text
 
 
-def test_fingering_written_otherwise_is_said_once_and_a_substitution_read(tmp_path):
+def test_fingering_written_otherwise_is_said_once_in_a_fingered_track(tmp_path):
     events = [(0, lyric("(2)")), (0, on(60)), (480, off(60)), (480, lyric("1-3-5")), (480, on(62)), (960, off(62))]
-    events += [(960, lyric("3-1")), (960, on(64)), (1440, off(64))]
-    path = midi_file(tmp_path / "f.mid", [("m", events)])
+    events += [(960, lyric("3")), (960, on(64)), (1440, off(64))]
+    verses = [(0, lyric("(2)")), (0, on(48)), (480, off(48)), (480, lyric("1-3")), (480, on(50)), (960, off(50))]
+    path = midi_file(tmp_path / "f.mid", [("m", events), ("words", verses)])
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         piece = read_midi(path)
-    assert [n.finger for n in piece] == [None, None, 3]
-    (said,) = [str(w.message) for w in caught if "written like fingering" in str(w.message)]
-    assert "2 text(s)" in said and "'(2)' at 0.000 s" in said
+    assert [n.finger for n in piece if n.pitch >= 60] == [None, None, 3]
+    said = [str(w.message) for w in caught if "written like fingering" in str(w.message)]
+    assert len(said) == 1 and "2 text(s)" in said[0] and "'(2)' at 0.000 s" in said[0], said  # (not the lyric track's)
+    assert "'3_1'" in said[0]
 
 
 def test_overlapping_notes_of_one_pitch_are_resolved_with_a_warning(tmp_path):

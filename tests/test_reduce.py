@@ -133,9 +133,10 @@ def test_warnings_say_each_change_once_with_its_count(tmp_path):
     assert sum("held note(s) now end earlier" in s for s in said) == 1 and any("1 held note(s)" in s for s in said)
 
 
-def test_without_hand_the_planner_still_refuses_what_the_hand_cannot_play(tmp_path):
-    """A fingered file is one hand's: the planner refuses what that hand cannot play (unfingered,
-    the same notes are given to both hands)."""
+def test_without_hand_a_fingered_file_one_hand_cannot_play_is_both_hands_and_with_it_reduced(tmp_path):
+    """A file fingered for one hand that no fingering of one hand plays (a chord wider than it spans, a
+    note held under a leap) was refused; both hands now play it, fingered anew, said in one line.
+    With --hand, that hand's part is reduced to what it can play, as before."""
     runner = CliRunner()
 
     def fingered(p: Piece, *fingers: int) -> Piece:
@@ -143,13 +144,12 @@ def test_without_hand_the_planner_still_refuses_what_the_hand_cannot_play(tmp_pa
 
     wide = write_midi(fingered(piece((0, "C4", 0.5), (0, "C5", 0.5), (0.5, "D5", 1)), 2, 4, 4), tmp_path / "wide.mid")
     held = write_midi(fingered(piece((0, "E4", 2), (0, "C5", 0.5), (0.5, "G5", 1)), 2, 3, 4), tmp_path / "held.mid")
-    for song, error in ((wide, "the chord C4 C5 at 0.000 s spans 16.4 cm"), (held, "no fingering lets this hand go")):
+    for song, why in ((wide, "the chord C4 C5 at 0.000 s spans 16.4 cm"), (held, "no fingering lets this hand go")):
         result = runner.invoke(app, ["finger", str(song), "-o", str(tmp_path / "out.mid")])
-        assert result.exit_code == 2 and error in " ".join(result.stderr.split()), result.output
-        if song == held:  # (what else to try: one voice, or --hand, which reduces the part; not --track alone)
-            assert "(--track), let the part be reduced to what one hand can play (--hand right" in " ".join(
-                result.stderr.split()
-            )
+        assert result.exit_code == 0, result.output
+        said = " ".join(result.stderr.split())
+        assert why in said and "given to both hands and fingered anew (its fingering is one hand's)" in said, said
+        assert "fingering for both hands written" in " ".join(result.stdout.split())
         result = runner.invoke(app, ["finger", str(song), "-o", str(tmp_path / "out.mid"), "--hand", "right"])
         assert result.exit_code == 0, result.output
         assert "the right hand's part" in " ".join(result.stderr.split())

@@ -2,21 +2,22 @@
 
 At the tick where notes start, one finger number per note starting there, lowest pitch first,
 separated by spaces or commas: ``"3"`` for a melody note, ``"2 4"`` for a two-note chord. A
-substitution written ``3_1``, ``3-1`` or ``3/1`` counts as its first finger (the one that
-strikes, as in a MusicXML score); ``-`` marks a note without a finger. A text that is not such a
-list (an ordinary lyric) is no fingering; one that looks like fingering but is none (``"(2)"``,
-``"1-3-5"``) is said by the reader (:func:`looks_like_fingering`).
+substitution written ``3_1`` (as in PIG) counts as its first finger, the one that strikes; ``-``
+marks a note without a finger. A text that is not such a list (an ordinary lyric) is no
+fingering. In a track that writes fingering so, a text that looks like fingering but is none
+(``"(2)"``, ``"1-3-5"``, ``"3-1"``: a dash may join a chord's fingers as well as a substitution's)
+is said by the reader (:func:`looks_like_fingering`).
 """
 
 from __future__ import annotations
 
 import re
 
-_TOKEN = r"(?:[0-9](?:[_/-][0-9])?|-)"
+_TOKEN = r"(?:[0-9](?:_[0-9])?|-)"
 _LIST = re.compile(rf"^\s*{_TOKEN}(?:[\s,]+{_TOKEN})*\s*$")
-_MARKS = r"[\s,()\[\]/_\-–]"
+_MARKS = r"[\s,()\[\]_\-–]"
 _FINGERISH = re.compile(rf"^{_MARKS}*[1-5](?:{_MARKS}+[1-5])*{_MARKS}*$")
-"""Fingers 1-5, one digit each, among brackets, dashes, slashes and spaces."""
+"""Fingers 1-5, one digit each, among brackets, dashes and spaces (not a slash: '3/4' is a meter)."""
 
 
 def parse_finger_text(text: str) -> list[int | None] | None:
@@ -33,8 +34,8 @@ def is_fingering(fingers: list[int | None]) -> bool:
 
 
 def looks_like_fingering(text: str) -> bool:
-    """Whether a text that :func:`parse_finger_text` does not read is made of finger numbers and
-    marks only (``"(2)"``, ``"1-3-5"``): fingering written otherwise, not a lyric."""
+    """Whether a text that :func:`parse_finger_text` does not read is made of fingers 1-5 and
+    brackets or dashes only (``"(2)"``, ``"1-3-5"``, ``"3-1"``): fingering written otherwise."""
     return parse_finger_text(text) is None and bool(_FINGERISH.match(text))
 
 

@@ -135,16 +135,21 @@ def suggest_transpose(piece: Piece, keyboard: KeyboardSpec) -> int | None:
     return min(octaves or fits, key=abs)
 
 
-def beyond_piano(piece: Piece) -> str:
+def beyond_piano(piece: Piece, transposed: int = 0) -> str:
     """'' where every note of ``piece`` lies on the piano's 88 keys, else which lie beyond and what
-    to do: 'N note(s) beyond the piano's 88 keys A0-C8 (88 keys): ...; use load.transpose -12'."""
+    to do: 'N note(s) beyond the piano's 88 keys A0-C8 (88 keys): ...; use load.transpose -12'
+    (``transposed``: the semitones the piece was already moved by, which the shift adds to)."""
     outside = [n for n in piece.notes if n.pitch not in PIANO]
     if not outside:
         return ""
     names = ", ".join(n.describe() for n in outside[:3]) + (" ..." if len(outside) > 3 else "")
     low, high = min(n.pitch for n in piece.notes), max(n.pitch for n in piece.notes)
     shifts = [s for s in range(-120, 121, 12) if PIANO.lowest <= low + s and high + s <= PIANO.highest]
-    fix = f"use load.transpose {min(shifts, key=abs)}" if shifts else "the piece spans more than the piano: cut notes"
+    fix = (
+        f"use load.transpose {min(shifts, key=abs) + transposed}"
+        if shifts
+        else "the piece spans more than the piano: cut notes"
+    )
     return f"{len(outside)} note(s) beyond the piano's 88 keys {PIANO.describe()}: {names}; {fix}"
 
 
@@ -158,9 +163,9 @@ def check_playable(piece: Piece, keyboard: KeyboardSpec, hand: HandSpec, transpo
     """
     if not piece.notes:
         raise PianobotError("the piece has no notes: give a MIDI file with at least one note")
-    if said := beyond_piano(piece):  # (no keyboard holds them)
-        raise SettingError(f"the piece has {said}", "load.transpose")
     outside = [n for n in piece.notes if n.pitch not in keyboard]
+    if outside and (said := beyond_piano(piece, transposed)):  # (no piano's keyboard holds them)
+        raise SettingError(f"the piece has {said}", "load.transpose")
     if outside:
         names = ", ".join(n.describe() for n in outside[:4]) + (" ..." if len(outside) > 4 else "")
         shift = suggest_transpose(piece, keyboard)

@@ -266,7 +266,7 @@ def load_hands(path: str | Path | midi_io.MidiSource, options: LoadOptions = Loa
                     "their notes are given to the hands by the fingering planner"
                 )
             )
-    _check_keys(piece, path)
+    _check_keys(piece, path, options.transpose)
     crossing = _crossing(piece)
     if crossing:
         one = "" if path.suffix.lower() == ".txt" else " (play one hand with load.hand right or load.hand left)"
@@ -280,9 +280,9 @@ def load_hands(path: str | Path | midi_io.MidiSource, options: LoadOptions = Loa
     return piece
 
 
-def _check_keys(piece: Piece, path: Path) -> None:
+def _check_keys(piece: Piece, path: Path, transposed: int = 0) -> None:
     """Refuse notes beyond the piano's 88 keys, suggesting the octave shift that fits them, if any."""
-    if said := beyond_piano(piece):
+    if said := beyond_piano(piece, transposed):
         raise SettingError(f"{path.name} has {said}", "load.transpose")
 
 

@@ -3,7 +3,7 @@
 Fingering (:mod:`pianobot.music.finger_text`, docs/fingering.md): at the tick where notes start,
 a lyric (or text) meta event in the same track holds one finger number per note starting there,
 lowest pitch first (``"3"``, ``"2 4"``). Texts that are not finger lists (ordinary lyrics) are
-ignored, those written like fingering otherwise (``"(2)"``) said in one warning, and so is every
+ignored, those written like fingering otherwise in a fingered track (``"(2)"``) said in one warning, and so is every
 number in a track whose texts hold one that is no finger 1-5 (a continuo's figured bass: "6", "7").
 
 Hands: in a type 1 file, a track whose name says it holds a hand's part ('Right Hand', 'RH',
@@ -273,12 +273,13 @@ def _track_notes(
                 "programs write them)"
             )
         )
-    if unread:
+    if unread and fingering:  # (a track without fingering: its texts are lyrics, verse numbers)
         tick, text = unread[0]
         warnings.warn(
             PianobotWarning(
                 f"track {index}: {len(unread)} text(s) written like fingering are not read as fingers (the first: "
-                f"'{quote(text)}' at {seconds(tick):.3f} s): write one finger per note, lowest first ('2', '1 3 5')"
+                f"'{quote(text)}' at {seconds(tick):.3f} s): write one finger per note, lowest first ('2', '1 3 5'; a "
+                "substitution '3_1')"
             )
         )
     if figures and fingering:

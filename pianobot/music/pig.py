@@ -17,7 +17,7 @@ from dataclasses import replace
 from pathlib import Path
 
 from pianobot.errors import PianobotError, quote
-from pianobot.files import atomic_write, misnamed, read_input
+from pianobot.files import atomic_write, content_kind, read_input, renamed
 from pianobot.music.piece import HANDS, Note, Piece, parse_pitch, pitch_name, resolve_overlaps
 
 HEADER = "//Version: PianoFingering_v170101"
@@ -50,8 +50,11 @@ def read_pig_rows(path: str | Path) -> list[tuple[Note, int]]:
         kind="PIG fingering file",
         missing=f"fingering file {path} does not exist: check the path given to load.fingering",
     )
-    if said := misnamed(path, data):
-        raise PianobotError(said)
+    if found := content_kind(data):  # (a song named .txt, or a fingering file that is none)
+        raise PianobotError(
+            f"{path} holds {found[0]}, not PIG fingering text: to play it, name it {renamed(path, found[1])}; "
+            "as a fingering file, give the PIG .txt file"
+        )
     try:
         text = data.decode("utf-8")
     except UnicodeDecodeError as e:

@@ -1,7 +1,8 @@
 """Each hand's part of a two-hand piece as its simulated hand is given it: moved onto the keys its
 player knows, thinned and reduced to what the hand can play, and fingered (:func:`prepare_part`);
 how many notes that leaves (:func:`given_notes`), and so which finger set leaves most (:func:`keeps_more`,
-by which the reading chooses fingers)."""
+by which the reading chooses fingers); and why one hand cannot play a piece (:func:`one_hand_refusal`),
+by which the reading gives it to both."""
 
 from __future__ import annotations
 
@@ -9,7 +10,7 @@ import warnings
 from dataclasses import replace
 
 from pianobot.errors import PianobotError, PianobotWarning
-from pianobot.music.instrument import THUMB, HandSpec, KeyboardSpec
+from pianobot.music.instrument import THUMB, HandSpec, KeyboardSpec, check_playable, suggest_transpose
 from pianobot.music.load import thin_hand
 from pianobot.music.piece import Piece
 from pianobot.music.window import Window, window_for
@@ -111,3 +112,32 @@ def thumbs_keep_more(
     """(notes both hands are given with three fingers, with thumbs) where the thumbs keep more, else None:
     :func:`keeps_more` of the Allegro-like hand's sets, ``three``/``thumbs`` (default: the same) as read for each."""
     return keeps_more([(HandSpec(), three), (THUMB, three if thumbs is None else thumbs)], keyboard)[1]
+
+
+def one_hands_fingering(piece: Piece) -> bool:
+    """Whether ``piece`` has fingering and it could be one hand's: no note has a hand, and the notes
+    struck together have distinct fingers."""
+    if any(n.hand is not None for n in piece.notes) or all(n.finger is None for n in piece.notes):
+        return False
+    marked = [[n.finger for n in chord if n.finger is not None] for chord in piece.chords()]
+    return all(len(fingers) == len(set(fingers)) for fingers in marked)
+
+
+def one_hand_refusal(piece: Piece, spec: HandSpec, keyboard: KeyboardSpec, refinger: bool = False) -> str:
+    """Why one hand with ``spec``'s fingers cannot play ``piece`` (unfingered, spanning fewer keys
+    than ``keyboard`` has), in words; '' where it can. It is asked on ``keyboard`` moved by the
+    transposition one hand's reading would suggest (:func:`~pianobot.music.instrument.suggest_transpose`):
+    notes a transposition brings onto the keys are no reason for two hands. A single line of notes is
+    always one hand's (the fingering planner only slows what is fast); chords and held notes are
+    asked of the planner."""
+    shift = suggest_transpose(piece, keyboard) or 0  # (0 where the notes fit: the plan is then reused)
+    under = KeyboardSpec(max(0, min(keyboard.lowest - shift, 128 - keyboard.count)), keyboard.count)
+    try:
+        check_playable(piece, under, spec)  # (more notes at once than fingers)
+        if piece.max_polyphony()[0] > 1:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")  # (one hand's reading says them, where one hand plays)
+                ensure_fingering(piece, under, spec, refinger)
+    except PianobotError as refused:
+        return str(refused).split(": ")[0]
+    return ""

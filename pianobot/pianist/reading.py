@@ -5,7 +5,8 @@ Every command that reads a piece (``play``, ``score``, ``inspect``, ``finger``, 
 
 1. :func:`open_song`: the file read and parsed, once (a PIG .txt file as text where needed);
 2. :func:`choose_model`: where no hand model is named, the pianist's hands for a file they play
-   with both hands or fingered with fingers the Allegro-like hand lacks, else that hand;
+   with both hands, fingered with fingers the Allegro-like hand lacks, or that hand's one hand
+   refuses and the pianist's plays, else that hand;
    :func:`choose_fingers`: the model's finger set both hands play with where none is named
    (:func:`~pianobot.pianist.parts.keeps_more`: the Allegro-like hand's thumbs where they keep notes three fingers leave out);
 3. :func:`read_both_hands`: whether the file plays both hands (:func:`two_hands`), and then every
@@ -31,14 +32,15 @@ from pathlib import Path
 
 from pianobot.errors import PianobotError, PianobotWarning
 from pianobot.music import midi_io
-from pianobot.music.instrument import HandSpec, KeyboardSpec, check_playable, keys_for, suggest_transpose
+from pianobot.music.instrument import HandSpec, KeyboardSpec, check_playable, keys_for
 from pianobot.music.load import LoadOptions, end_legato, load_hands, load_part, load_pedal, load_piece
 from pianobot.music.midi_io import MidiSource, TrackInfo, source_path
 from pianobot.music.pedal import Pedal
 from pianobot.music.piece import HANDS, Piece, pitch_name
+from pianobot.music.pig import sidecar_for
 from pianobot.pianist.assign import load_two_hands
 from pianobot.pianist.fingering import FingeringPlan, ensure_fingering
-from pianobot.pianist.parts import keeps_more
+from pianobot.pianist.parts import keeps_more, one_hand_refusal, one_hands_fingering
 from pianobot.pianist.reduce import load_for_hand
 from pianobot.sim.hand import default_fingers, hand_model
 
@@ -138,7 +140,8 @@ def choose_model(
     sets favour them for two-hand music (docs/benchmarks.md, "The pianist's hand"): both where they
     play it with both hands (:func:`two_hands`: tracks named for hands, or notes one of their hands
     cannot play; their reading then), else one (a chordal part the Allegro-like hand would give to
-    both hands; a fingering with a finger it lacks, 1 or 5, played as written). Where the pianist's
+    both hands; a fingering with a finger it lacks, 1 or 5, played as written; a part not fingered
+    throughout that its one hand refuses, :func:`_only_pianist`). Where the pianist's
     reading refuses the file, the Allegro-like hand's reads it, and says why where it refuses it too."""
     keys = keyboard or KeyboardSpec()
     with warnings.catch_warnings(record=True) as caught:
@@ -161,14 +164,16 @@ def choose_model(
 
 
 def _only_pianist(source: Source, options: LoadOptions, keys: KeyboardSpec) -> bool:
-    """Whether the pianist's one hand plays an unfingered one-hand file that the Allegro-like hand's
-    one hand refuses (its notes held into the next ones, say, past its three fingers)."""
+    """Whether the pianist's one hand plays a one-hand file, unfingered or fingered in part (which the
+    Allegro-like hand fingers anew), that the Allegro-like hand's one hand refuses (its notes held
+    into the next ones, say, past its three fingers)."""
     piece = end_legato(load_piece(source, options))
-    if options.hand is not None or any(n.finger is not None for n in piece.notes):
+    if options.hand is not None or (piece.has_fingering and not options.refinger):
         return False
-    if not one_hand_refusal(piece, HandSpec(), keys, options.refinger):
+    notes = piece.without_fingering()
+    if not one_hand_refusal(notes, HandSpec(), keys):
         return False
-    return not one_hand_refusal(piece, default_fingers(PIANIST), keys, options.refinger)
+    return not one_hand_refusal(notes, default_fingers(PIANIST), keys)
 
 
 def read_both_hands(
@@ -353,6 +358,8 @@ def read_hands(
         if hand is not None:
             (named if hand == note.hand else lent)[note.hand] += 1
     said = "the PIG channel" if source_path(path).suffix.lower() == ".txt" else "its track"
+    if said == "its track" and (options.fingering or sidecar_for(source_path(path)).exists()):
+        said = "its track" if names_hands(source, options.track) else "its fingering file's channel"
     return HandsReading(piece, named, said, lent)
 
 
@@ -380,10 +387,11 @@ def two_hands(
     Both hands, without ``options.hand`` and with ``options.track`` naming none or two or more
     tracks of notes (only those read): a file with tracks named for hands (the others' notes
     given hands by the fingering planner) or a PIG file, with notes for both; or a file one hand
-    cannot play, whose notes the planner gives to both: wider than one hand's ``keyboard``, or,
-    unfingered, refused by one hand's reading (notes off the keys, more at once than the fingers,
-    a chord or move out of reach). Where the planner gives every note to one hand, or both hands'
-    reading refuses it too, one hand's reading says why. Warnings are said only where both hands
+    cannot play, whose notes the planner gives to both: wider than one hand's ``keyboard``, or
+    refused by one hand's reading of the notes alone (notes off the keys, more at once than the
+    fingers, a chord or move out of reach; a fingering that could be one hand's is then not taken,
+    :func:`one_hands_fingering`, unless the file gives the hands too). Where the planner gives every
+    note to one hand, or both hands' reading refuses it too, one hand's reading says why. Warnings are said only where both hands
     play (or where the file is refused: notes beyond the piano)."""
     if options.hand is not None:
         return None
@@ -403,9 +411,7 @@ def two_hands(
             piece = end_legato(load_piece(source, options))  # (as one hand's reading reads it)
         pitches = [n.pitch for n in piece.notes]
         if max(pitches) - min(pitches) < keyboard.count:
-            fingered = any(
-                n.finger is not None for n in piece.notes
-            )  # (one hand's, as its fingers say, where it plays)
+            fingered = one_hands_fingering(piece)  # (one hand's fingering, where that hand plays it)
             one_hand_refuses = one_hand_refusal(piece.without_fingering(), spec, keyboard, options.refinger)
             if not one_hand_refuses:
                 return None
@@ -422,33 +428,14 @@ def two_hands(
         return None
     _warn_again(caught)
     if one_hand_refuses:
-        anew = " and fingered anew (its fingering is one hand's)" if fingered else ""
+        anew = " and fingered anew (its fingering is one hand's)" if fingered and not any(hands.named.values()) else ""
         warnings.warn(
             PianobotWarning(
                 f"{path.name}: one hand cannot play it ({one_hand_refuses}): its notes are given to both hands{anew}"
             )
         )
-    return replace(hands, piece=hands.piece.without_fingering()) if fingered and one_hand_refuses else hands
-
-
-def one_hand_refusal(piece: Piece, spec: HandSpec, keyboard: KeyboardSpec, refinger: bool = False) -> str:
-    """Why one hand with ``spec``'s fingers cannot play ``piece`` (unfingered, spanning fewer keys
-    than ``keyboard`` has), in words; '' where it can. It is asked on ``keyboard`` moved by the
-    transposition one hand's reading would suggest (:func:`~pianobot.music.instrument.suggest_transpose`):
-    notes a transposition brings onto the keys are no reason for two hands. A single line of notes is
-    always one hand's (the fingering planner only slows what is fast); chords and held notes are
-    asked of the planner."""
-    shift = suggest_transpose(piece, keyboard) or 0  # (0 where the notes fit: the plan is then reused)
-    under = KeyboardSpec(max(0, min(keyboard.lowest - shift, 128 - keyboard.count)), keyboard.count)
-    try:
-        check_playable(piece, under, spec)  # (more notes at once than fingers)
-        if piece.max_polyphony()[0] > 1:
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore")  # (one hand's reading says them, where one hand plays)
-                ensure_fingering(piece, under, spec, refinger)
-    except PianobotError as refused:
-        return str(refused).split(": ")[0]
-    return ""
+    anew = fingered and one_hand_refuses and not any(hands.named.values())  # (else the file gave hands too)
+    return replace(hands, piece=hands.piece.without_fingering()) if anew else hands
 
 
 def _warn_again(caught: list) -> None:

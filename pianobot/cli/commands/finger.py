@@ -66,7 +66,9 @@ def finger(
             )
             out.print(f"{hand} hand, fingers {hand_spec.describe()}: {travel} over {count} notes", soft_wrap=True)
             for problem in plan.said() if plan else ():
-                out.print(f"[yellow]cannot be played at this tempo:[/yellow] {said(phrase(problem))}")
+                out.print(
+                    f"[yellow]{'cannot be played at this tempo: ' * (problem in plan.problems)}[/yellow]{said(phrase(problem))}"
+                )
         kept = len(fingered.piece)
         less = (
             f"; {kept} of {len(hands.piece)} notes, the others reduced away: the warnings say why"
@@ -87,7 +89,9 @@ def finger(
         f"in {plan.moves} move{'s' * (plan.moves != 1)} over {len(piece)} notes"
     )
     for problem in plan.said():
-        out.print(f"[yellow]cannot be played at this tempo:[/yellow] {said(phrase(problem))}")
+        out.print(
+            f"[yellow]{'cannot be played at this tempo: ' * (problem in plan.problems)}[/yellow]{said(phrase(problem))}"
+        )
     if had:
         out.print(
             f"[yellow]the file's own fingering ({had} of {len(piece)} notes) was replaced by the planner's[/yellow] "
