@@ -666,25 +666,18 @@ def test_score_reads_the_hands_with_the_fingers_play_chose_whatever_keys_play_na
         assert figures["hands"][hand]["f1"] == report["hands"][hand]["f1"], hand
 
 
+def _fingered_chord(start, end, pitches, fingers):
+    """A chord's events, its fingering as a lyric at its onset."""
+    return [(start, lyric(fingers)), *((start, on(p)) for p in pitches), *((end, off(p)) for p in pitches)]
+
+
 def test_a_file_fingered_for_one_hand_that_no_hand_spans_is_both_hands_fingered_anew(tmp_path):
     """An octave chord marked 1 2 3 5 for one hand, as a score marks it for a human hand: the
     pianist's hand spans a sixth, so no fingering of one hand plays it. It was played as written by
     one hand (the little finger striking beside C5, nothing said); both hands now play it, their
     fingering planned anew (the file's is one hand's), said in one line."""
-    events = [
-        (0, lyric("1 3 5")),
-        (0, on(60)),
-        (0, on(64)),
-        (0, on(67)),
-        (480, off(60)),
-        (480, off(64)),
-        (480, off(67)),
-    ]
-    events += [
-        (480, lyric("1 2 3 5")),
-        *((480, on(p)) for p in (60, 64, 67, 72)),
-        *((960, off(p)) for p in (60, 64, 67, 72)),
-    ]
+    events = _fingered_chord(0, 480, (60, 64, 67), "1 3 5")
+    events += _fingered_chord(480, 960, (60, 64, 67, 72), "1 2 3 5")
     song = midi_file(tmp_path / "octave.mid", [("Piano", events)])
     result = run("play", song, "-o", tmp_path / "out.mid", "--controller", "scripted")
     assert result.exit_code == 0, result.output
@@ -694,8 +687,7 @@ def test_a_file_fingered_for_one_hand_that_no_hand_spans_is_both_hands_fingered_
     report = json.loads((tmp_path / "out.report.json").read_text())
     assert set(report["hands"]) == {"right", "left"} and report["f1"] == 1.0
     # a fingering with a finger twice in one chord is both hands': kept where they play it
-    both = [(0, lyric("5 3 1 1 3 5")), *((0, on(p)) for p in (60, 64, 67, 69, 72, 76))]
-    both += [(480, off(p)) for p in (60, 64, 67, 69, 72, 76)]
+    both = _fingered_chord(0, 480, (60, 64, 67, 69, 72, 76), "5 3 1 1 3 5")
     result = run(
         "play",
         midi_file(tmp_path / "two.mid", [("Piano", both)]),
@@ -708,15 +700,7 @@ def test_a_file_fingered_for_one_hand_that_no_hand_spans_is_both_hands_fingered_
     notes = json.loads((tmp_path / "two_out.report.json").read_text())["notes"]
     assert {n["pitch"]: n["played_finger"] for n in notes} == {"C4": 5, "E4": 3, "G4": 1, "A4": 1, "C5": 3, "E5": 5}
     # a chord one hand spans keeps its marks and its one hand
-    inside = [
-        (0, lyric("1 3 5")),
-        (0, on(60)),
-        (0, on(64)),
-        (0, on(67)),
-        (480, off(60)),
-        (480, off(64)),
-        (480, off(67)),
-    ]
+    inside = _fingered_chord(0, 480, (60, 64, 67), "1 3 5")
     one = run("inspect", midi_file(tmp_path / "fifth.mid", [("Piano", inside)]))
     assert one.exit_code == 0 and "`pianobot play` plays both" not in " ".join(one.stdout.split())
     assert "3/3 notes fingered in the file" in " ".join(one.stdout.split())
