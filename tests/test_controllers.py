@@ -80,6 +80,25 @@ def test_a_finger_given_soft_repeats_sooner_than_it_prepares_them_rises_and_play
         assert report.f1 == 1.0 and report.velocity_mae <= 2, report.rows
 
 
+def test_the_pianist_s_hand_holds_a_repeated_key_until_just_before_it_strikes_it_again():
+    """Six legato repeats of D4 (0.5 s each, velocity 60) for one finger: the finger strikes again
+    from just over the depth at which the key let its note go (``repeat_rise``), so each note is
+    held to within note F1 with offsets' tolerance of its written end (it let go 154 ms early,
+    rising to the ready height over the key's top, and every note but the last missed it)."""
+    from pianobot.music.piece import Note, Piece
+    from pianobot.perform.plan import perform_plan, plan_performance
+    from pianobot.sim.hand import default_fingers
+
+    piece = Piece(tuple(Note(0.5 * i, 62, 0.5 * (i + 1), 60, 3) for i in range(6)), bpm=120)
+    performance = perform_plan(
+        plan_performance(piece, "scripted", hand=default_fingers("pianist"), keyboard=KeyboardSpec(48, 24))
+    )
+    report = performance.report()
+    assert report.f1 == 1.0 and report.f1_with_offsets == 1.0, report.rows
+    early = [r.reference.offset - r.played.offset for r in report.rows[:-1]]
+    assert max(early) < 0.1
+
+
 def test_random_controller_is_a_poor_pianist():
     reference = load_piece(EXAMPLES[0])
     report = compare(reference, perform(reference, "random", seed=0).played)

@@ -116,6 +116,29 @@ def test_a_finger_still_on_the_key_it_let_go_of_rises_before_striking_it_again()
     assert allegro.plan(ended, repeat[0], tips)[finger].phase == "strike"
 
 
+def test_a_finger_strikes_the_key_it_let_go_of_again_from_just_over_where_the_key_let_its_note_go():
+    """A key lets its note go once it rises over the keyboard's release depth, so a finger striking
+    it again need not rise to the ready height over its top (``repeat_rise``, the pianist's hand's):
+    it strikes from 1 mm over the release depth, fewer steps, and so lets go of the held note later
+    than for a strike from the ready height; another finger on that key, and a hand without
+    ``repeat_rise`` (the Allegro-like hand's), as before."""
+    world = WorldConfig()
+    layout = KeyLayout(world)
+    tuning = replace(PianistTuning(), rise_before_repeat=True, repeat_rise=0.001)
+    planner = StrikePlanner(world, layout, tuning)
+    soft = Run(5, 0, 1, 30.0)
+    height, lead = planner.ready(soft, repeat=True)
+    usual_height, usual_lead = planner.ready(soft)
+    let_go_at = layout.contact_y(5) * np.tan(layout.release_angle)  # (m under the key's top)
+    assert -let_go_at < planner.repeat_height(5) <= height < 0 < usual_height  # risen past it, still in the key
+    assert lead < usual_lead
+    assert planner.release_steps(5, 5, 30.0, same_finger=True) < planner.release_steps(5, 5, 30.0)
+    assert planner.hop_steps(5, 5, 30.0) < planner.hop_steps(5, 7, 30.0)
+    allegro = StrikePlanner(world, layout, replace(PianistTuning(), rise_before_repeat=True))
+    assert allegro.ready(soft, repeat=True) == allegro.ready(soft)
+    assert allegro.release_steps(5, 5, 30.0, same_finger=True) == allegro.release_steps(5, 5, 30.0)
+
+
 def test_a_note_let_go_before_its_end_is_not_pressed_again():
     """A left hand holds C3 and G3 and strikes C3 again under the held G3 (a new user's organ
     file): the pianist let go of G3 for the repeat, then pressed it again while it was still

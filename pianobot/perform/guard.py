@@ -14,7 +14,11 @@ strike. With the pianist's hand, a held key the teacher has let up (its fingerti
 :attr:`~pianobot.pianist.tuning.PianistTuning.let_up_height` over it) stays up until its note ends:
 pressed again, it would sound twice; a key let go less far is pressed on, so a key the policy's
 wrist drew out of reach only briefly is held again (docs/history.md). The Allegro-like hand's guard
-presses every held key on. ``pianobot play`` plays a general policy of
+presses every held key on. Before a repeat of a held key the guard's teacher lets it go as the
+packaged policies' teacher did when they learnt, rising to the ready height over the key
+(:attr:`~pianobot.pianist.tuning.PianistTuning.repeat_rise` off), for the policy strikes the repeat
+and learnt to strike it from there; the scripted pianist, playing alone, lets go later and strikes it
+again from just over where the key let its note go (docs/history.md). ``pianobot play`` plays a general policy of
 the families in :data:`HOLD_GUARD_FAMILIES` through it (the packaged left hand's policy), and
 any general policy with ``--hold-guard``; ``--no-hold-guard`` plays each alone. A phrase's own
 policy plays unguarded.
@@ -42,6 +46,7 @@ training evaluated it; a general policy that drags keys while the hand shifts pl
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -87,6 +92,7 @@ class HoldGuard:
                 "angles: it needs target_observations, target_onsets and control 'velocity' or 'position'"
             )
         self.policy = policy
+        tuning = replace(tuning or tuning_for(config.world.hand), repeat_rise=math.inf)  # (as the policy learnt)
         self.teacher = ScriptedPianist(config, tuning)
         joints = actuated_indices(config)[:-1]  # (then the wrist's, then with the pedal an action the foot's)
         self.wrist_at = len(joints)

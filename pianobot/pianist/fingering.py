@@ -278,7 +278,8 @@ class Planner:
             before = 0.0  # how long before the onset the note must be let go (s)
             for key, finger, velocity in zip(keys, fingers, velocities):
                 if finger == finger_p or key == key_p:
-                    before = max(before, strikes.release_steps(key_p, key, velocity) * strikes.dt)
+                    steps = strikes.release_steps(key_p, key, velocity, same_finger=finger == finger_p)
+                    before = max(before, steps * strikes.dt)
             lost = min(max((before - slack) / note.duration, 0.0), 1.0)
             # out of reach from the next wrist position: let go before the slowest strike's lead and the slide
             leap = (tuning.prepare_steps + lead) * strikes.dt

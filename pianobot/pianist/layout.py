@@ -37,6 +37,8 @@ class KeyLayout:
         """Height of the black keys' tops over the white keys' (m)."""
         self.strike_angle = world.keyboard.strike_fraction * geometry.max_angle
         """Key angle at which a key sounds (rad)."""
+        self.release_angle = world.keyboard.release_fraction * geometry.max_angle
+        """Key angle over which a sounding key, rising, lets its note go (rad)."""
         self.white_contact_y = geometry.white_length - WHITE_STRIKE_FROM_FRONT
         """Where on a white key the fingertip strikes (m from the hinge): the keyboard's strike point."""
         self.black_contact_y = geometry.black_length - BLACK_STRIKE_FROM_FRONT

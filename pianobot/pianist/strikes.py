@@ -105,6 +105,9 @@ class StrikePlanner:
         self.dt = 1.0 / world.control_hz
         self.curve = world.keyboard.curve
         self.max_wrist_speed = world.hand.max_wrist_speed
+        self._timings: dict[tuple, tuple[float, int] | int] = {}
+        """:meth:`ready`, :meth:`hop_steps` and :meth:`release_steps` by their arguments: each depends on
+        them alone, and the fingering planner asks the same ones many thousand times."""
 
     def plan(
         self,
@@ -171,18 +174,34 @@ class StrikePlanner:
         room = self.tuning.hold_depth_margin - self.overshoot(tip_speed)  # below the strike depth
         return float(min(max(1.0 - room / (tip_speed * self.dt), 0.5), 1.0))
 
-    def ready_steps(self, tip_speed: float, depth: float) -> int:
-        """Control steps of constant-speed travel from the ready height before the onset's step."""
+    def ready_steps(self, tip_speed: float, depth: float, lowest: float | None = None) -> int:
+        """Control steps of constant-speed travel from the ready height before the onset's step
+        (``lowest``: the lowest ready height over the key's top, m; default ``min_ready_height``)."""
         point = self.strike_point(tip_speed)
-        needed = (self.tuning.min_ready_height + depth) / (tip_speed * self.dt) - point
+        lowest = self.tuning.min_ready_height if lowest is None else lowest
+        needed = (lowest + depth) / (tip_speed * self.dt) - point
         return max(self.tuning.min_lead_steps, math.ceil(needed))
 
-    def ready(self, run: Run) -> tuple[float, int]:
+    def repeat_height(self, key: int) -> float:
+        """The lowest ready height (m over ``key``'s top) of a finger striking again the key it has
+        just let go of: ``repeat_rise`` over the depth at which the key let its note go, as a piano
+        strikes a key again before it is all the way up; at most ``min_ready_height``."""
+        released = self.layout.contact_y(key) * math.tan(self.layout.release_angle)
+        return min(self.tuning.min_ready_height, self.tuning.repeat_rise - released)
+
+    def ready(self, run: Run, repeat: bool = False) -> tuple[float, int]:
         """(height, lead) of ``run``'s strike: its ready height over the key's top (m) and the
-        control steps of constant-speed travel from there before the onset's step."""
-        speed, depth = self.tip_speed(run.key, run.velocity), self.strike_depth(run.key)
-        steps = self.ready_steps(speed, depth)
-        return (steps + self.strike_point(speed)) * speed * self.dt - depth, steps
+        control steps of constant-speed travel from there before the onset's step (``repeat``: the
+        finger strikes again the key it has just let go of, from :meth:`repeat_height`)."""
+        found = self._timings.get(("ready", run.key, run.velocity, repeat))
+        if found is None:
+            speed, depth = self.tip_speed(run.key, run.velocity), self.strike_depth(run.key)
+            steps = self.ready_steps(speed, depth, self.repeat_height(run.key) if repeat else None)
+            found = self._timings["ready", run.key, run.velocity, repeat] = (
+                (steps + self.strike_point(speed)) * speed * self.dt - depth,
+                steps,
+            )
+        return found
 
     def positioning_steps(self, tip: Tip, key: int, height: float) -> int:
         """Control steps a fingertip at ``tip`` takes to hover ``height`` over ``key``'s top in front
@@ -204,14 +223,31 @@ class StrikePlanner:
         """Fewest control steps from one note's onset to the next note's onset for the same finger:
         ``from_key`` sounds in its onset's step and is let go at the next, the fingertip goes from the
         pressed key to its ready height over ``to_key`` (:meth:`positioning_steps`, at least
-        ``prepare_steps``), then strikes at ``velocity``. ``to_key`` may be ``from_key`` (a repeat)."""
-        return 1 + self._lift_and_strike(from_key, to_key, velocity, self.tuning.prepare_steps)
+        ``prepare_steps``), then strikes at ``velocity``. ``to_key`` may be ``from_key`` (a repeat: with
+        ``repeat_rise``, as :meth:`release_steps` times it)."""
+        found = self._timings.get(("hop", from_key, to_key, velocity))
+        if found is None:
+            if self._repeats(from_key, to_key):
+                found = 1 + self.release_steps(from_key, to_key, velocity, same_finger=True)
+            else:
+                found = 1 + self._lift_and_strike(from_key, to_key, velocity, self.tuning.prepare_steps)
+            self._timings["hop", from_key, to_key, velocity] = found
+        return found
 
-    def release_steps(self, from_key: int, to_key: int, velocity: float) -> int:
+    def release_steps(self, from_key: int, to_key: int, velocity: float, same_finger: bool = False) -> int:
         """Control steps before a strike on ``to_key`` at ``velocity`` that a finger holding ``from_key``
-        lets go, as :meth:`plan` does (:meth:`preparing_steps`, then the strike)."""
-        height, lead = self.ready(Run(to_key, 0, 1, velocity))
-        return self.preparing_steps(self._pressed(from_key), from_key, to_key, height) + lead
+        lets go, as :meth:`plan` does (:meth:`preparing_steps`, then the strike; ``same_finger``: the
+        strike is the holding finger's own, which strikes the same key again from :meth:`repeat_height`)."""
+        found = self._timings.get(("release", from_key, to_key, velocity, same_finger))
+        if found is None:
+            height, lead = self.ready(Run(to_key, 0, 1, velocity), repeat=same_finger and from_key == to_key)
+            found = self.preparing_steps(self._pressed(from_key), from_key, to_key, height) + lead
+            self._timings["release", from_key, to_key, velocity, same_finger] = found
+        return found
+
+    def _repeats(self, from_key: int, to_key: int) -> bool:
+        """Whether a finger striking ``to_key`` again after ``from_key`` strikes it from :meth:`repeat_height`."""
+        return from_key == to_key and self.tuning.repeat_rise < math.inf
 
     def preparing_steps(self, tip: Tip, from_key: int, to_key: int, height: float) -> int:
         """Control steps a finger holding ``from_key`` with its tip at ``tip`` needs from letting go to
@@ -264,7 +300,7 @@ class StrikePlanner:
         goal = max(tip_height - self.tip_speed(key, current.velocity) * self.dt, floor)
         if upcoming is None:
             return Plan(key, "hold", goal=goal)
-        height, lead = self.ready(upcoming)
+        height, lead = self.ready(upcoming, repeat=upcoming.key == key)
         next_lead = lead + self.preparing_steps(tip, key, upcoming.key, height)
         return Plan(key, "hold", goal=goal, next_note=upcoming, next_lead=next_lead)
 
@@ -285,8 +321,8 @@ class StrikePlanner:
         top, more than ``path_tolerance`` under its strike's path (it has not risen from the key, which
         must come up to sound again: a repeat sooner than the strike from the ready height takes),
         hovers instead: it rises, and strikes once up, late and louder if it must."""
-        plan = self._strike(run, tip)
         tip_height = tip.height - self.layout.key_top[run.key]
+        plan = self._strike(run, tip, repeat=run.key == pressed and tip_height < 0)
         rise = self.tuning.rise_before_repeat and run.key == pressed
         if rise and plan.phase == "strike" and run.start > 0 and tip_height < 0:
             if self._path_height(run) > tip_height + self.tuning.path_tolerance:
@@ -301,13 +337,13 @@ class StrikePlanner:
         depth = self.strike_depth(run.key)
         return -depth - self.overshoot(speed) + speed * self.dt * (run.start - 1 + self.strike_point(speed))
 
-    def _strike(self, run: Run, tip: Tip) -> Plan:
+    def _strike(self, run: Run, tip: Tip, repeat: bool = False) -> Plan:
         """Hover over ``run``'s key while its onset is far, else strike it (closed loop: re-planned each
-        step from where the fingertip is)."""
+        step from where the fingertip is; ``repeat``: as :meth:`ready`'s)."""
         key, start = run.key, run.start
         speed = self.tip_speed(key, run.velocity)
         depth = self.strike_depth(key)
-        height, steps = self.ready(run)
+        height, steps = self.ready(run, repeat)
         point = self.strike_point(speed)
         if start > steps:
             return Plan(key, "ready", height=height, start=start, lead=steps)

@@ -113,6 +113,11 @@ class PianistTuning:
     it strikes (:meth:`~pianobot.pianist.strikes.StrikePlanner._approach`). Off, the default (the
     Allegro-like hand's, whose figures stay as measured), such a strike goes down from where the tip is:
     on a key that never rose, and the repeats do not sound."""
+    repeat_rise: float = math.inf
+    """How far over the depth at which a key lets its note go (the keyboard's ``release_fraction``) a
+    finger that has just let go of the key rises before it strikes it again, as a piano's key is
+    struck again before it is all the way up (m; ``math.inf``, the default: to the ready height over
+    the key's top, as every other strike, the Allegro-like hand's)."""
     let_up_height: float = math.inf
     """Under the hold guard (:class:`~pianobot.perform.guard.HoldGuard`): a holding finger whose tip has
     risen this far over its key's top let the key up, and its note ended; the guard's teacher leaves the

@@ -39,6 +39,7 @@ PIANIST = HandModel(
         ("let_up_height", 0.008),
         ("travel_share", 0.75),
         ("rise_before_repeat", True),
+        ("repeat_rise", 0.001),
     ),
     passes=frozenset({(1, 2), (1, 3), (1, 4)}),
     written_fingering=True,
@@ -85,6 +86,9 @@ planner counts on its fingertips covering three quarters of their longest positi
 across to a white one) to strike on time, and the fingering planner gives a finger that time between
 its notes. A finger that strikes again the key it has let go of rises from it first
 (``rise_before_repeat``): pressed on from the bottom of a key that never rose, soft repeats written
-for one finger did not sound."""
+for one finger did not sound. It strikes it again from 1 mm over the depth at which the key let its
+note go (``repeat_rise``), as a piano's key is struck again before it is all the way up, so the note
+before is held nearer its written end (risen to the ready height, a soft one was let go 0.15-0.3 s
+early)."""
 
 register_hand_model(PIANIST)
