@@ -9,15 +9,25 @@
 - a PIG sidecar's fingering applied to a piece of 20,000 notes (``apply_fingering``: each note
   against the PIG notes of its pitch near its onset; every note against every note took minutes).
 
+- both hands of a long real piece read as ``pianobot play`` reads a two-hand file, planned and
+  reduced for the pianist's hands (``two_hands``, then ``prepare_parts``): the whole Maple Leaf Rag
+  from music21's corpus (2,308 notes, 129 s; needs ``pip install -e ".[corpus]"``, else left out).
+  With ``--peer DIR`` (a checkout of another pianobot commit, e.g. a ``git worktree``), the same figure
+  of that checkout too, run after ours in a process of its own: the ratio of the medians is the speed-up.
+
 Each figure is the median of ``--repeats`` runs, in a fresh temporary folder.
 """
 
 from __future__ import annotations
 
 import argparse
+import os
 import statistics
+import subprocess
+import sys
 import tempfile
 import time
+import warnings
 from pathlib import Path
 from typing import Callable
 
@@ -78,21 +88,72 @@ def pig_matching(folder: Path) -> Callable[[], object]:
     return lambda: apply_fingering(unfingered, folder / "many.txt")
 
 
+LONG_PIECE = "joplin/maple_leaf_rag"
+"""The long two-hand piece of music21's corpus that the last figure reads whole."""
+
+
+def two_hand_reading(folder: Path) -> Callable[[], object]:
+    import music21  # (the corpus extra)
+
+    from pianobot.errors import PianobotWarning
+    from pianobot.music.load import LoadOptions
+    from pianobot.perform.together import prepare_parts, two_hands
+    from pianobot.sim.hand import default_fingers
+
+    path = folder / "long.mid"
+    music21.corpus.parse(LONG_PIECE).write("midi", fp=str(path))
+    fingers = default_fingers("pianist")
+
+    def read() -> object:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", PianobotWarning)
+            return prepare_parts(two_hands(path, LoadOptions(), fingers).piece, None, fingers)
+
+    return read
+
+
+def _has_corpus() -> bool:
+    try:
+        import music21  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
+
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--repeats", type=int, default=5)
+    parser.add_argument("--peer", type=Path, help="a checkout of another pianobot commit: its long piece's reading too")
+    parser.add_argument("--long-only", action="store_true", help=argparse.SUPPRESS)  # (how --peer runs the peer)
     args = parser.parse_args(argv)
     if args.repeats < 1:
         parser.error("--repeats must be at least 1")
+    if args.long_only:
+        print(median_seconds(two_hand_reading, args.repeats))
+        return
+    long = f"both hands of the whole Maple Leaf Rag ({LONG_PIECE}) read and reduced for the pianist's hands"
     figures = (
         (f"{LOOKUPS:,} tick times, {TEMPO_CHANGES:,} tempo changes", tempo_lookups),
         (f"read_midi: {TEMPO_CHANGES:,} tempo changes, {NOTES_IN_MIDI:,} notes", midi_read),
         (f"apply_fingering: a PIG sidecar of {NOTES_IN_PIG:,} notes", pig_matching),
-    )
-    print(f"| figure | median of {args.repeats} |")
-    print("| --- | ---: |")
+    ) + (((long, two_hand_reading),) if _has_corpus() else ())
+    print(f"| figure | median of {args.repeats} |" + (" peer | peer / ours |" if args.peer else ""))
+    print("| --- | ---: |" + (" ---: | ---: |" if args.peer else ""))
     for name, work in figures:
-        print(f"| {name} | {median_seconds(work, args.repeats):.3f} s |", flush=True)
+        ours = median_seconds(work, args.repeats)
+        peer = ""
+        if args.peer and work is two_hand_reading:
+            env = {**os.environ, "PYTHONPATH": str(args.peer.resolve())}
+            command = [sys.executable, str(Path(__file__).resolve()), "--long-only", "--repeats", str(args.repeats)]
+            seconds = float(
+                subprocess.run(command, env=env, cwd=args.peer, check=True, capture_output=True, text=True).stdout
+            )
+            peer = f" {seconds:.1f} s | {seconds / ours:.1f}x |"
+        elif args.peer:
+            peer = " | |"
+        print(f"| {name} | {ours:.3f} s |{peer}", flush=True)
+    if not _has_corpus():
+        print(f"(the reading of {LONG_PIECE} needs music21: pip install -e '.[corpus]')")
 
 
 if __name__ == "__main__":

@@ -171,35 +171,51 @@ class Planner:
         self._distance = np.abs(self._move)
         self._move.flags.writeable = self._move_cost.flags.writeable = self._distance.flags.writeable = False
         self._in_reach: dict[tuple[int, int], np.ndarray] = {}
+        self._chord_states: dict[tuple[int, ...], tuple[tuple[tuple[int, ...], ...], tuple[int, ...], np.ndarray]] = {}
+        """Each chord's :meth:`_states`, by its keys (read-only)."""
         world = WorldConfig(keyboard=keyboard, hand=hand)
         self.strikes = StrikePlanner(world, KeyLayout(world), tuning)
         """The scripted pianist's strike planning (``tuning``: its constants): how soon a finger can strike
         again, and how soon before the next strike it lets go of a key."""
 
     # -- one chord ---------------------------------------------------------------------------
-    def _states(self, chord: Sequence[Note]) -> tuple[list[tuple[int, ...]], list[int], np.ndarray]:
+    def _states(self, chord: Sequence[Note]) -> tuple[tuple[tuple[int, ...], ...], tuple[int, ...], np.ndarray]:
         """Finger assignments (pitch order = finger order), the chord's keys, and per assignment
         and wrist position the stretch cost (at least :data:`_INFEASIBLE` where a finger cannot
         reach its key)."""
-        keys = [self.spec.index(n.pitch) for n in sorted(chord, key=lambda n: n.pitch)]
-        assignments = list(combinations(self.fingers, len(chord)))
+        keys = tuple(self.spec.index(n.pitch) for n in sorted(chord, key=lambda n: n.pitch))
+        known = self._chord_states.get(keys)  # (a chord's keys alone decide: asked again and again)
+        if known is not None:
+            return known
+        assignments = tuple(combinations(self.fingers, len(chord)))
         cost = np.zeros((len(assignments), len(self.grid)))
         for a, fingers in enumerate(assignments):
             for key, finger in zip(keys, fingers):
                 offset = (self.key_x[key] - self.grid - self.base_x[finger]) / self.reach[finger][key]
                 cost[a] += np.where(np.abs(offset) <= 1.0, self.stretch_cost[finger] * offset**2, _INFEASIBLE)
+        cost.flags.writeable = False
+        self._chord_states[keys] = assignments, keys, cost
         return assignments, keys, cost
 
     def _transition(
-        self, prev_keys: list[int], keys: list[int], fingers_prev: tuple, fingers: tuple, held: list[bool], time: float
+        self,
+        prev_keys: Sequence[int],
+        keys: Sequence[int],
+        fingers_prev: tuple,
+        fingers: tuple,
+        held: list[bool],
+        time: float,
+        rows: np.ndarray,
+        cols: np.ndarray,
     ) -> np.ndarray:
-        """Cost (W_prev x W) of going from one state's fingers to the next's, for every pair of wrist positions."""
-        move, cost = self._move, self._move_cost
+        """Cost (len(rows) x len(cols)) of going from one state's fingers to the next's, for every pair of
+        wrist positions (``rows``: the previous ones, ``cols``: the next ones, as grid indices)."""
+        move, cost = self._move[rows][:, cols], self._move_cost[rows][:, cols]
         for key_p, finger_p, is_held in zip(prev_keys, fingers_prev, held):
             if is_held:  # still sounding at the next onset: finger busy, key kept in reach
                 if finger_p in fingers:
                     return np.full_like(cost, _INFEASIBLE)
-                cost = cost + np.where(self._reaches(key_p, finger_p), 0.0, _INFEASIBLE)[None, :]
+                cost = cost + np.where(self._reaches(key_p, finger_p)[cols], 0.0, _INFEASIBLE)[None, :]
             for key, finger in zip(keys, fingers):
                 if finger == finger_p:
                     easy = time >= HOP_TIME and not (self.black[key] or self.black[key_p])
@@ -242,23 +258,48 @@ class Planner:
         too_fast = np.where(self._wrist_too_fast(self._distance, time, chord), slow, 0.0)
         # the slowest strike's lead from its ready height: a note out of reach is let go before it
         lead = max(self.strikes.ready(Run(key, 0, 1, v))[1] for key, v in zip(keys, velocities))
-        blocks = np.empty((len(p_assign), len(self.grid), len(assignments), len(self.grid)))
-        for a_p, f_p in enumerate(p_assign):
-            for a, f in enumerate(assignments):
+        # Only states that can be reached count: a previous state at _INFEASIBLE or more, or a next one
+        # whose fingers cannot reach their keys, is never on a feasible way, so the transitions are worked
+        # out between the others alone (the same costs and choices there; the rest stay infeasible).
+        width = len(self.grid)
+        before_cost = before.cost.reshape(len(p_assign), width)
+        rows = [np.flatnonzero(c < _INFEASIBLE) for c in before_cost]
+        cost = local + _INFEASIBLE  # (where nothing feasible leads: infeasible, as before)
+        best = np.zeros(local.shape, dtype=np.intp)
+        for a, f in enumerate(assignments):
+            cols = np.flatnonzero(local[a] < _INFEASIBLE)
+            if not len(cols):
+                continue
+            steps, origins = [], []
+            for a_p, f_p in enumerate(p_assign):
+                if not len(rows[a_p]):
+                    continue
                 hop = slow if self._fast_hop(p_keys, f_p, keys, f, time, velocities) else 0.0
                 legato = self._legato(prev_chord, onset, p_keys, f_p, keys, f, velocities, lead)
-                blocks[a_p, :, a, :] = self._transition(p_keys, keys, f_p, f, held, time) + too_fast + hop + legato
-        step = before.cost[:, None] + blocks.reshape(len(before.cost), -1)
-        best = np.argmin(step, axis=0)
-        return Reach(chord, step[best, np.arange(step.shape[1])] + local.ravel()), best
+                legato = legato[:, cols] if isinstance(legato, np.ndarray) else legato
+                block = (
+                    self._transition(p_keys, keys, f_p, f, held, time, rows[a_p], cols)
+                    + too_fast[rows[a_p]][:, cols]
+                    + hop
+                    + legato
+                )
+                steps.append(before_cost[a_p, rows[a_p]][:, None] + block)
+                origins.append(a_p * width + rows[a_p])
+            if not steps:
+                continue
+            step, origin = np.concatenate(steps), np.concatenate(origins)
+            chosen = np.argmin(step, axis=0)
+            cost[a, cols] = step[chosen, np.arange(len(cols))] + local[a, cols]
+            best[a, cols] = origin[chosen]
+        return Reach(chord, cost.ravel()), best.ravel()
 
     def _legato(
         self,
         prev_chord: Sequence[Note],
         onset: float,
-        prev_keys: list[int],
+        prev_keys: Sequence[int],
         fingers_prev: tuple,
-        keys: list[int],
+        keys: Sequence[int],
         fingers: tuple,
         velocities: Sequence[int],
         lead: int,
@@ -314,9 +355,9 @@ class Planner:
 
     def _fast_hop(
         self,
-        prev_keys: list[int],
+        prev_keys: Sequence[int],
         fingers_prev: tuple,
-        keys: list[int],
+        keys: Sequence[int],
         fingers: tuple,
         time: float,
         velocities: Sequence[int],
