@@ -53,7 +53,8 @@ from pianobot.music import window as windows
 from pianobot.music.instrument import HandSpec, KeyboardSpec, keyboard_for
 from pianobot.music.load import CHORD_SPREAD, LEGATO_OVERLAP, LoadOptions, load_hands, thin_hand
 from pianobot.music.piece import Note, Piece, mirror_pitch, pitch_name
-from pianobot.pianist.fingering import FingeringPlan, Planner, ensure_fingering
+from pianobot.pianist.fingering import Planner, ensure_fingering
+from pianobot.pianist.fingering_plan import FingeringPlan
 from pianobot.pianist.reduce import reduce_part
 from pianobot.pianist.tuning import tuning_for
 from pianobot.sim.hand import hand_config, hand_model, thumb_side_reach

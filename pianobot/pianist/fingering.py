@@ -38,7 +38,7 @@ part of a recording asks them to reduce the part to what the hand can play
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from functools import lru_cache
 from itertools import combinations
 from typing import Sequence
@@ -48,6 +48,7 @@ import numpy as np
 from pianobot.errors import PianobotError, SettingError
 from pianobot.music.instrument import HandSpec, KeyboardSpec, check_playable
 from pianobot.music.piece import Note, Piece, pitch_name
+from pianobot.pianist.fingering_plan import FingeringPlan
 from pianobot.pianist.layout import KeyLayout
 from pianobot.pianist.strikes import Run, StrikePlanner
 from pianobot.pianist.tuning import PianistTuning, tuning_for
@@ -89,35 +90,6 @@ _SLOW_MARK = MARK_COST / 4
 """A move or hop too fast, where a mark may be kept though only the hand's speed is against it
 (``Planner.plan(timing=False)``): less than a mark, so the mark stays, but not free, so the notes
 fingered anew are still fingered in time where they can be."""
-
-
-SAID_PROBLEMS = 3
-"""How many of a plan's places too fast for the hand are said one by one (then how many more)."""
-
-
-@dataclass(frozen=True)
-class FingeringPlan:
-    """The planner's result: the fingered piece, the wrist's path and what could not be met."""
-
-    piece: Piece
-    wrist: tuple[float, ...]
-    """Wrist position (m along the rail) for each chord, in time order."""
-    travel: float
-    """Total wrist travel (m)."""
-    moves: int
-    """Number of wrist moves."""
-    problems: tuple[str, ...] = field(default=())
-    """Notes this hand cannot play as written at this tempo, and why."""
-
-    def said(self, most: int = SAID_PROBLEMS) -> list[str]:
-        """:attr:`problems` as lines to say: the first ``most``, then how many more there are."""
-        if len(self.problems) <= most:
-            return list(self.problems)
-        rest = len(self.problems) - most
-        return [
-            *self.problems[:most],
-            f"and {rest} more place(s) faster than this hand can (slow down with load.tempo)",
-        ]
 
 
 @dataclass(frozen=True, eq=False)

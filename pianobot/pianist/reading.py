@@ -39,7 +39,8 @@ from pianobot.music.pedal import Pedal
 from pianobot.music.piece import HANDS, Piece, pitch_name
 from pianobot.music.pig import sidecar_for
 from pianobot.pianist.assign import load_two_hands
-from pianobot.pianist.fingering import FingeringPlan, ensure_fingering
+from pianobot.pianist.fingering import ensure_fingering
+from pianobot.pianist.fingering_plan import FingeringPlan
 from pianobot.pianist.parts import keeps_more, one_hand_refusal, one_hands_fingering
 from pianobot.pianist.reduce import load_for_hand
 from pianobot.sim.hand import default_fingers, hand_model
