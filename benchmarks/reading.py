@@ -120,6 +120,18 @@ def _has_corpus() -> bool:
     return True
 
 
+def peer_seconds(peer: Path, repeats: int) -> float:
+    """The long piece's median reading time with ``peer``'s pianobot: this script again, in a process of
+    its own whose ``import pianobot`` finds the peer's (a failure: one line, exit code 2)."""
+    env = {**os.environ, "PYTHONPATH": str(peer.resolve())}
+    command = [sys.executable, str(Path(__file__).resolve()), "--long-only", "--repeats", str(repeats)]
+    done = subprocess.run(command, env=env, cwd=peer, capture_output=True, text=True)
+    if done.returncode != 0:
+        last = (done.stderr.strip().splitlines() or ["no output"])[-1]
+        raise SystemExit(f"the peer checkout {peer} could not read the long piece: {last}")
+    return float(done.stdout)
+
+
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--repeats", type=int, default=5)
@@ -128,6 +140,10 @@ def main(argv: list[str] | None = None) -> None:
     args = parser.parse_args(argv)
     if args.repeats < 1:
         parser.error("--repeats must be at least 1")
+    if args.peer is not None and not (args.peer / "pianobot" / "__init__.py").is_file():
+        parser.error(f"--peer {args.peer}: not a pianobot checkout (no pianobot/__init__.py there)")
+    if args.peer is not None and not _has_corpus():
+        parser.error("--peer times the long piece's reading, which needs music21: pip install -e '.[corpus]'")
     if args.long_only:
         print(median_seconds(two_hand_reading, args.repeats))
         return
@@ -143,11 +159,7 @@ def main(argv: list[str] | None = None) -> None:
         ours = median_seconds(work, args.repeats)
         peer = ""
         if args.peer and work is two_hand_reading:
-            env = {**os.environ, "PYTHONPATH": str(args.peer.resolve())}
-            command = [sys.executable, str(Path(__file__).resolve()), "--long-only", "--repeats", str(args.repeats)]
-            seconds = float(
-                subprocess.run(command, env=env, cwd=args.peer, check=True, capture_output=True, text=True).stdout
-            )
+            seconds = peer_seconds(args.peer, args.repeats)
             peer = f" {seconds:.1f} s | {seconds / ours:.1f}x |"
         elif args.peer:
             peer = " | |"
