@@ -198,3 +198,16 @@ def test_an_interrupted_train_says_how_to_go_on(capsys):
         assert stopped.value.exit_code == 130
         said = capsys.readouterr().err.strip()
         assert said.startswith("interrupted") and words in said and ("checkpoint" in said) == bool(words)
+
+
+def test_a_track_with_more_notes_at_once_than_fingers_points_to_the_option_that_reduces_it(tmp_path):
+    """One track is read as it is written and refused where the hand cannot play it; the line names
+    --hand, which reduces that part to what the hand can play, and that command plays."""
+    song = EXAMPLES / "minuet-performed.mid"  # (its right hand's track holds a four-note chord)
+    refused = run("play", song, "--track", "1", "-o", tmp_path / "a.mid", "--controller", "scripted")
+    assert refused.exit_code == 2 and "Traceback" not in refused.output
+    error = refused.stderr.strip().splitlines()[-1]  # (after the reading's warnings)
+    assert error.startswith("error: ") and "but the hand has 3 fingers" in error
+    assert "--hand right or --hand left" in error and "--track" in error
+    reduced = run("play", song, "--hand", "right", "-o", tmp_path / "b.mid", "--controller", "scripted")
+    assert reduced.exit_code == 0, reduced.output

@@ -5,6 +5,7 @@ tables whole in files and pipes, warnings before the error that stopped a comman
 import io
 import json
 import re
+from dataclasses import replace
 from pathlib import Path
 
 import mido
@@ -181,3 +182,22 @@ def test_the_sound_notice_says_what_make_sound_installs():
 
     packages = re.search(r"^SOUND_PACKAGES := (.+)$", (ROOT / "Makefile").read_text(), re.M).group(1).split()
     assert re.findall(r"[a-z0-9-]*(?:fluidsynth|soundfont)[a-z0-9-]*", SOUND.split("(")[1]) == packages
+
+
+def test_play_counts_the_file_s_own_fingering_as_score_does(tmp_path):
+    """A file without fingering: n/a in both (the planner's fingering is not the file's); a file with
+    marks on some notes: both count those marks only."""
+    plain = Piece(tuple(Note(0.5 * i, 60 + 2 * i, 0.5 * i + 0.45, 80) for i in range(5)), bpm=120)
+    marked = Piece(tuple(replace(n, finger=3) if i in (0, 3) else n for i, n in enumerate(plain.notes)), bpm=120)
+    for name, piece, marks in (("plain", plain, 0), ("marked", marked, 2)):
+        song = write_midi(piece, tmp_path / f"{name}.mid")
+        played = run("play", song, "-o", tmp_path / f"{name}-o.mid", "--controller", "scripted", "--json", "-")
+        assert played.exit_code == 0, played.output
+        report = json.loads(played.stdout)
+        scored = json.loads(run("score", tmp_path / f"{name}-o.mid", song, "--json", "-").stdout)
+        assert report["fingering_accuracy"] == scored["fingering_accuracy"]
+        assert sum(n["target_finger"] is not None for n in report["notes"]) == marks
+        if marks:
+            assert report["fingering_accuracy"] is not None
+        else:
+            assert report["fingering_accuracy"] is None and "fingering" in played.stderr

@@ -188,10 +188,12 @@ def check_playable(piece: Piece, keyboard: KeyboardSpec, hand: HandSpec, transpo
         sounding = [n.name for n in piece.notes if n.onset <= when < n.offset]
         raise SettingError(
             f"{polyphony} notes sound at once at {when:.3f} s ({', '.join(sounding)}) but the hand has "
-            f"{len(hand.fingers)} fingers: drop notes from that chord (e.g. with load.track)"
-            + (" or enable the thumb with hand.fingers" if 1 not in hand.fingers else ""),
+            f"{len(hand.fingers)} fingers: drop notes from that chord (e.g. with load.track), let the part be reduced "
+            "to what one hand can play (load.hand right or load.hand left)"
+            + (", or enable the thumb with hand.fingers" if 1 not in hand.fingers else ""),
             "hand.fingers",
             "load.track",
+            "load.hand",
         )
     for note in piece.notes:
         if note.finger is not None and note.finger not in hand.fingers:

@@ -379,21 +379,23 @@ class Planner:
             raise ValueError(f"room has {len(room)} entries for {len(chords)} chords")
         too_many = next((c for c in chords if len(c) > len(self.fingers)), None)
         if too_many is not None:
-            raise SettingError(
-                f"{len(too_many)} notes start together at {too_many[0].onset:.3f} s ({', '.join(n.name for n in too_many)}) "
-                f"but the hand has {len(self.fingers)} fingers: drop notes from that chord (e.g. with load.track) or "
-                "enable the thumb with hand.fingers",
-                "hand.fingers",
-                "load.track",
+            said = f"{len(too_many)} notes start together at {too_many[0].onset:.3f} s ({', '.join(n.name for n in too_many)})"
+            message = (
+                f"{said} but the hand has {len(self.fingers)} fingers: drop notes from that chord (e.g. with load.track), "
+                "let the part be reduced to what one hand can play (load.hand right or load.hand left), or enable the "
+                "thumb with hand.fingers"
             )
+            raise SettingError(message, "hand.fingers", "load.track", "load.hand")
         reaches, back = [], [None]
         for i, chord in enumerate(chords):
             if not self.place(chord).possible:
                 keys = [self.spec.index(n.pitch) for n in chord]
                 span = abs(self.key_x[keys[-1]] - self.key_x[keys[0]]) * 100
-                raise PianobotError(
+                raise SettingError(
                     f"the chord {' '.join(n.name for n in chord)} at {chord[0].onset:.3f} s spans {span:.1f} cm, "
-                    "more than this hand reaches: drop a note from it or transpose part of it"
+                    "more than this hand reaches: drop a note from it, transpose part of it, or let the part be "
+                    "reduced to what one hand can play (load.hand right or load.hand left)",
+                    "load.hand",
                 )
             if i == 0:
                 reach = self.place(chord)

@@ -286,6 +286,7 @@ def play_one(
             video=video is not None,
             on_step=on_step,
         )
+    performance = against_written_fingering(performance, read.part)
     plan = performance.plan
     report = performance.report()
     write_midi(performance.played, output, name=f"pianobot ({plan.performer}): {song.stem}", pedal=performance.pedal)
@@ -323,6 +324,22 @@ def play_one(
         title = f"{song.name}: {plan.performer}"
         write_html(html, report, title, plan=plan, seed=seed, video=video, audio=wav)
         console.print(f"report to open in a browser written to {said(html)}")
+
+
+def against_written_fingering(performance, part):
+    """``performance`` with the notes it is scored against fingered as the file fingers them (``part``:
+    the part as read, before the planner fingered it; None: as it is): its fingering figure counts the
+    file's own marks, as `score` of the file counts them, and is n/a for a file without any."""
+    from dataclasses import replace
+
+    from pianobot.music.piece import Piece
+
+    reference = performance.rollout.reference
+    if part is None or len(part.notes) != len(reference.notes):
+        return performance
+    marks = tuple(replace(note, finger=mark.finger) for note, mark in zip(reference.notes, part.notes))
+    rollout = replace(performance.rollout, reference=Piece(marks, bpm=reference.bpm))
+    return replace(performance, rollout=rollout)
 
 
 def play_both(
