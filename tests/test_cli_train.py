@@ -126,11 +126,12 @@ def test_train_with_the_dagger_learner_in_rounds_of_round_steps(tmp_path):
     song = EXAMPLES / "one-note.mid"
     result = run(
         "train", song, "--steps", "100", "--learner", "dagger", "--round-steps", "40", "--no-tactile",
-        "--dagger-learning-rate", "1e-5", "--models", tmp_path, "--json", "-",
+        "--dagger-learning-rate", "1e-5", "--dagger-hold-guard", "--models", tmp_path, "--json", "-",
     )  # fmt: skip
     assert result.exit_code == 0, result.output
     manifest = json.loads((Path(json.loads(result.stdout)["policies"][0]["folder"]) / "manifest.json").read_text())
     assert manifest["config"]["learner"] == "dagger" and manifest["config"]["dagger"]["round_steps"] == 40
+    assert manifest["config"]["dagger"]["hold_guard"] is True
     # the step size starts where --dagger-learning-rate says and falls no lower than it when it is below the default end
     assert manifest["config"]["dagger"]["learning_rate"] == manifest["config"]["dagger"]["final_learning_rate"] == 1e-5
     rounds = [e["round"] for e in manifest["evaluations"] if "round" in e]
@@ -141,6 +142,7 @@ def test_train_with_the_dagger_learner_in_rounds_of_round_steps(tmp_path):
         (("--learner", "dagger", "--dagger-learning-rate", "0"), ("--dagger-learning-rate 0", "above 0")),
         (("--learner", "dagger", "--dagger-learning-rate", "inf"), ("--dagger-learning-rate inf", "above 0")),
         (("--learner", "dagger", "--control", "torque", "--explore", "prior"), ("velocity or position",)),
+        (("--learner", "dagger", "--dagger-hold-guard", "--control", "torque"), ("--dagger-hold-guard", "velocity")),
     ):
         result = run("train", song, *QUICK, *args, "--models", tmp_path / "bad")
         assert result.exit_code == 2 and len(result.stderr.strip().splitlines()) == 1, result.output

@@ -10,11 +10,12 @@ import torch
 
 from pianobot.agent import store
 from pianobot.agent.config import SACConfig
+from pianobot.agent.general import PACKAGED
 from pianobot.agent.imitation import Imitation
 from pianobot.agent.policy import load_policy, make_agent
 from pianobot.agent.store import config_hash
 from pianobot.env.piano import EnvConfig
-from pianobot.learn.config import DaggerConfig, TrainConfig
+from pianobot.learn.config import DaggerConfig, TrainConfig, config_from_manifest
 from pianobot.learn.dagger import dagger_policy
 from pianobot.learn.jobs import learner
 from pianobot.learn.train import Progress, make_env, train_policy
@@ -202,3 +203,41 @@ def test_the_fingers_actor_reads_each_fingers_own_values_and_learns_by_imitation
     assert store.config_hash(small()) != store.config_hash(small(sac=fingers))  # its own folder
     with pytest.raises(ValueError, match="finger target"):
         make_agent(make_env(PHRASE, EnvConfig(target_observations=False)), fingers)
+
+
+def test_the_hold_guard_plays_the_policys_episodes_and_names_its_own_folder(tmp_path, monkeypatch):
+    """With ``hold_guard`` every step the policy plays goes through the hold guard and is stepped as
+    the guard passes it on (the teacher's episodes are not guarded); without it the guard is not
+    made. A run with it has a folder of its own; without it, the folder every DAgger run had before
+    (the packaged policies' names still match their manifests)."""
+    from pianobot.perform import guard
+
+    proposed, passed = [], []
+    act = guard.HoldGuard.act
+
+    def spy(self, observation):
+        proposed.append(self.policy.act(observation).copy())
+        passed.append(act(self, observation))
+        return passed[-1]
+
+    monkeypatch.setattr(guard.HoldGuard, "act", spy)
+    held = Piece((Note(0.0, 64, 1.0, 80, 3),), bpm=60)  # a held note: the guard's teacher moves the holding finger
+    settings = DaggerConfig(round_steps=70, updates_per_step=0.5, batch_size=32, teacher_share=0.0)
+    config = small(dagger=settings)
+    dagger_policy(held, config, tmp_path / "plain", stop_after=100)
+    assert passed == []
+    dagger_policy(
+        held, replace(config, dagger=replace(settings, hold_guard=True)), tmp_path / "guarded", stop_after=100
+    )
+    (data,) = (tmp_path / "guarded" / store.CHECKPOINT_DIR).glob("*/buffer")
+    actions = np.load(data / "action.npy")
+    teacher = len(actions) - len(passed)  # round 0 is the teacher's (whole episodes), round 1 the policy's
+    assert teacher >= 70 and len(passed) >= 70
+    np.testing.assert_allclose(actions[teacher:], np.array(passed), atol=1e-6)  # stepped as the guard passed them
+    assert any(np.abs(a - b).max() > 1e-3 for a, b in zip(proposed, passed))  # it took over the holding finger
+
+    guarded = replace(config, dagger=replace(settings, hold_guard=True))
+    assert store.config_hash(guarded) != store.config_hash(config)
+    for folder in PACKAGED.glob("task-parts-*"):
+        manifest = json.loads((folder / store.MANIFEST_FILE).read_text())
+        assert folder.name.endswith(store.config_hash(config_from_manifest(manifest)))

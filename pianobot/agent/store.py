@@ -85,7 +85,8 @@ def config_hash(config) -> str:
     configuration, fine-tuned or trained from scratch (the manifest's ``start`` says which).
     A SAC run (``TrainConfig.learner`` 'sac') leaves out ``learner`` and the DAgger settings it
     does not use, so that its folder keeps the name it had before there was another learner; an
-    agent with the default actor (``SACConfig.actor`` 'mlp') leaves out ``sac.actor`` likewise, a run
+    agent with the default actor (``SACConfig.actor`` 'mlp') leaves out ``sac.actor`` likewise, a DAgger run
+    without the hold guard (``DaggerConfig.hold_guard`` False) that setting, a run
     of the Allegro-like hand (``HandSpec.model`` 'allegro') its hand model, and a run whose foot
     follows the score (``EnvConfig.pedal_action`` False) the pedal's settings."""
     runtime = {f.name for f in dataclasses.fields(config) if f.metadata.get("runtime") or f.metadata.get("start")}
@@ -93,6 +94,8 @@ def config_hash(config) -> str:
     if fields.get("learner") == "sac":
         fields.pop("learner")
         fields.pop("dagger", None)
+    if isinstance(fields.get("dagger"), dict) and not fields["dagger"].get("hold_guard", True):
+        fields["dagger"] = {k: v for k, v in fields["dagger"].items() if k != "hold_guard"}
     if isinstance(fields.get("sac"), dict) and fields["sac"].get("actor") == "mlp":
         fields["sac"] = {k: v for k, v in fields["sac"].items() if k != "actor"}
     env = fields.get("env", {})

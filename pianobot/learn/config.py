@@ -35,6 +35,10 @@ class DaggerConfig:
     (round 0: every one), else by the policy; the teacher labels every step either way."""
     dataset_size: int = 500_000
     """Steps kept to learn from (the oldest go first); at most the run's steps are held in memory."""
+    hold_guard: bool = False
+    """The policy's episodes are played through the hold guard (:class:`~pianobot.perform.guard.HoldGuard`),
+    as `pianobot play` plays a general policy of hands' parts: the policy learns in the states the guard
+    leads it to (the teacher labels every step either way; the evaluation plays the policy alone)."""
 
     def __post_init__(self) -> None:
         check_ranges(self, round_steps=(1, 10**9), batch_size=(1, 1 << 16), dataset_size=(1, 10**8))

@@ -12,7 +12,8 @@ steps, which is how the general policy is trained (docs/training.md).
 1. gather: every step is labelled with the teacher's noise-free action. In round 0 the teacher
    plays every episode, with the scripted exploration's per-episode noise (the noisy episodes
    show the learner the states a mistake leads to, as in DART); in round r an episode is the
-   teacher's with probability ``teacher_share ** r`` and the policy's otherwise;
+   teacher's with probability ``teacher_share ** r`` and the policy's otherwise (with
+   ``hold_guard``, the policy's through the hold guard, as `pianobot play` plays it);
 2. learn: ``updates_per_step`` gradient steps of behaviour cloning per step gathered
    (:class:`~pianobot.agent.imitation.Imitation`), on batches drawn from everything gathered
    so far (up to ``dataset_size`` steps, the oldest dropped first), with a step size that falls
@@ -38,8 +39,39 @@ import math
 import numpy as np
 
 from pianobot.agent.imitation import Imitation
+from pianobot.env.piano import EnvConfig
 from pianobot.learn.explore import Explorer
 from pianobot.learn.run import Progress, Run, evaluate, open_run
+from pianobot.perform.guard import HoldGuard
+
+
+class GuardedAction:
+    """The hold guard (:class:`~pianobot.perform.guard.HoldGuard`) over the policy's actions in one
+    environment: ``act(observation, action)`` is the policy's ``action`` as the guard passes it on."""
+
+    def __init__(self, env: EnvConfig):
+        self.proposed = _Proposed()
+        self.guard = HoldGuard(self.proposed, env)
+
+    def reset(self) -> None:
+        """A new episode."""
+        self.guard.reset()
+
+    def act(self, observation: dict, action: np.ndarray) -> np.ndarray:
+        self.proposed.action = action
+        return self.guard.act(observation)
+
+
+class _Proposed:
+    """The policy, as the hold guard asks it: the action it has already chosen."""
+
+    action: np.ndarray | None = None
+
+    def reset(self) -> None:
+        pass
+
+    def act(self, observation: dict) -> np.ndarray:
+        return self.action
 
 
 def dagger_policy(target, config, folder, report=lambda p: None, stop_after=None, about=None, start=None) -> dict:
@@ -60,6 +92,7 @@ def _dagger(run: Run, stop_after: int | None) -> dict:
     config, envs, n = run.config, run.envs, run.config.envs
     action_size = envs.single_action_space.shape[0]
     teachers = [Explorer("scripted", action_size, config.env, rng) for _ in range(n)]  # one per environment
+    guards = [GuardedAction(config.env) for _ in range(n)] if settings.hold_guard else None
     step, episode, rounds = state["step"], state["episode"], state.get("rounds", 0)
     losses, returns = None, np.zeros(n)
     final = run.evaluate_start(agent)  # fine-tuning: the start's figures, when it already plays well enough
@@ -67,6 +100,8 @@ def _dagger(run: Run, stop_after: int | None) -> dict:
     def new_episodes(which: np.ndarray) -> np.ndarray:  # who plays each new episode: True for the teacher
         for i in np.flatnonzero(which):
             teachers[i].reset()
+            if guards:
+                guards[i].reset()
         return rng.random(n) < settings.teacher_share**rounds
 
     teacher_plays = new_episodes(np.ones(n, bool))
@@ -79,8 +114,11 @@ def _dagger(run: Run, stop_after: int | None) -> dict:
             each = [{k: v[i] for k, v in observations.items()} for i in range(n)]
             taught = [teacher.teach(o) for teacher, o in zip(teachers, each)]
             actions = agent.act_batch(vectors, tactiles)
-            for i in np.flatnonzero(teacher_plays):
-                actions[i] = teachers[i].act(each[i], taught[i])
+            for i in range(n):
+                if teacher_plays[i]:
+                    actions[i] = teachers[i].act(each[i], taught[i])
+                elif guards:
+                    actions[i] = guards[i].act(each[i], actions[i])
             observations, rewards, terminations, truncations, _ = envs.step(actions)
             next_vectors, next_tactiles = agent.split_batch(observations)
             dataset.add_batch(vectors, tactiles, actions, rewards, terminations, next_vectors, next_tactiles, taught)

@@ -6,6 +6,7 @@ import contextlib
 import math
 import os
 import warnings
+from dataclasses import replace
 from pathlib import Path
 from typing import Optional
 
@@ -91,6 +92,12 @@ DAGGER_LEARNING_RATE_OPTION = typer.Option(
     "--dagger-learning-rate",
     help="With --learner dagger: Adam's step size at the run's first step; it falls along a cosine to "
     f"{DaggerConfig.final_learning_rate:g} (or to this, if lower) at the last.",
+)
+DAGGER_HOLD_GUARD_OPTION = typer.Option(
+    DaggerConfig.hold_guard,
+    "--dagger-hold-guard",
+    help="With --learner dagger: the policy plays its episodes through the hold guard, as `play` plays a general "
+    "policy of hands' parts (needs policies that observe their finger targets, e.g. --task parts).",
 )
 UNTIL_F1_OPTION = typer.Option(
     TrainConfig.until_f1,
@@ -188,6 +195,7 @@ def train(
     learner: Learner = LEARNER_OPTION,
     round_steps: int = ROUND_STEPS_OPTION,
     dagger_learning_rate: float = DAGGER_LEARNING_RATE_OPTION,
+    dagger_hold_guard: bool = DAGGER_HOLD_GUARD_OPTION,
     until_f1: Optional[float] = UNTIL_F1_OPTION,
     from_general: bool = FROM_GENERAL_OPTION,
     general_policy: Optional[Path] = GENERAL_POLICY_OPTION,
@@ -228,6 +236,7 @@ def train(
     keyboard, hand = (reading.keyboard, reading.hand) if read is None else (read.keyboard, read.fingers)
     settings = dict(steps=steps, seed=seed, learner=learner, round_steps=round_steps, until_f1=until_f1, envs=envs)
     settings |= dict(dagger_learning_rate=dagger_learning_rate, from_general=from_general, device=device)
+    settings |= dict(dagger_hold_guard=dagger_hold_guard)
     settings |= dict(control=control, reward=reward, explore=explore, exploration_steps=exploration_steps)
     settings |= dict(actor=actor, tactile=tactile, joints=joints, fingering_gate=fingering_gate, task=task)
     settings |= dict(finish=finish)
@@ -313,6 +322,7 @@ def _config(keyboard, hand, *, general_policy, task, **given) -> TrainConfig:
     """The run's :class:`~pianobot.learn.config.TrainConfig` from the options (``given``, by their
     parameter names), each value refused in the words of its option."""
     from pianobot.learn.train import TASK_EVAL_EPISODES
+    from pianobot.perform.guard import HoldGuard
     from pianobot.sim.hand import hand_config
     from pianobot.sim.keyboard import KeyboardConfig
 
@@ -337,6 +347,13 @@ def _config(keyboard, hand, *, general_policy, task, **given) -> TrainConfig:
             raise ValueError("a step size must be a number above 0")
         final = min(DaggerConfig.final_learning_rate, dagger_learning_rate)
         dagger = DaggerConfig(round_steps=round_steps, learning_rate=dagger_learning_rate, final_learning_rate=final)
+    if g["dagger_hold_guard"]:
+        if not HoldGuard.fits(env):
+            raise PianobotError(
+                "--dagger-hold-guard: the hold guard reads which finger holds a note from the finger targets: train a "
+                "policy that observes them with their holds (--task parts does), driven by --control velocity or position"
+            )
+        dagger = replace(dagger, hold_guard=True)
     with option("--exploration-steps", exploration_steps):
         sac = SACConfig(exploration_steps=exploration_steps, actor=value(actor) or SACConfig.actor)
     with option():
