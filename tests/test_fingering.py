@@ -148,6 +148,19 @@ def test_a_chord_wider_than_the_hand_is_a_clear_error():
         plan_fingering(Piece((Note(0, 60, 1), Note(0, 72, 1))))
 
 
+def test_a_chord_with_more_notes_than_fingers_offers_the_thumb_only_to_a_hand_without_one():
+    """Both hands are offered a reduction of the part (load.hand); only a hand without its thumb the thumb."""
+    from pianobot.errors import SettingError
+    from pianobot.sim.hand import default_fingers, hand_config
+
+    for spec, count in ((HandSpec(), 4), (default_fingers("pianist"), 6)):
+        chord = Piece(tuple(Note(0, 60 + 2 * i, 1) for i in range(count)))
+        with pytest.raises(SettingError) as refused:
+            Planner(KeyboardConfig(spec=KeyboardSpec(48, 37)), hand_config(spec)).plan(chord)
+        assert "load.hand right or load.hand left" in str(refused.value) and "load.hand" in refused.value.fields
+        assert ("enable the thumb" in str(refused.value)) == (1 not in spec.fingers)
+
+
 def test_ensure_fingering_keeps_given_fingering_unless_asked():
     piece = (
         melody("C4 D4 E4").with_fingers([4, 3, 2])

@@ -382,9 +382,8 @@ class Planner:
             said = f"{len(too_many)} notes start together at {too_many[0].onset:.3f} s ({', '.join(n.name for n in too_many)})"
             message = (
                 f"{said} but the hand has {len(self.fingers)} fingers: drop notes from that chord (e.g. with load.track), "
-                "let the part be reduced to what one hand can play (load.hand right or load.hand left), or enable the "
-                "thumb with hand.fingers"
-            )
+                "let the part be reduced to what one hand can play (load.hand right or load.hand left)"
+            ) + (", or enable the thumb with hand.fingers" if 1 not in self.fingers else "")
             raise SettingError(message, "hand.fingers", "load.track", "load.hand")
         reaches, back = [], [None]
         for i, chord in enumerate(chords):
