@@ -386,7 +386,9 @@ def test_the_keyboard_options_name_the_keys_each_hand_plays_on(tmp_path):
     assert run(*args, "--lowest-note", "C3", "--keys", "36").exit_code == 0
     hands = json.loads(report.read_text())["hands"]
     assert hands["right"]["played_as"] == "on C3-B5 (36 keys), the pianist hand"
-    assert hands["left"]["played_as"] == "mirrored about D, on C3-B5 (36 keys), the pianist hand"
+    assert (
+        hands["left"]["played_as"] == "mirrored about D, on F2-E5 (36 keys), the pianist hand"
+    )  # its mirror image's keys
     assert hands["left"]["f1"] == 1.0
 
 

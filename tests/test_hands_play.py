@@ -29,6 +29,23 @@ def test_a_window_maps_written_keys_onto_the_simulated_hand_and_back_keeping_the
     assert Window("left", KeyboardSpec(), 0).inward(36) > Window("left", KeyboardSpec(), 0).inward(48)
 
 
+def test_a_window_says_which_written_keys_it_plays_and_which_way_it_moved_them():
+    """What a hand's row says ('played as'): the piece's own keys, not its player's (a left hand's
+    player on C4-B5 plays the left hand's F2-E4), and the octave move in the piece's terms."""
+    keys = KeyboardSpec(60, 24)  # C4-B5, the player's keys
+    assert Window("right", keys, 0).written_keys() == keys and Window("right", keys, 0).moved() == ""
+    assert Window("left", keys, 0).written_keys() == KeyboardSpec(41, 24)  # F2-E4
+    # moved up onto the player's keys: the right hand's part was written an octave lower and sounds higher ...
+    assert Window("right", keys, 1).written_keys() == KeyboardSpec(48, 24)
+    assert Window("right", keys, 1).moved() == "played 1 octave higher"
+    # ... and the left hand's mirror image moved up stands for keys an octave higher, played lower
+    assert Window("left", keys, 1).written_keys() == KeyboardSpec(53, 24)  # F3-E5
+    assert Window("left", keys, 1).moved() == "played 1 octave lower"
+    for window in (Window("left", keys, -2), Window("right", keys, 3)):
+        for key in keys.pitches:
+            assert window.outward(key) in window.written_keys()
+
+
 def test_the_window_keeps_the_most_notes_on_the_keyboard_the_player_knows():
     bass = Piece(tuple(Note(i, p, i + 0.9, hand="left") for i, p in enumerate([36, 40, 43, 48, 55])))
     window = window_for(bass, "left", KeyboardSpec())  # mirrored: E6 C6 A5 E5 A4; C4-B5 is known

@@ -33,6 +33,22 @@ class Window:
         moved = pitch - OCTAVE * self.octaves
         return mirror_pitch(moved) if self.hand == "left" else moved
 
+    def written_keys(self) -> KeyboardSpec:
+        """The keys of the piece, at their written pitches, that this window's keys stand for: the
+        left hand's are the mirror image of its player's (the player's C4-B5 are the left hand's
+        F2-E4), and a window moved by octaves stands for keys as many octaves the other way."""
+        ends = (self.outward(self.keyboard.lowest), self.outward(self.keyboard.highest))
+        return KeyboardSpec(min(ends), self.keyboard.count)
+
+    def moved(self) -> str:
+        """How far the part was moved to be played, in the piece's own terms ('' where it was not):
+        'played 1 octave higher' (the left hand's part moved up in its mirror image sounds lower)."""
+        if not self.octaves:
+            return ""
+        higher = (self.octaves > 0) != (self.hand == "left")
+        count = abs(self.octaves)
+        return f"played {count} octave{'s' * (count > 1)} {'higher' if higher else 'lower'}"
+
 
 def window_for(part: Piece, hand: str, keyboard: KeyboardSpec | None, grow: bool = False) -> Window:
     """The window for ``hand``'s ``part``: on ``keyboard`` (a policy's) the octave shift that keeps

@@ -116,22 +116,18 @@ class HandPerformance:
         return " ".join([played.performer, *folders, *guarded])
 
     def describe(self) -> str:
-        """Where and with what the simulated hand played the part: 'mirrored about D, moved up 1
-        octave, on C4-B5 (24 keys)', and ', with its thumb' where the Allegro-like hand had one (another
-        hand model: ', the pianist hand')."""
-        moves = []
-        if self.hand == "left":
-            moves.append("mirrored about D")
-        if self.window.octaves:
-            octaves = abs(self.window.octaves)
-            moves.append(f"moved {'up' if self.window.octaves > 0 else 'down'} {octaves} octave{'s' * (octaves > 1)}")
+        """Where and with what the simulated hand played the part, in the piece's own keys: 'on C4-B5
+        (24 keys)', the left hand's 'mirrored about D, on F2-E4 (24 keys)' (its player is a right hand,
+        its part the mirror image), ', played 1 octave higher' where the part was moved onto its
+        player's keys, and ', with its thumb' where the Allegro-like hand had one (another hand model:
+        ', the pianist hand')."""
+        where = ["mirrored about D"] if self.hand == "left" else []
+        where.append(f"on {self.window.written_keys().describe()}")
+        if self.window.moved():
+            where.append(self.window.moved())
         spec = self.performance.plan.config.world.hand.spec
         thumb = [f"with its {FINGER_NAMES[1]}"] if 1 in spec.fingers else []
-        return ", ".join(
-            moves
-            + [f"on {self.window.keyboard.describe()}"]
-            + (thumb if spec.model == "allegro" else [f"the {spec.model} hand"])
-        )
+        return ", ".join(where + (thumb if spec.model == "allegro" else [f"the {spec.model} hand"]))
 
 
 @dataclass(frozen=True)
