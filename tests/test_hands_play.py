@@ -35,15 +35,17 @@ def test_a_window_says_which_written_keys_it_plays_and_which_way_it_moved_them()
     keys = KeyboardSpec(60, 24)  # C4-B5, the player's keys
     assert Window("right", keys, 0).written_keys() == keys and Window("right", keys, 0).moved() == ""
     assert Window("left", keys, 0).written_keys() == KeyboardSpec(41, 24)  # F2-E4
-    # moved up onto the player's keys: the right hand's part was written an octave lower and sounds higher ...
+    # moved up onto the player's keys: the right hand's part was written an octave lower than its player's keys ...
     assert Window("right", keys, 1).written_keys() == KeyboardSpec(48, 24)
-    assert Window("right", keys, 1).moved() == "played 1 octave higher"
-    # ... and the left hand's mirror image moved up stands for keys an octave higher, played lower
+    assert Window("right", keys, 1).moved() == "its player's keys 1 octave up"
+    # ... and the left hand's mirror image moved up stands for keys an octave higher than its unmoved
+    # mirror image (F2-E4): its player's keys lie an octave below the part's
     assert Window("left", keys, 1).written_keys() == KeyboardSpec(53, 24)  # F3-E5
-    assert Window("left", keys, 1).moved() == "played 1 octave lower"
+    assert Window("left", keys, 1).moved() == "its player's keys 1 octave down"
     for window in (Window("left", keys, -2), Window("right", keys, 3)):
-        for key in keys.pitches:
-            assert window.outward(key) in window.written_keys()
+        written = sorted(window.outward(key) for key in keys.pitches)
+        assert KeyboardSpec(written[0], len(written)) == window.written_keys()  # every key, end to end
+    assert Window("right", keys, -2).moved() == "its player's keys 2 octaves down"
 
 
 def test_the_window_keeps_the_most_notes_on_the_keyboard_the_player_knows():

@@ -41,13 +41,15 @@ class Window:
         return KeyboardSpec(min(ends), self.keyboard.count)
 
     def moved(self) -> str:
-        """How far the part was moved to be played, in the piece's own terms ('' where it was not):
-        'played 1 octave higher' (the left hand's part moved up in its mirror image sounds lower)."""
+        """Where its player's keys lie from the keys its window stands for (:meth:`written_keys`), in the
+        piece's own terms ('' where the part was not moved): "its player's keys 1 octave up". The part
+        sounds where it is written either way (what the player plays is read back at the written
+        pitches); a left hand's part moved up in its mirror image has its player's keys an octave down."""
         if not self.octaves:
             return ""
-        higher = (self.octaves > 0) != (self.hand == "left")
+        up = (self.octaves > 0) != (self.hand == "left")
         count = abs(self.octaves)
-        return f"played {count} octave{'s' * (count > 1)} {'higher' if higher else 'lower'}"
+        return f"its player's keys {count} octave{'s' * (count > 1)} {'up' if up else 'down'}"
 
 
 def window_for(part: Piece, hand: str, keyboard: KeyboardSpec | None, grow: bool = False) -> Window:

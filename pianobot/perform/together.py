@@ -118,8 +118,8 @@ class HandPerformance:
     def describe(self) -> str:
         """Where and with what the simulated hand played the part, in the piece's own keys: 'on C4-B5
         (24 keys)', the left hand's 'mirrored about D, on F2-E4 (24 keys)' (its player is a right hand,
-        its part the mirror image), ', played 1 octave higher' where the part was moved onto its
-        player's keys, and ', with its thumb' where the Allegro-like hand had one (another hand model:
+        its part the mirror image), ", its player's keys 1 octave up" where the part was moved onto
+        its player's keys, and ', with its thumb' where the Allegro-like hand had one (another hand model:
         ', the pianist hand')."""
         where = ["mirrored about D"] if self.hand == "left" else []
         where.append(f"on {self.window.written_keys().describe()}")
