@@ -139,6 +139,10 @@ def test_parts_too_far_apart_for_one_keyboard_play_apart_and_say_so():
     said = [str(w.message) for w in caught if issubclass(w.category, PianobotWarning)]
     assert any("more than a piano's 88" in line and "simulation of its own" in line for line in said), said
     assert not performance.together and performance.report().f1 == 1.0
+    # each row names the written keys its window stands for, and where its player's keys lie from them
+    right, left = sorted(performance.hands, key=lambda h: h.hand != "right")
+    assert right.describe() == "on C7-B8 (24 keys), its player's keys 3 octaves down"
+    assert left.describe() == "mirrored about D, on F0-E2 (24 keys), its player's keys 2 octaves up"
 
 
 def test_notes_outside_the_keys_named_are_said_and_count_as_missed():
