@@ -2,7 +2,7 @@
 scores, written to MIDI files and played as ``pianobot play`` plays them, against each file.
 
     pip install -e ".[corpus]"      # music21, which carries its corpus
-    python -m benchmarks.corpus [--set test|validation] [--out out/corpus] [--json out.json] [--only NAME ...]
+    python -m benchmarks.corpus [--set test|validation|more] [--out out/corpus] [--json out.json] [--only NAME ...]
                                 [--hold-guard | --no-hold-guard]
 
 Each excerpt is a piece's first measures (from :data:`EXCERPTS`' first measure), as many as keep
@@ -14,7 +14,8 @@ chorale's "Bass" is read as a left hand's track (its other voices go to the hand
 Nothing was chosen or tuned on these pieces: they were played once, as found. ``--set
 validation`` plays twelve other excerpts (:data:`VALIDATION`: three more of Clara Schumann's
 polonaises, her trio's piano part, two songs' accompaniments, six chorales), which no figure of
-the test set comes from: a setting is chosen on them, and the test set then says how it plays.
+the test set comes from: a setting is chosen on them, and the test set then says how it plays. ``--set more`` plays a second, larger test set added later
+(:data:`MORE`: 30 more chorales and five pieces of other kinds), which chose nothing either.
 
     python -m benchmarks.corpus --write-training out/chorales [--count 160]
 
@@ -96,7 +97,23 @@ VALIDATION = (
 )
 """Other excerpts, for choosing settings: none of the test set's pieces (the trio's and the songs'
 piano staves only)."""
-SETS = {"test": EXCERPTS, "validation": VALIDATION}
+MORE = tuple(
+    (path.split("/")[-1], path, None, 0)
+    for path in [f"bach/bwv{n}" for n in (265, 266, 267, 268, "27.6", 270, 271, 272, 273, 274, 275, 276, 277, 278)]
+    + [f"bach/bwv{n}" for n in (279, "28.6", 280, 281, 282, 283, 284, 285, 286, 287, 288, 289, "29.8", 290, 291, 292)]
+) + (
+    ("schumann-dichterliebe-2", "schumann_robert/dichterliebe_no2", (1, 2), 1),
+    ("verdi-la-donna-e-mobile", "verdi/laDonnaEMobile", (0, 1), 1),
+    ("weber-concertino", "weber/concertino_clarinet", (1, 2), 1),
+    ("johnson-lift-every-voice", "johnson_j_r/lift_every_voice", None, 1),
+    ("corelli-op3-1-grave", "corelli/opus3no1/1grave", None, 1),
+)
+"""A second test set, larger and added later (2026-12-07), that chose nothing: the 30 Bach chorales
+that come next by corpus path after the 160 :func:`write_training` writes (bwv265 to bwv292), and
+five pieces of other kinds: a song's piano staves (Schumann), an aria's piano reduction (Verdi), a
+concertino's piano reduction (Weber), a four-part hymn (Johnson) and a trio sonata's three parts
+(Corelli), which the hands play reduced."""
+SETS = {"test": EXCERPTS, "validation": VALIDATION, "more": MORE}
 TRAINING_COUNT = 160
 """Chorales :func:`write_training` writes by default: those the packaged thumb's policy was trained on."""
 MAX_NOTES = 150
@@ -160,7 +177,7 @@ def write_training(out: Path, count: int = TRAINING_COUNT, quartets: bool = Fals
     cannot excerpt is passed over (said)."""
     from music21 import corpus
 
-    used = {path for _, path, *_ in EXCERPTS + VALIDATION} | {"bach/bwv846"}
+    used = {path for _, path, *_ in EXCERPTS + VALIDATION + MORE} | {"bach/bwv846"}
     scores = [str(p).split("corpus/")[-1] for p in corpus.getComposer("bach")]
     found = {p.rsplit(".", 1)[0] for p in scores if p.endswith(".mxl")}
     chorales = [p for p in sorted(found) if p not in used]
@@ -301,9 +318,14 @@ def _share(general: float, scripted: float) -> str:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--set", choices=tuple(SETS), default="test", help="the test excerpts, or the validation ones")
     parser.add_argument(
-        "--out", type=Path, help="folder the excerpts are written to (default out/corpus, or out/corpus-validation)"
+        "--set",
+        choices=tuple(SETS),
+        default="test",
+        help="the test excerpts, the validation ones, or the larger second test set",
+    )
+    parser.add_argument(
+        "--out", type=Path, help="folder the excerpts are written to (default out/corpus, or out/corpus-SET)"
     )
     parser.add_argument("--only", nargs="+", default=(), help="only these excerpts (by name)")
     parser.add_argument("--json", type=Path, help="write every figure to this file")
@@ -364,7 +386,7 @@ def main() -> None:
     )  # (None: as play --hand-model allegro chooses)
     if args.hand_model is not None and args.hand_model != HandSpec.model:
         hand = default_fingers(args.hand_model)
-    out = args.out or Path("out/corpus" if args.set == "test" else "out/corpus-validation")
+    out = args.out or Path("out/corpus" if args.set == "test" else f"out/corpus-{args.set}")
     rows = play_corpus(out, tuple(args.only), not args.apart, hand, args.general, SETS[args.set], args.hold_guard)
     seconds = time.perf_counter() - started
     print()

@@ -317,3 +317,29 @@ def test_a_held_key_is_let_go_in_time_for_its_finger_s_far_move_to_strike_on_tim
     assert played(0.75).f1 == 1.0
     late = played(1.0)
     assert [(r.reference.pitch, r.reference.onset) for r in late.rows if r.played is None] == [(78, 1.0)]
+
+
+def test_a_chord_whose_finger_must_move_the_wrist_for_its_own_next_note_is_held_until_that_move_begins():
+    """C4 E4 G4 held by fingers 1, 3 and 5, then the little finger's own next note, D5, a sixth past the
+    thumb's C4, out of the hand's reach while the chord is held: every key of the chord lets go for it.
+    The pianist's hand lets go when the little finger's way there must begin (``lift_steps`` 0: that way
+    starts with its rise, and the wrist slides while the finger moves on), a control step later than
+    counting one more step for the rise before it (1, the Allegro-like hand's), and D5 still sounds on time."""
+    from pianobot.perform.perform import PLAY_CONFIG, perform
+    from pianobot.pianist.scripted import ScriptedPianist
+
+    hand = hand_config(FIVE)
+    config = replace(PLAY_CONFIG, world=replace(PLAY_CONFIG.world, hand=hand))
+    chord = [Note(0.0, pitch, 1.0, 80, finger) for pitch, finger in ((60, 1), (64, 3), (67, 5))]
+    piece = Piece((*chord, Note(1.0, 74, 1.5, 80, 5)), bpm=60)
+    assert tuning_for(hand).lift_steps == 0 and PianistTuning().lift_steps == 1
+
+    def played(lift: int):
+        tuning = replace(tuning_for(hand), lift_steps=lift)
+        report = perform(piece, lambda env: ScriptedPianist(env.config, tuning), config).report()
+        assert report.f1 == 1.0 and max(abs(r.onset_error) for r in report.rows) < 0.03
+        return {r.reference.pitch: r.played.offset for r in report.rows}
+
+    now, before = played(0), played(1)
+    for pitch in (60, 64, 67):
+        assert now[pitch] < 1.0 and now[pitch] - before[pitch] == pytest.approx(0.05, abs=0.01)

@@ -176,6 +176,12 @@ def test_the_corpus_options_reach_the_players(monkeypatch, tmp_path):
     assert asked["excerpts"] == corpus.VALIDATION and asked["folder"] == Path("out/corpus-validation")
     assert not {name for name, *_ in corpus.VALIDATION} & {name for name, *_ in corpus.EXCERPTS}
     assert not {path for _, path, *_ in corpus.VALIDATION} & {path for _, path, *_ in corpus.EXCERPTS}
+    monkeypatch.setattr(sys, "argv", ["corpus", "--set", "more"])
+    corpus.main()
+    assert asked["excerpts"] == corpus.MORE and asked["folder"] == Path("out/corpus-more")
+    paths = {path for _, path, *_ in corpus.MORE}
+    assert len(paths) == len(corpus.MORE) == 35  # (a second test set: none of the others' pieces)
+    assert not paths & {path for _, path, *_ in corpus.EXCERPTS + corpus.VALIDATION}
 
 
 def test_the_corpus_plays_the_general_policy_alone_with_no_hold_guard(monkeypatch, tmp_path):

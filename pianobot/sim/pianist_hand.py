@@ -40,6 +40,7 @@ PIANIST = HandModel(
         ("travel_share", 0.75),
         ("rise_before_repeat", True),
         ("repeat_rise", 0.001),
+        ("lift_steps", 0),
     ),
     passes=frozenset({(1, 2), (1, 3), (1, 4)}),
     written_fingering=True,
@@ -89,6 +90,8 @@ its notes. A finger that strikes again the key it has let go of rises from it fi
 for one finger did not sound. It strikes it again from 1 mm over the depth at which the key let its
 note go (``repeat_rise``), as a piano's key is struck again before it is all the way up, so the note
 before is held nearer its written end (risen to the ready height, a soft one was let go 0.15-0.3 s
-early)."""
+early). A holding finger whose own next strike needs the wrist elsewhere lets go when its way there
+must begin (``lift_steps`` 0): that way starts with its rise, and the wrist slides while the finger
+moves on, so one more step for the rise held every such chord's notes a step shorter."""
 
 register_hand_model(PIANIST)
