@@ -320,7 +320,7 @@ def test_a_held_key_is_let_go_in_time_for_its_finger_s_far_move_to_strike_on_tim
 
 
 def test_a_chord_whose_finger_must_move_the_wrist_for_its_own_next_note_is_held_until_that_move_begins():
-    """C4 E4 G4 held by fingers 1, 3 and 5, then the little finger's own next note, D5, a sixth past the
+    """C4 E4 G4 held by fingers 1, 3 and 5, then the little finger's own next note, D5, a ninth above the
     thumb's C4, out of the hand's reach while the chord is held: every key of the chord lets go for it.
     The pianist's hand lets go when the little finger's way there must begin (``lift_steps`` 0: that way
     starts with its rise, and the wrist slides while the finger moves on), a control step later than
