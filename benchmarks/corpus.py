@@ -14,8 +14,9 @@ chorale's "Bass" is read as a left hand's track (its other voices go to the hand
 Nothing was chosen or tuned on these pieces: they were played once, as found. ``--set
 validation`` plays twelve other excerpts (:data:`VALIDATION`: three more of Clara Schumann's
 polonaises, her trio's piano part, two songs' accompaniments, six chorales), which no figure of
-the test set comes from: a setting is chosen on them, and the test set then says how it plays. ``--set more`` plays a second, larger test set added later
-(:data:`MORE`: 30 more chorales and five pieces of other kinds), which chose nothing either.
+the test set comes from: a setting is chosen on them, and the test set then says how it plays.
+``--set more`` plays a second, larger test set added later (:data:`MORE`: 30 more chorales and
+five pieces of other kinds), which chose nothing either.
 
     python -m benchmarks.corpus --write-training out/chorales [--count 160]
 
@@ -97,11 +98,10 @@ VALIDATION = (
 )
 """Other excerpts, for choosing settings: none of the test set's pieces (the trio's and the songs'
 piano staves only)."""
-MORE = tuple(
-    (path.split("/")[-1], path, None, 0)
-    for path in [f"bach/bwv{n}" for n in (265, 266, 267, 268, "27.6", 270, 271, 272, 273, 274, 275, 276, 277, 278)]
-    + [f"bach/bwv{n}" for n in (279, "28.6", 280, 281, 282, 283, 284, 285, 286, 287, 288, 289, "29.8", 290, 291, 292)]
-) + (
+MORE_CHORALES = (265, 266, 267, 268, "27.6", 270, 271, 272, 273, 274, 275, 276, 277, 278, 279, "28.6", 280)
+MORE_CHORALES += (281, 282, 283, 284, 285, 286, 287, 288, 289, "29.8", 290, 291, 292)
+"""The chorales of :data:`MORE`: music21's next 30 by corpus path (bwvN) after those :func:`write_training` writes."""
+MORE = tuple((f"bwv{n}", f"bach/bwv{n}", None, 0) for n in MORE_CHORALES) + (
     ("schumann-dichterliebe-2", "schumann_robert/dichterliebe_no2", (1, 2), 1),
     ("verdi-la-donna-e-mobile", "verdi/laDonnaEMobile", (0, 1), 1),
     ("weber-concertino", "weber/concertino_clarinet", (1, 2), 1),
@@ -171,7 +171,7 @@ two hands play reduced, as in a quartet's piano reduction."""
 def write_training(out: Path, count: int = TRAINING_COUNT, quartets: bool = False) -> list[Path]:
     """Write excerpts of the first ``count`` Bach chorales of music21's corpus (its MusicXML files, by path, each
     from its first measure within the limits, as the test chorales are) to ``out``, none of the
-    test or validation pieces, nor the Well-Tempered Clavier's prelude: training pieces for
+    test, validation or second test set's pieces, nor the Well-Tempered Clavier's prelude: training pieces for
     ``pianobot train --task parts --pieces``; ``quartets``: then an excerpt of every movement of the
     string quartets of :data:`QUARTETS` (MusicXML), all four parts, from measure 1. A piece music21
     cannot excerpt is passed over (said)."""
