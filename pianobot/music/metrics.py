@@ -203,27 +203,14 @@ def compare(
 ) -> Report:
     """Score ``played`` against ``reference``; with ``pedals`` (the reference's sustain pedal, the
     performance's), where either is pressed, also the pedal's figures."""
-    _, transcription, transcription_velocity = _mir_eval()
     ref_int, ref_hz, ref_vel = _arrays(reference)
     out_int, out_hz, out_vel = _arrays(played)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")  # mir_eval warns about empty note lists; the figures say it
-        precision, recall, f1, _ = transcription.precision_recall_f1_overlap(
-            ref_int, ref_hz, out_int, out_hz, onset_tolerance=onset_tolerance, offset_ratio=None
-        )
-        _, _, f1_offsets, _ = transcription.precision_recall_f1_overlap(
-            ref_int, ref_hz, out_int, out_hz, onset_tolerance=onset_tolerance
-        )
-        _, _, velocity_f1, _ = transcription_velocity.precision_recall_f1_overlap(
-            ref_int, ref_hz, ref_vel, out_int, out_hz, out_vel, onset_tolerance=onset_tolerance, offset_ratio=None
-        )
-        pairs = (
-            transcription.match_notes(
-                ref_int, ref_hz, out_int, out_hz, onset_tolerance=onset_tolerance, offset_ratio=None
-            )
-            if len(reference) and len(played)
-            else []
-        )
+    pairs = match_notes(ref_int, ref_hz, out_int, out_hz, onset_tolerance)
+    precision, recall, f1 = _f1(len(pairs), len(reference), len(played))
+    f1_offsets = _f1(
+        len(match_notes(ref_int, ref_hz, out_int, out_hz, onset_tolerance, OFFSET_RATIO)), len(reference), len(played)
+    )[2]
+    velocity_f1 = _f1(_velocity_matches(pairs, ref_vel, out_vel), len(reference), len(played))[2]
 
     matched = {r: p for r, p in pairs}
     rows = [NoteRow(n, played.notes[matched[i]] if i in matched else None) for i, n in enumerate(reference.notes)]
@@ -265,18 +252,85 @@ def compare(
     )
 
 
+OFFSET_RATIO = 0.2
+"""A note's offset matches within this share of the reference note's length (at least 50 ms):
+mir_eval's default, the MIREX standard."""
+VELOCITY_TOLERANCE = 0.1
+"""mir_eval's: a matched note's velocity, rescaled to the reference's (least squares over the matched
+notes), is within this share of the reference's velocity range."""
+_BLOCK_GAP = 1e-3
+"""Onsets this much farther apart than the tolerance never match (mir_eval rounds onset distances to 1e-4 s)."""
+
+
+def _blocks(ref: np.ndarray, out: np.ndarray, tolerance: float) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Indices into ``ref`` and ``out`` (times, s) in groups that no match within ``tolerance`` joins:
+    all the times sorted together, split wherever two neighbours lie farther apart; groups of both."""
+    times = np.concatenate([ref, out])
+    order = np.argsort(times, kind="stable")
+    groups = np.split(order, np.flatnonzero(np.diff(times[order]) > tolerance + _BLOCK_GAP) + 1)
+    found = [(g[g < len(ref)], g[g >= len(ref)] - len(ref)) for g in groups]
+    return [(r, o) for r, o in found if len(r) and len(o)]
+
+
+def match_notes(
+    ref_int: np.ndarray,
+    ref_hz: np.ndarray,
+    out_int: np.ndarray,
+    out_hz: np.ndarray,
+    tolerance: float,
+    offset_ratio=None,
+) -> list[tuple[int, int]]:
+    """mir_eval's one-to-one note matching (``transcription.match_notes``: the same pitch, onsets within
+    ``tolerance``; with ``offset_ratio``, offsets too), as (reference, played) index pairs. Notes of
+    one pitch whose onsets lie farther apart than the tolerance never match, so mir_eval matches
+    each group of them alone: it compares every pair it is given, and a whole hour's notes at once
+    took gigabytes; this way memory follows the largest group, not the piece's length squared."""
+    _, transcription, _ = _mir_eval()
+    pairs: list[tuple[int, int]] = []
+    for hz in np.intersect1d(ref_hz, out_hz):  # (pitches from MIDI numbers: one frequency each)
+        ref_i, out_i = np.flatnonzero(ref_hz == hz), np.flatnonzero(out_hz == hz)
+        for r, o in _blocks(ref_int[ref_i, 0], out_int[out_i, 0], tolerance):
+            r, o = ref_i[r], out_i[o]
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                found = transcription.match_notes(
+                    ref_int[r], ref_hz[r], out_int[o], out_hz[o], onset_tolerance=tolerance, offset_ratio=offset_ratio
+                )
+            pairs += [(int(r[i]), int(o[j])) for i, j in found]
+    return sorted(pairs)
+
+
+def _f1(matched: int, references: int, played: int) -> tuple[float, float, float]:
+    """Precision, recall and F1 of ``matched`` notes (0 for all three where either piece has none, as mir_eval)."""
+    util, _, _ = _mir_eval()
+    if not references or not played:
+        return 0.0, 0.0, 0.0
+    precision, recall = matched / played, matched / references
+    return precision, recall, float(util.f_measure(precision, recall))
+
+
+def _velocity_matches(pairs: list[tuple[int, int]], ref_vel: np.ndarray, out_vel: np.ndarray) -> int:
+    """How many of the matched ``pairs`` are also as loud, as mir_eval's ``transcription_velocity``
+    judges it: the reference's velocities scaled to [0, 1], the played ones fitted to them by least
+    squares over the matched notes, each within :data:`VELOCITY_TOLERANCE`."""
+    if not pairs:
+        return 0
+    low, high = ref_vel.min(), ref_vel.max()
+    ref = (ref_vel - low) / float(max(1, high - low))
+    index = np.array(pairs)
+    target, given = ref[index[:, 0]], out_vel[index[:, 1]]
+    slope, intercept = np.linalg.lstsq(np.vstack([given, np.ones(len(given))]).T, target, rcond=None)[0]
+    return int((np.abs(slope * given + intercept - target) < VELOCITY_TOLERANCE).sum())
+
+
 def _pedal_figures(reference: Piece, played: Piece, pedals: tuple[Pedal, Pedal] | None, tolerance: float) -> dict:
     """The Report's pedal fields (empty where neither piece uses the pedal)."""
     if pedals is None or not any(pedals):
         return {}
-    _, transcription, _ = _mir_eval()
     ref_int, ref_hz, _ = _arrays(pedals[0].sounding(reference))
     out_int, out_hz, _ = _arrays(pedals[1].sounding(played))
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        _, _, sounding, _ = transcription.precision_recall_f1_overlap(
-            ref_int, ref_hz, out_int, out_hz, onset_tolerance=tolerance
-        )
+    matched = len(match_notes(ref_int, ref_hz, out_int, out_hz, tolerance, OFFSET_RATIO))
+    sounding = _f1(matched, len(ref_int), len(out_int))[2]
     f1, error = pedal_f1(*pedals, tolerance)
     return {
         "sounding_f1_with_offsets": float(sounding),
@@ -346,8 +400,9 @@ def pedal_f1(reference: Pedal, played: Pedal, tolerance: float = DEFAULT_ONSET_T
     for kind in (True, False):
         ref = np.array([t for t, down in reference.changes() if down is kind])
         out = np.array([t for t, down in played.changes() if down is kind])
-        for i, j in util.match_events(ref, out, tolerance):
-            hits += 1
-            errors.append(abs(ref[i] - out[j]))
+        for r, o in _blocks(ref, out, tolerance):  # (each group alone, as the notes)
+            for i, j in util.match_events(ref[r], out[o], tolerance):
+                hits += 1
+                errors.append(abs(ref[r][i] - out[o][j]))
     changes = 2 * (len(reference) + len(played))
     return 2 * hits / changes, float(np.mean(errors)) if errors else math.nan

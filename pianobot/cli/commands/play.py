@@ -288,8 +288,8 @@ def play_one(
         )
     performance = against_written_fingering(performance, read.part)
     plan = performance.plan
-    report = performance.report()
     write_midi(performance.played, output, name=f"pianobot ({plan.performer}): {song.stem}", pedal=performance.pedal)
+    report = performance.report()  # (after the performance is written: nothing played is lost to the scoring)
     atomic_write(report_path, json.dumps(performance.to_dict(), indent=2) + "\n")
     if json_path is not None:
         write_json(json_path, performance.to_dict())
