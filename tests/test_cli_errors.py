@@ -200,14 +200,47 @@ def test_an_interrupted_train_says_how_to_go_on(capsys):
         assert said.startswith("interrupted") and words in said and ("checkpoint" in said) == bool(words)
 
 
-def test_a_track_with_more_notes_at_once_than_fingers_points_to_the_option_that_reduces_it(tmp_path):
-    """One track is read as it is written and refused where the hand cannot play it; the line names
-    --hand, which reduces that part to what the hand can play, and that command plays."""
+def test_a_track_one_hand_cannot_play_is_played_by_both_and_hand_reduces_it_to_one(tmp_path):
+    """One track is read as a whole file of one track: where its hand cannot play it (a four-note chord
+    for three fingers), both hands play it, said in one line; --hand plays the hand's part reduced."""
     song = EXAMPLES / "minuet-performed.mid"  # (its right hand's track holds a four-note chord)
-    refused = run("play", song, "--track", "1", "-o", tmp_path / "a.mid", "--controller", "scripted")
-    assert refused.exit_code == 2 and "Traceback" not in refused.output
-    error = refused.stderr.strip().splitlines()[-1]  # (after the reading's warnings)
-    assert error.startswith("error: ") and "but the hand has 3 fingers" in error
-    assert "--hand right or --hand left" in error and "--track" in error
+    both = run(
+        "play", song, "--track", "1", "-o", tmp_path / "a.mid", "--controller", "scripted", "--hand-model", "allegro"
+    )
+    assert both.exit_code == 0, both.output
+    assert "name every note for the right hand, which cannot reach all of its chords" in both.output
+    assert {n.hand for n in read_midi(tmp_path / "a.mid").notes} == {"right", "left"}
     reduced = run("play", song, "--hand", "right", "-o", tmp_path / "b.mid", "--controller", "scripted")
     assert reduced.exit_code == 0, reduced.output
+
+
+def test_one_track_holding_both_hands_is_chosen_with_track_and_played_by_both(tmp_path, monkeypatch):
+    """--track names a song's piano track, both hands' notes in it (a chord two octaves wide): one hand
+    cannot play it, so both hands do, as a whole file's notes; the voice is left out."""
+    monkeypatch.chdir(tmp_path)
+    piano = [
+        (0, on(48)),
+        (0, on(72)),
+        (480, off(48)),
+        (480, off(72)),
+        (480, on(50)),
+        (480, on(74)),
+        (960, off(50)),
+        (960, off(74)),
+    ]
+    midi_file(tmp_path / "song.mid", [("Voice", [(0, on(79)), (960, off(79))]), ("Piano", piano)])
+    result = run("play", "song.mid", "--track", "Piano", "--controller", "scripted", "-o", "out.mid")
+    assert result.exit_code == 0, result.output
+    played = read_midi(tmp_path / "out.mid")
+    assert sorted(n.pitch for n in played.notes) == [48, 50, 72, 74]
+    assert {n.hand for n in played.notes} == {"right", "left"}
+
+
+def test_a_track_without_notes_and_notes_of_no_time_are_refused_in_one_line(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    midi_file(tmp_path / "song.mid", [("Piano", [(0, on(60)), (480, off(60))])])
+    assert_one_line_error(run("play", "song.mid", "--track", "0", "-o", "o.mid"), "no notes in track 0", "1 'Piano'")
+    # a tempo of 1 microsecond a beat: every note lasts under 1 ms; the file plays at a tempo given
+    midi_file(tmp_path / "fast.mid", [("Piano", [(0, on(60)), (480, off(60))])], tempo_events=((0, 1),))
+    assert_one_line_error(run("play", "fast.mid", "-o", "o.mid"), "every note of fast.mid lasts under 1 ms", "--tempo")
+    assert run("play", "fast.mid", "--tempo", "120", "--controller", "scripted", "-o", "o.mid").exit_code == 0

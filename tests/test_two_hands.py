@@ -97,3 +97,24 @@ def test_a_pig_sidecar_with_both_hands_gives_the_notes_of_an_unnamed_file_their_
     assert load_hands(path) == written
     slow = load_hands(path, LoadOptions(tempo=60, transpose=2))  # re-timed and moved: the hands stay
     assert [(n.pitch, n.offset, n.finger, n.hand) for n in slow] == [(50, 2.0, 5, "left"), (74, 1.0, 3, "right")]
+
+
+def test_a_voice_beside_the_piano_is_said_with_the_track_that_leaves_it_out(tmp_path):
+    """A song's file: a voice (General MIDI program 52, a choir) and a piano track. Its notes are played
+    by the hands as every track's are, but said, with the --track that plays the piano alone; a file
+    of instruments none of which is a keyboard (a quartet, reduced for the hands) is not."""
+    import mido
+
+    voice = [(0, mido.Message("program_change", program=52, channel=3))] + _track((74, 0, 1))
+    path = midi_file(tmp_path / "song.mid", [("Voice", voice), ("Piano", _track((48, 0, 1), (72, 0, 1)))])
+    piece, lines = warning_lines(load_hands, path)
+    assert len(piece) == 3
+    assert lines == [
+        "song.mid: track(s) 1 'Voice' (General MIDI ensemble) play no keyboard instrument, and their notes are "
+        "played by the hands too; to play the keyboard's alone, name its tracks with load.track 2"
+    ]
+    strings = [(0, mido.Message("program_change", program=40))]
+    quartet = midi_file(
+        tmp_path / "duo.mid", [("Violin", strings + _track((74, 0, 1))), ("Cello", strings + _track((48, 0, 1)))]
+    )
+    assert warning_lines(load_hands, quartet)[1] == []

@@ -266,6 +266,19 @@ def load_hands(path: str | Path | midi_io.MidiSource, options: LoadOptions = Loa
                     "their notes are given to the hands by the fingering planner"
                 )
             )
+        others = [t for t in unnamed if not t.keyboard]
+        keys = [t for t in tracks if t.keyboard or midi_io.track_hand(t.name)]
+        if options.track is None and others and keys:
+            said = ", ".join(
+                f"{t.index}{f' {quote(t.name, 30)!r}' if t.name else ''} (General MIDI {t.instrument})" for t in others
+            )
+            warnings.warn(
+                PianobotWarning(
+                    f"{path.name}: track(s) {said} play no keyboard instrument, and their notes are played by the hands "
+                    f"too; to play the keyboard's alone, name its tracks with load.track "
+                    f"{','.join(str(t.index) for t in keys)}"
+                )
+            )
     _check_keys(piece, path, options.transpose)
     crossing = _crossing(piece)
     if crossing:

@@ -71,6 +71,26 @@ class TrackInfo:
     low: int | None = None
     """Lowest and highest pitch played."""
     high: int | None = None
+    program: int | None = None
+    """The General MIDI program (0-127) its first program change sets, if any."""
+
+    @property
+    def instrument(self) -> str | None:
+        """Its General MIDI program's family ("strings", "reed"), None where it sets none."""
+        return None if self.program is None else GM_FAMILIES[self.program // 8]
+
+    @property
+    def keyboard(self) -> bool:
+        """Whether its General MIDI program is a keyboard's (a piano, a celesta, an organ; a track that
+        sets none plays General MIDI's default, the piano)."""
+        return self.program is None or self.program < 9 or 16 <= self.program < 24
+
+
+GM_FAMILIES = (
+    "piano", "chromatic percussion", "organ", "guitar", "bass", "strings", "ensemble", "brass",
+    "reed", "pipe", "synth lead", "synth pad", "synth effects", "ethnic", "percussive", "sound effects",
+)  # fmt: skip
+"""General MIDI's sixteen families of eight programs each, in program order."""
 
 
 def _absolute(track: mido.MidiTrack) -> list[tuple[int, mido.Message]]:
@@ -158,6 +178,7 @@ def list_tracks(midi: mido.MidiFile) -> list[TrackInfo]:
                 pedal,
                 min(pitches, default=None),
                 max(pitches, default=None),
+                next((m.program for m in track if m.type == "program_change"), None),
             )
         )
     return infos
@@ -215,6 +236,10 @@ def _select_tracks(midi: mido.MidiFile, track: str | int | None, path: Path) -> 
                 + f": choose one of the tracks with notes: {with_notes or 'none'} (several: separate them with commas)"
             )
         chosen += [index for index in hits if index not in chosen]
+    if not any(infos[i].notes for i in chosen):
+        raise PianobotError(
+            f"{path} has no notes in track {quote(whole)}: choose one of the tracks with notes: {with_notes or 'none'}"
+        )
     return sorted(chosen)
 
 
@@ -322,6 +347,7 @@ def read_midi(
         step = max(1, round(midi.ticks_per_beat * 4 * grid))
         snap = lambda tick: round(tick / step) * step  # noqa: E731
     notes: list[Note] = []
+    instant = 0  # notes dropped for lasting under 1 ms
     names = [info.name if midi.type == 1 else "" for info in list_tracks(midi)]  # type 0: a title
     chosen = tracks if tracks is not None else _select_tracks(midi, track, path)
     drums = sum(
@@ -382,8 +408,14 @@ def read_midi(
             onset, offset = seconds(on), seconds(off)
             if round(offset, 3) <= round(onset, 3):
                 warnings.warn(PianobotWarning(f"{pitch_name(pitch)} at {onset:.3f} s lasts under 1 ms; dropped"))
+                instant += 1
                 continue
             notes.append(Note(onset=onset, pitch=pitch, offset=offset, velocity=vel, finger=finger, hand=hand))
+    if instant and not notes:
+        raise SettingError(
+            f"every note of {path} lasts under 1 ms at the file's tempo: give the tempo to play it at with load.tempo",
+            "load.tempo",
+        )
     if drums and not notes:
         raise PianobotError(
             f"{path} holds only drum notes (MIDI channel 10, General MIDI's percussion), no piano keys: "

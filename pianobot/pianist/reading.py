@@ -385,8 +385,8 @@ def two_hands(
 ) -> HandsReading | None:
     """Both hands of the file at ``path`` where ``pianobot play`` plays both, else None (one hand).
 
-    Both hands, without ``options.hand`` and with ``options.track`` naming none or two or more
-    tracks of notes (only those read): a file with tracks named for hands (the others' notes
+    Both hands, without ``options.hand`` (with ``options.track``, only the tracks it names are
+    read, one as a whole file's notes): a file with tracks named for hands (the others' notes
     given hands by the fingering planner) or a PIG file, with notes for both; or a file one hand
     cannot play, whose notes the planner gives to both: wider than one hand's ``keyboard``, or
     refused by one hand's reading of the notes alone (notes off the keys, more at once than the
@@ -400,9 +400,6 @@ def two_hands(
     if options.track is not None:
         if path.suffix.lower() == ".txt":
             return None  # (one hand's reading refuses --track on a PIG file)
-        read = set(midi_io.selected_tracks(source, options.track))
-        if len([t for t in midi_io.describe_tracks(source) if t.notes and t.index in read]) < 2:
-            return None  # (one track: one hand's part, as before two hands)
     if path.suffix.lower() == ".txt" and (options.tempo or options.fingering or options.quantize):
         return None  # (one hand's reading refuses them in its own words)
     one_hand_refuses, fingered = "", False
