@@ -660,3 +660,11 @@ def test_score_says_which_option_a_low_score_may_lack(tmp_path):
         assert words in bare and f"played with {option}" in bare, bare
         same = run("score", played, song, option, value, "--no-notes").output
         assert "score it with the same option" not in same
+    # a performance played as written, scored with --transpose: the hint names no option, not its negative
+    played = tmp_path / "plain.mid"
+    assert run("play", song, "-o", played, "--controller", "scripted", "--quiet").exit_code == 0
+    wrong = " ".join(run("score", played, song, "--transpose", "2", "--no-notes").output.split())
+    assert "lie 2 semitones below the reference's as read with --transpose 2" in wrong
+    assert "played without --transpose, score it without" in wrong, wrong
+    slow = " ".join(run("score", played, song, "--tempo", "40", "--no-notes").output.split())
+    assert "read with --tempo 40: if the piece was played at another tempo, score it with that one" in slow, slow

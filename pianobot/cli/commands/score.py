@@ -75,7 +75,8 @@ def score(
     if scores.hands:
         console.print(display.hands_scores_table(scores))
     display.print_all(console, display.report_tables(report, every, None if notes else 0))
-    hint = mismatch_hint(reference_piece, played_piece, report.f1, onset_tolerance)
+    given = reading.options
+    hint = mismatch_hint(reference_piece, played_piece, report.f1, onset_tolerance, given.transpose, given.tempo)
     if hint:
         console.print(f"[yellow]{hint}[/yellow]", soft_wrap=True)
     if json_path is not None:
@@ -93,10 +94,14 @@ def score(
         console.print(f"report to open in a browser written to {said(html)}")
 
 
-def mismatch_hint(reference, played, f1: float, tolerance: float) -> str:
+def mismatch_hint(
+    reference, played, f1: float, tolerance: float, transpose: int = 0, tempo: float | None = None
+) -> str:
     """Where a performance scores low against its reference (note F1 under 0.5), what reading
     option may differ: every note shifted by the same interval (``--transpose``), or a performance
-    much longer or shorter than the reference (``--tempo``); '' where neither."""
+    much longer or shorter than the reference (``--tempo``); '' where neither. ``transpose`` and
+    ``tempo``: the options the reference was read with, so the hint names the value to give instead
+    (none, where the performance was played without one)."""
     if f1 >= 0.5 or not reference.notes or not played.notes:
         return ""
     import bisect
@@ -114,14 +119,16 @@ def mismatch_hint(reference, played, f1: float, tolerance: float) -> str:
 
     best = max(range(-48, 49), key=lambda shift: (matched(shift), -abs(shift)))
     if best != 0 and matched(best) >= 0.8 * min(len(played), len(reference)):
-        return (
-            f"{matched(best)} of the {len(played)} played notes lie {abs(best)} semitones {'above' if best > 0 else 'below'} "
-            f"the reference's: if the piece was played with --transpose {best}, score it with the same option"
-        )
+        lie = f"{matched(best)} of the {len(played)} played notes lie {abs(best)} semitones {'above' if best > 0 else 'below'} the reference's"
+        if transpose + best == 0:
+            return f"{lie} as read with --transpose {transpose}: if the piece was played without --transpose, score it without"
+        return f"{lie}: if the piece was played with --transpose {transpose + best}, score it with the same option"
     ratio = played.duration / reference.duration if reference.duration else 1.0
     if not 0.8 <= ratio <= 1.25:
-        return (
-            f"the performance lasts {played.duration:.1f} s and the reference {reference.duration:.1f} s: if the "
-            "piece was played with --tempo, score it with the same option"
-        )
+        lasts = f"the performance lasts {played.duration:.1f} s and the reference {reference.duration:.1f} s"
+        if tempo is not None:
+            return (
+                f"{lasts} read with --tempo {tempo:g}: if the piece was played at another tempo, score it with that one"
+            )
+        return f"{lasts}: if the piece was played with --tempo, score it with the same option"
     return ""
