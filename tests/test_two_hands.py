@@ -75,7 +75,8 @@ def test_three_unnamed_staves_are_read_as_one_part_said_in_one_line(tmp_path):
     )
     piece, lines = warning_lines(load_hands, path)
     assert lines == [
-        "satb.mid has 3 tracks of notes, 3 not named for a hand: their notes are given to the hands by the fingering planner"
+        "satb.mid has 3 tracks of notes, 3 not named for a hand: their notes are given to the hands by the fingering planner "
+        "(to play some of them alone, name those with load.track)"
     ]
     assert len(piece) == 3 and piece.hands == ()
 

@@ -263,7 +263,8 @@ def load_hands(path: str | Path | midi_io.MidiSource, options: LoadOptions = Loa
             warnings.warn(
                 PianobotWarning(
                     f"{path.name} has {len(tracks)} tracks of notes, {len(unnamed)} not named for a hand: "
-                    "their notes are given to the hands by the fingering planner"
+                    "their notes are given to the hands by the fingering planner (to play some of them alone, name those "
+                    "with load.track)"
                 )
             )
         others = [t for t in unnamed if not t.keyboard]
