@@ -425,3 +425,30 @@ def test_a_da_capo_is_said_not_taken(tmp_path):
     )
     _, piece, said = read(write(tmp_path / "dc.musicxml", score(part, names=["Piano"])))
     assert len(piece) == 2 and any("are not expanded" in line for line in said)
+
+
+def test_repeats_and_endings_are_written_out_with_the_pedal_marks_in_them(tmp_path):
+    """|: C5 D5 | 1. E5 F5 :| 2. G5 A5 | plays C5 D5 E5 F5 C5 D5 G5 A5, as a pianist plays it (it was
+    played once as written: the first and second endings back to back); a pedal mark in the repeated
+    measure is pressed on each pass. A da capo is still said and not taken (the test above)."""
+    attributes = (
+        "<attributes><divisions>2</divisions><time><beats>2</beats><beat-type>4</beat-type></time></attributes>"
+    )
+    forward = '<barline location="left"><repeat direction="forward"/></barline>'
+    pedal = '<direction><direction-type><pedal type="start"/></direction-type></direction>'
+    up = '<direction><direction-type><pedal type="stop"/></direction-type></direction>'
+    first = '<barline location="left"><ending number="1" type="start"/></barline>'
+    back = '<barline location="right"><ending number="1" type="stop"/><repeat direction="backward"/></barline>'
+    second = '<barline location="left"><ending number="2" type="start"/></barline>'
+    end = '<barline location="right"><ending number="2" type="discontinue"/></barline>'
+    part = [
+        attributes + forward + pedal + note("C5", 2) + note("D5", 2) + up,
+        first + note("E5", 2) + note("F5", 2) + back,
+        second + note("G5", 2) + note("A5", 2) + end,
+    ]
+    source, piece, said = read(write(tmp_path / "repeats.musicxml", score(part, names=["Piano"])))
+    assert [n.pitch for n in piece] == [72, 74, 76, 77, 72, 74, 79, 81]
+    assert [n.onset for n in piece] == [0.0, 0.5, 1.0, 1.5, 2.0, 2.5, 3.0, 3.5]
+    assert any("repeats are played as a pianist plays them" in line for line in said), said
+    downs = [round(t, 3) for t, down in read_pedal(source).changes() if down]
+    assert downs == [0.0, 2.0]

@@ -9,7 +9,9 @@ read or written) and rendered into an in-memory type 1 MIDI file, so that every 
   staff 2 "Left Hand"; a one-staff part keeps its part's name (a hand where the name says one, as
   for a MIDI track); other staves are named for their part and staff;
 - notes with their ties merged; grace notes and unpitched (percussion) notes left out, each said in
-  one line; tuplets at their true length; repeats played once as written, said in one line;
+  one line; tuplets at their true length; repeat signs and endings written out as a pianist plays
+  them (music21's ``expandRepeats``), said in one line; a score that jumps (da capo, dal segno), or
+  whose repeats music21 cannot follow, played once as written, said in one line;
 - each ``<fingering>`` 1-5 as the note's finger, written as lyric events in midi_io's convention
   (a chord's notes each their own); a mark such as "1-2" or "3_1" counts as its first finger, one
   that is no finger is dropped, each kind said in one line;
@@ -77,11 +79,31 @@ def open_musicxml(path: str | Path) -> MidiSource:
     except Exception as e:  # music21 raises many types on odd scores
         reason = quote(str(e).strip().splitlines()[0] if str(e).strip() else type(e).__name__)
         raise PianobotError(f"{path} is not a score pianobot can read ({reason}): re-export it as MusicXML") from None
-    return MidiSource(path, _render(score, tree, path))
+    return MidiSource(path, _render(*_expand_repeats(m21, score, tree), tree, path))
 
 
-def _render(score, tree: Score, path: Path) -> mido.MidiFile:
-    """The MIDI file of a music21 ``score`` (its pedal marks from ``tree``)."""
+def _expand_repeats(m21, score, tree: Score) -> tuple[object, dict[str, list] | None]:
+    """``score`` with its repeat signs and endings written out, as a pianist plays them (music21's
+    ``expandRepeats``), and each part's measure numbers as written (by which the pedal's marks are
+    placed again); ``score`` itself and None where it has none, where it jumps (da capo, dal segno:
+    not taken), where its measure numbers repeat, or where music21 cannot expand it."""
+    if not tree.repeats or tree.jumps:
+        return score, None
+    numbers = {
+        name: [m.number for m in staves[0].getElementsByClass("Measure")]
+        for name, staves in _score_parts(m21, score, tree)
+    }
+    if any(len(set(n)) != len(n) for n in numbers.values()):
+        return score, None
+    try:
+        return score.expandRepeats(), numbers
+    except Exception:  # music21 raises many types on repeats it cannot follow
+        return score, None
+
+
+def _render(score, numbers: dict[str, list] | None, tree: Score, path: Path) -> mido.MidiFile:
+    """The MIDI file of a music21 ``score`` (its pedal marks from ``tree``; ``numbers``: each part's
+    measure numbers as written, where ``score`` has its repeats written out)."""
     m21 = music21()
     said: dict[str, int] = defaultdict(int)
     tracks: list[mido.MidiTrack] = []
@@ -97,11 +119,12 @@ def _render(score, tree: Score, path: Path) -> mido.MidiFile:
         what = " (only percussion)" if said["percussion"] else ""
         raise PianobotError(f"{path} holds no pitched notes{what}: give a score with notes for the piano")
     tempo = _tempo_track(score, said)
+    said["expanded"] = numbers is not None
     _say(path, said, tree)
     midi = mido.MidiFile(type=1, ticks_per_beat=TICKS_PER_BEAT)
     midi.tracks.append(tempo)
     pedal_track = next((t for t in tracks if t.name == TRACK_NAMES["right"]), tracks[0])
-    _add_pedal(pedal_track, _pedal_times(parts, tree))
+    _add_pedal(pedal_track, _pedal_times(parts, tree, numbers))
     midi.tracks.extend(tracks)
     return midi
 
@@ -273,16 +296,24 @@ def _tempo_track(score, said: dict[str, int]) -> mido.MidiTrack:
     return _timed(mido.MidiTrack([mido.MetaMessage("track_name", name="Tempo")]), timed)
 
 
-def _pedal_times(parts: list[tuple[str, list]], tree: Score) -> list[tuple[Fraction, bool]]:
+def _pedal_times(
+    parts: list[tuple[str, list]], tree: Score, numbers: dict[str, list] | None = None
+) -> list[tuple[Fraction, bool]]:
     """The score's sustain pedal changes as (quarter notes from the start, down), placed by music21's
-    measures (``parts``: :func:`_score_parts`)."""
-    starts = {name: [m.offset for m in staves[0].getElementsByClass("Measure")] for name, staves in parts}
+    measures (``parts``: :func:`_score_parts`; ``numbers``: each part's measure numbers as written,
+    where the parts have their repeats written out: a mark is placed in every measure of its number)."""
     times = []
-    for mark in tree.pedal:
-        measures = starts.get(mark.part, [])
-        if mark.measure < len(measures):
-            times.append((Fraction(measures[mark.measure]) + mark.beats, mark.down))
-    return times
+    for name, staves in parts:
+        measures = staves[0].getElementsByClass("Measure")
+        for mark in (m for m in tree.pedal if m.part == name):
+            if numbers is None:
+                places = [measures[mark.measure].offset] if mark.measure < len(measures) else []
+            else:
+                written = numbers.get(name, [])
+                number = written[mark.measure] if mark.measure < len(written) else None
+                places = [m.offset for m in measures if number is not None and m.number == number]
+            times += [(Fraction(offset) + mark.beats, mark.down) for offset in places]
+    return sorted(times)
 
 
 def _add_pedal(track: mido.MidiTrack, pedal: list[tuple[Fraction, bool]]) -> None:
@@ -327,7 +358,11 @@ def _say(path: Path, said: dict[str, int], tree: Score) -> None:
         warnings.warn(
             PianobotWarning(f"{path.name}: left out {tree.cues} cue note(s) (another part's notes, not played)")
         )
-    if tree.repeats:
+    if tree.repeats and said.get("expanded"):
+        warnings.warn(
+            PianobotWarning(f"{path.name}: its repeats are played as a pianist plays them, each section again")
+        )
+    elif tree.repeats:
         warnings.warn(
             PianobotWarning(
                 f"{path.name}: its repeats (or its da capo, dal segno) are not expanded: it is played once, as written"

@@ -47,7 +47,9 @@ class Score:
     root: ET.Element
     pedal: list[PedalMark] = field(default_factory=list)
     repeats: bool = False
-    """Whether it has repeat signs, endings or jumps (:data:`JUMPS`; not expanded)."""
+    """Whether it has repeat signs, endings or jumps (:data:`JUMPS`)."""
+    jumps: bool = False
+    """Whether it has jumps (:data:`JUMPS`: not taken, so its repeats are not written out either)."""
     cues: int = 0
     """Cue notes left out (:func:`_silence_cues`)."""
 
@@ -71,9 +73,9 @@ def read_tree(path: Path) -> Score:
         for measure in part.iter("measure"):
             cues += _silence_cues(measure)
             _fix_fingering(measure)
-    repeats = any(True for _ in root.iter("repeat")) or any(True for _ in root.iter("ending"))
-    repeats = repeats or any(sound.get(jump) for sound in root.iter("sound") for jump in JUMPS)
-    return Score(root, _pedal(root), repeats, cues)
+    jumps = any(sound.get(jump) for sound in root.iter("sound") for jump in JUMPS)
+    repeats = jumps or any(True for _ in root.iter("repeat")) or any(True for _ in root.iter("ending"))
+    return Score(root, _pedal(root), repeats, jumps, cues)
 
 
 def _xml_bytes(path: Path) -> bytes:
