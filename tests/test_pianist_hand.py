@@ -343,32 +343,3 @@ def test_a_chord_whose_finger_must_move_the_wrist_for_its_own_next_note_is_held_
     now, before = played(0), played(1)
     for pitch in (60, 64, 67):
         assert now[pitch] < 1.0 and now[pitch] - before[pitch] == pytest.approx(0.05, abs=0.01)
-
-
-def test_a_key_repeated_faster_than_it_can_sound_again_is_reduced_whichever_fingers_take_turns():
-    """C5 every 60 ms: two fingers taking turns on it were given every note (the planner timed a repeat
-    only for one finger), and the key, which must rise to sound again, sounded 14 of 50. With
-    ``repeat_timing`` (the pianist's hand) a key struck again by any finger waits as long as by its own
-    finger (``hop_steps``), so the reduction leaves out what cannot sound, and what is given sounds;
-    without it (the Allegro-like hand's) the planner is as it was."""
-    from pianobot.perform.perform import PLAY_CONFIG, perform
-    from pianobot.pianist.reduce import reduce_part
-    from pianobot.pianist.scripted import ScriptedPianist
-
-    fast = Piece(tuple(Note(0.06 * i, 72, 0.06 * i + 0.05, 80) for i in range(30)), bpm=120)
-    keyboard = KeyboardSpec(60, 24)
-    assert tuning_for(hand_config(FIVE)).repeat_timing and not PianistTuning().repeat_timing
-    given = reduce_part(fast, keyboard, FIVE).piece
-    assert 8 <= len(given) <= 15  # (one strike in two or three control steps)
-    gaps = np.diff([n.onset for n in given])
-    planner = Planner(KeyboardConfig(spec=keyboard), hand_config(FIVE))
-    assert gaps.min() >= planner.strikes.hop_steps(12, 12, 80) * planner.strikes.dt - 1e-9
-    hand = hand_config(FIVE)
-    config = replace(PLAY_CONFIG, world=replace(PLAY_CONFIG.world, hand=hand, keyboard=KeyboardConfig(spec=keyboard)))
-    fingered = plan_fingering(given, KeyboardConfig(spec=keyboard), hand).piece
-    report = perform(fingered, lambda env: ScriptedPianist(env.config), config).report()
-    assert report.f1 == 1.0  # every repeat given sounds
-    turns = ((12,), (2,), (12,), (3,), 0.06, (80,))  # C5 by finger 2, then by finger 3 60 ms later
-    assert planner._fast_hop(*turns) == "fingers 2 then 3 must go from C5 to C5"
-    before = Planner(KeyboardConfig(spec=keyboard), hand, replace(tuning_for(hand), repeat_timing=False))
-    assert before._fast_hop(*turns) == ""  # (as the Allegro-like hand's planner still times it)

@@ -326,19 +326,22 @@ class Planner:
         return (move > limit + 1e-9) | ((move > farthest) & (move > leap_limit + 1e-9))
 
     def _fast_hop(
-        self, prev_keys: Sequence[int], fingers_prev: tuple, keys: Sequence[int], fingers: tuple, time, velocities
+        self,
+        prev_keys: Sequence[int],
+        fingers_prev: tuple,
+        keys: Sequence[int],
+        fingers: tuple,
+        time: float,
+        velocities: Sequence[int],
     ) -> str:
-        """'FINGER from KEY to KEY' where a finger must strike again (another key, or the same one; with
-        the tuning's ``repeat_timing``, a key struck again by any finger) sooner than the scripted pianist
-        can let go, move over, settle and strike at the new note's velocity
-        (:meth:`~pianobot.pianist.strikes.StrikePlanner.hop_steps`), else ''."""
-        turns, low = self.strikes.tuning.repeat_timing, self.spec.lowest
+        """'FINGER from KEY to KEY' where a finger must strike again (another key, or the same one)
+        sooner than the scripted pianist can let go, move over, settle and strike at the new note's
+        velocity (:meth:`~pianobot.pianist.strikes.StrikePlanner.hop_steps`), else ''."""
         for key_p, finger_p in zip(prev_keys, fingers_prev):
             for key, finger, velocity in zip(keys, fingers, velocities):
-                same = finger == finger_p or (turns and key == key_p)
-                if same and time < self.strikes.hop_steps(key_p, key, velocity) * self.strikes.dt - 1e-9:
-                    who = f"finger {finger}" if finger == finger_p else f"fingers {finger_p} then {finger}"
-                    return f"{who} must go from {pitch_name(low + key_p)} to {pitch_name(low + key)}"
+                if finger == finger_p and time < self.strikes.hop_steps(key_p, key, velocity) * self.strikes.dt - 1e-9:
+                    low = self.spec.lowest
+                    return f"finger {finger} must go from {pitch_name(low + key_p)} to {pitch_name(low + key)}"
         return ""
 
     def _outside(self, chord: Sequence[Note], low: float, high: float) -> np.ndarray:

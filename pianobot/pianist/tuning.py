@@ -113,12 +113,6 @@ class PianistTuning:
     it strikes (:meth:`~pianobot.pianist.strikes.StrikePlanner._approach`). Off, the default (the
     Allegro-like hand's, whose figures stay as measured), such a strike goes down from where the tip is:
     on a key that never rose, and the repeats do not sound."""
-    repeat_timing: bool = False
-    """Whether the fingering planner gives a key struck again by another finger no less time than by
-    the same finger (:meth:`~pianobot.pianist.strikes.StrikePlanner.hop_steps`): the key must rise to
-    sound again whichever finger strikes it. Off, the default (the Allegro-like hand's, whose figures
-    stay as measured), two fingers may take turns on one key at any speed, and the reduction leaves
-    no such repeat out."""
     repeat_rise: float = math.inf
     """How far over the depth at which a key lets its note go (the keyboard's ``release_fraction``) a
     finger that has just let go of the key rises before it strikes it again, as a piano's key is

@@ -41,7 +41,6 @@ PIANIST = HandModel(
         ("rise_before_repeat", True),
         ("repeat_rise", 0.001),
         ("lift_steps", 0),
-        ("repeat_timing", True),
     ),
     passes=frozenset({(1, 2), (1, 3), (1, 4)}),
     written_fingering=True,
@@ -93,9 +92,6 @@ note go (``repeat_rise``), as a piano's key is struck again before it is all the
 before is held nearer its written end (risen to the ready height, a soft one was let go 0.15-0.3 s
 early). A holding finger whose own next strike needs the wrist elsewhere lets go when its way there
 must begin (``lift_steps`` 0): that way starts with its rise, and the wrist slides while the finger
-moves on, so one more step for the rise held every such chord's notes a step shorter. A key struck
-again by another finger is given the planner's time for a repeat by the same finger
-(``repeat_timing``): whichever finger strikes it, the key must rise to sound again, and two fingers
-taking turns on a key every 60 ms were given every note and sounded 14 of 50."""
+moves on, so one more step for the rise held every such chord's notes a step shorter."""
 
 register_hand_model(PIANIST)
