@@ -452,3 +452,17 @@ def test_repeats_and_endings_are_written_out_with_the_pedal_marks_in_them(tmp_pa
     assert any("repeats are played as a pianist plays them" in line for line in said), said
     downs = [round(t, 3) for t, down in read_pedal(source).changes() if down]
     assert downs == [0.0, 2.0]
+
+
+def test_a_note_with_two_fingering_marks_is_read_by_its_first_and_said(tmp_path):
+    """Two <fingering> marks on one note (a substitution written as two marks: 3 strikes, then 2
+    holds) were read by the first and nothing said; an alternate mark is still dropped unsaid."""
+    marks = "<technical><fingering>3</fingering><fingering>2</fingering></technical>"
+    alternate = '<technical><fingering>4</fingering><fingering alternate="yes">1</fingering></technical>'
+    part = _one_staff([])
+    part[0] += note("C5", 2, notations=marks) + note("D5", 2, notations=alternate) + note("E5", 2, finger=5)
+    _, piece, said = read(write(tmp_path / "two.musicxml", score(part, names=["Piano"])))
+    assert [n.finger for n in piece] == [3, 4, 5]
+    assert [line for line in said if "two fingering marks" in line] == [
+        "two.musicxml: 1 note(s) with two fingering marks read by their first (a substitution's striking finger)"
+    ]

@@ -354,6 +354,13 @@ def _say(path: Path, said: dict[str, int], tree: Score) -> None:
                 n=said[kind], example=quote(str(said.get("example", "")), 20), tempo=said.get("tempo example")
             )
             warnings.warn(PianobotWarning(f"{path.name}: {text}"))
+    if tree.second_marks:
+        warnings.warn(
+            PianobotWarning(
+                f"{path.name}: {tree.second_marks} note(s) with two fingering marks read by their first (a "
+                "substitution's striking finger)"
+            )
+        )
     if tree.cues:
         warnings.warn(
             PianobotWarning(f"{path.name}: left out {tree.cues} cue note(s) (another part's notes, not played)")

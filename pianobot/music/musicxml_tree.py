@@ -52,6 +52,8 @@ class Score:
     """Whether it has jumps (:data:`JUMPS`: not taken, so its repeats are not written out either)."""
     cues: int = 0
     """Cue notes left out (:func:`_silence_cues`)."""
+    second_marks: int = 0
+    """Notes with a second fingering mark (not an alternate), read by their first (:func:`_fix_fingering`)."""
 
 
 def read_tree(path: Path) -> Score:
@@ -68,14 +70,14 @@ def read_tree(path: Path) -> Score:
         raise PianobotError(f"{path} holds no notes: give a score with notes for the piano")
     if notes > MAX_NOTES:
         raise PianobotError(f"{path} holds {notes:,} notes, more than {MAX_NOTES:,}: that is not a piano piece; cut it")
-    cues = 0
+    cues = second = 0
     for part in root.iter("part"):
         for measure in part.iter("measure"):
             cues += _silence_cues(measure)
-            _fix_fingering(measure)
+            second += _fix_fingering(measure)
     jumps = any(sound.get(jump) for sound in root.iter("sound") for jump in JUMPS)
     repeats = jumps or any(True for _ in root.iter("repeat")) or any(True for _ in root.iter("ending"))
-    return Score(root, _pedal(root), repeats, jumps, cues)
+    return Score(root, _pedal(root), repeats, jumps, cues, second)
 
 
 def _xml_bytes(path: Path) -> bytes:
@@ -152,16 +154,18 @@ def _silence_cues(measure: ET.Element) -> int:
     return count
 
 
-def _fix_fingering(measure: ET.Element) -> None:
+def _fix_fingering(measure: ET.Element) -> int:
     """Each note's alternate and second fingering marks removed, and a chord with marks given a
-    placeholder "-" on each unfingered note, so that music21 keeps each mark with its note."""
+    placeholder "-" on each unfingered note, so that music21 keeps each mark with its note; how many
+    notes had a second mark (not an alternate: a substitution's, whose first finger strikes)."""
     chords: list[list[ET.Element]] = []
+    second = 0
     for note in measure.findall("note"):
         for technical in note.findall("notations/technical"):
             marks = technical.findall("fingering")
-            for mark in [m for m in marks if m.get("alternate") == "yes"] + [
-                m for m in marks if m.get("alternate") != "yes"
-            ][1:]:
+            others = [m for m in marks if m.get("alternate") != "yes"][1:]
+            second += bool(others)
+            for mark in [m for m in marks if m.get("alternate") == "yes"] + others:
                 technical.remove(mark)
         if note.find("chord") is not None and chords:
             chords[-1].append(note)
@@ -179,6 +183,7 @@ def _fix_fingering(measure: ET.Element) -> None:
                     if technical is None:
                         technical = ET.SubElement(notations, "technical")
                     ET.SubElement(technical, "fingering").text = "-"
+    return second
 
 
 def _pedal(root: ET.Element) -> list[PedalMark]:
