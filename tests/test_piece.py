@@ -111,3 +111,11 @@ def test_mirroring_a_left_hand_part_gives_a_right_hand_part():
     assert [(n.pitch, n.finger, n.hand) for n in mirrored] == [(76, 1, "right"), (81, 5, "right")]
     assert mirrored.mirror() == left
     assert Piece((Note(0, 60, 1),)).mirror().notes[0].hand is None
+
+
+@pytest.mark.parametrize("onset, offset", [(0.0, -1.797693134862316e305), (-1e300, 1.0), (float("nan"), 1.0)])
+def test_times_far_out_of_range_are_one_clear_error(onset, offset):
+    """A PIG file's offset of -1.8e305 s overflowed rounding to milliseconds (a traceback, found by the
+    fuzz test); every such time is now said as what it is."""
+    with pytest.raises(PianobotError, match="times must be"):
+        Note(onset=onset, pitch=60, offset=offset)

@@ -110,6 +110,8 @@ class Note:
                 raise PianobotError(
                     f"note {pitch_name(self.pitch)} has {name} {value!r}: times must be finite numbers of seconds"
                 )
+            if value < -MAX_SECONDS:  # (far before the start: no rounding to milliseconds holds it)
+                raise PianobotError(f"note {pitch_name(self.pitch)} has {name} {value:.3g} s: times must be >= 0")
             if value > MAX_SECONDS:
                 raise PianobotError(
                     f"note {pitch_name(self.pitch)} has {name} {value:.3f} s, after {MAX_SECONDS / 60:.0f} minutes: "
