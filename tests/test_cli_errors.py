@@ -238,8 +238,9 @@ def test_one_track_holding_both_hands_is_chosen_with_track_and_played_by_both(tm
 
 def test_a_track_without_notes_and_notes_of_no_time_are_refused_in_one_line(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
-    midi_file(tmp_path / "song.mid", [("Piano", [(0, on(60)), (480, off(60))])])
+    midi_file(tmp_path / "song.mid", [("Piano", [(0, on(60)), (480, off(60))]), ("Words", [])])
     assert_one_line_error(run("play", "song.mid", "--track", "0", "-o", "o.mid"), "no notes in track 0", "1 'Piano'")
+    assert_one_line_error(run("play", "song.mid", "--track", "Words", "-o", "o.mid"), "no notes in track Words")
     # a tempo of 1 microsecond a beat: every note lasts under 1 ms; the file plays at a tempo given
     midi_file(tmp_path / "fast.mid", [("Piano", [(0, on(60)), (480, off(60))])], tempo_events=((0, 1),))
     assert_one_line_error(run("play", "fast.mid", "-o", "o.mid"), "every note of fast.mid lasts under 1 ms", "--tempo")

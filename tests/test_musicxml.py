@@ -466,3 +466,18 @@ def test_a_note_with_two_fingering_marks_is_read_by_its_first_and_said(tmp_path)
     assert [line for line in said if "two fingering marks" in line] == [
         "two.musicxml: 1 note(s) with two fingering marks read by their first (a substitution's striking finger)"
     ]
+
+
+def test_repeats_with_a_da_capo_written_as_words_are_played_once_as_written(tmp_path):
+    """music21 takes a "D.C. al Fine" written as words; pianobot takes no jump, so such a score's
+    repeats are not written out either: played once, as written, said."""
+    attributes = (
+        "<attributes><divisions>2</divisions><time><beats>2</beats><beat-type>4</beat-type></time></attributes>"
+    )
+    forward = '<barline location="left"><repeat direction="forward"/></barline>'
+    back = '<barline location="right"><repeat direction="backward"/></barline>'
+    words = "<direction><direction-type><words>D.C. al Fine</words></direction-type></direction>"
+    part = [attributes + forward + note("C5", 2) + note("D5", 2) + back, note("E5", 2) + note("F5", 2) + words]
+    _, piece, said = read(write(tmp_path / "dc.musicxml", score(part, names=["Piano"])))
+    assert [n.pitch for n in piece] == [72, 74, 76, 77]
+    assert any("are not expanded: it is played once, as written" in line for line in said), said

@@ -114,6 +114,21 @@ def test_a_voice_beside_the_piano_is_said_with_the_track_that_leaves_it_out(tmp_
         "song.mid: track(s) 1 'Voice' (General MIDI ensemble) play no keyboard instrument, and their notes are "
         "played by the hands too; to play the keyboard's alone, name its tracks with load.track 2"
     ]
+    # a chorale whose voices set voice programs ("Bass" names a hand, but sings): no keyboard, nothing said
+    choir = [(0, mido.Message("program_change", program=52))]
+    satb = [
+        (name, choir + _track((p, 0, 1))) for name, p in (("Soprano", 72), ("Alto", 67), ("Tenor", 60), ("Bass", 48))
+    ]
+    assert not [
+        line for line in warning_lines(load_hands, midi_file(tmp_path / "satb.mid", satb))[1] if "keyboard" in line
+    ]
+    # a piano beside an electric bass named "Bass" (program 33): the bass is said, by its program
+    bass = [(0, mido.Message("program_change", program=33))] + _track((40, 0, 1))
+    band = midi_file(tmp_path / "band.mid", [("Piano", _track((72, 0, 1))), ("Bass", bass)])
+    assert [line for line in warning_lines(load_hands, band)[1] if "keyboard" in line] == [
+        "band.mid: track(s) 2 'Bass' (General MIDI bass) play no keyboard instrument, and their notes are played by "
+        "the hands too; to play the keyboard's alone, name its tracks with load.track 1"
+    ]
     strings = [(0, mido.Message("program_change", program=40))]
     quartet = midi_file(
         tmp_path / "duo.mid", [("Violin", strings + _track((74, 0, 1))), ("Cello", strings + _track((48, 0, 1)))]

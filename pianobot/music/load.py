@@ -267,8 +267,8 @@ def load_hands(path: str | Path | midi_io.MidiSource, options: LoadOptions = Loa
                     "with load.track)"
                 )
             )
-        others = [t for t in unnamed if not t.keyboard]
-        keys = [t for t in tracks if t.keyboard or midi_io.track_hand(t.name)]
+        others = [t for t in tracks if not t.keyboard]  # (by program alone: a chorale's "Bass" is a voice)
+        keys = [t for t in tracks if t.keyboard]
         if options.track is None and others and keys:
             said = ", ".join(
                 f"{t.index}{f' {quote(t.name, 30)!r}' if t.name else ''} (General MIDI {t.instrument})" for t in others

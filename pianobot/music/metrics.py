@@ -268,7 +268,7 @@ def _blocks(ref: np.ndarray, out: np.ndarray, tolerance: float) -> list[tuple[np
     times = np.concatenate([ref, out])
     order = np.argsort(times, kind="stable")
     groups = np.split(order, np.flatnonzero(np.diff(times[order]) > tolerance + _BLOCK_GAP) + 1)
-    found = [(g[g < len(ref)], g[g >= len(ref)] - len(ref)) for g in groups]
+    found = [(np.sort(g[g < len(ref)]), np.sort(g[g >= len(ref)] - len(ref))) for g in groups]  # (in index order)
     return [(r, o) for r, o in found if len(r) and len(o)]
 
 

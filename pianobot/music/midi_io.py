@@ -131,7 +131,7 @@ def _select_tracks(midi: mido.MidiFile, track: str | int | None, path: Path) -> 
     whole = str(track).strip()
     named = [t.index for t in infos if whole and t.name.strip().lower() == whole.lower()]
     if named:  # (a name may hold a comma: the whole value first)
-        return named
+        return _with_notes(named, infos, whole, with_notes, path)
     chosen: list[int] = []
     for key in (part.strip() for part in whole.split(",")):
         if key.isdigit() and int(key) < len(infos):
@@ -145,11 +145,16 @@ def _select_tracks(midi: mido.MidiFile, track: str | int | None, path: Path) -> 
                 + f": choose one of the tracks with notes: {with_notes or 'none'} (several: separate them with commas)"
             )
         chosen += [index for index in hits if index not in chosen]
+    return _with_notes(sorted(chosen), infos, whole, with_notes, path)
+
+
+def _with_notes(chosen: list[int], infos: list[TrackInfo], whole: str, with_notes: str, path: Path) -> list[int]:
+    """``chosen``, where one of those tracks has notes; else one line naming the tracks that have."""
     if not any(infos[i].notes for i in chosen):
         raise PianobotError(
             f"{path} has no notes in track {quote(whole)}: choose one of the tracks with notes: {with_notes or 'none'}"
         )
-    return sorted(chosen)
+    return chosen
 
 
 def _track_notes(

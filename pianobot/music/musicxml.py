@@ -87,7 +87,8 @@ def _expand_repeats(m21, score, tree: Score) -> tuple[object, dict[str, list] | 
     ``expandRepeats``), and each part's measure numbers as written (by which the pedal's marks are
     placed again); ``score`` itself and None where it has none, where it jumps (da capo, dal segno:
     not taken), where its measure numbers repeat, or where music21 cannot expand it."""
-    if not tree.repeats or tree.jumps:
+    words = any(True for _ in score.recurse().getElementsByClass(m21.repeat.RepeatExpression))
+    if not tree.repeats or tree.jumps or words:  # (a jump written as words, "D.C. al Fine", music21 would take)
         return score, None
     numbers = {
         name: [m.number for m in staves[0].getElementsByClass("Measure")]

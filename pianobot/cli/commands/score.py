@@ -128,7 +128,8 @@ def mismatch_hint(
         lasts = f"the performance lasts {played.duration:.1f} s and the reference {reference.duration:.1f} s"
         if tempo is not None:
             return (
-                f"{lasts} read with --tempo {tempo:g}: if the piece was played at another tempo, score it with that one"
+                f"{lasts} read with --tempo {tempo:g}: if the piece was played at another tempo, score it with that "
+                "one, or without --tempo if it was played without"
             )
         return f"{lasts}: if the piece was played with --tempo, score it with the same option"
     return ""
