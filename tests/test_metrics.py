@@ -47,17 +47,19 @@ def test_exact_figures_for_a_known_set_of_mistakes(reference):
     assert [r.played is None for r in report.rows].count(True) == 1
 
 
+def arrays(piece):
+    """A piece as mir_eval takes it: intervals, frequencies, velocities."""
+    return (
+        np.array([[n.onset, n.offset] for n in piece]),
+        mir_eval.util.midi_to_hz(np.array([n.pitch for n in piece], dtype=float)),
+        np.array([n.velocity for n in piece], dtype=float),
+    )
+
+
 def test_figures_agree_with_mir_eval_called_directly(reference):
     played = flawed(reference)
     played = Piece(played.notes + (Note(2.5, 71, 3.0, 50),))  # an extra note too
     report = compare(reference, played, onset_tolerance=0.02)
-
-    def arrays(piece):
-        return (
-            np.array([[n.onset, n.offset] for n in piece]),
-            mir_eval.util.midi_to_hz(np.array([n.pitch for n in piece], dtype=float)),
-            np.array([n.velocity for n in piece], dtype=float),
-        )
 
     (ri, rp, rv), (ei, ep, ev) = arrays(reference), arrays(played)
     p, r, f, _ = mir_eval.transcription.precision_recall_f1_overlap(
@@ -108,13 +110,6 @@ def test_notes_matched_group_by_group_score_as_mir_eval_matching_them_all_at_onc
     tolerance): the figures of mir_eval given every note at once, on performances with near misses."""
     reference, played = _performed(seed, 400)
     report = compare(reference, played)
-
-    def arrays(piece):
-        return (
-            np.array([[n.onset, n.offset] for n in piece]),
-            mir_eval.util.midi_to_hz(np.array([n.pitch for n in piece], dtype=float)),
-            np.array([n.velocity for n in piece], dtype=float),
-        )
 
     (ri, rp, rv), (ei, ep, ev) = arrays(reference), arrays(played)
     p, r, f, _ = mir_eval.transcription.precision_recall_f1_overlap(ri, rp, ei, ep, offset_ratio=None)
