@@ -32,7 +32,7 @@ def test_help_is_whole_at_80_columns(command):
     assert "…" not in result.output
     words = " ".join(result.output.split())
     for param in typer.main.get_command(app).commands[command].params:
-        if param.help:
+        if param.help and not getattr(param, "hidden", False):  # (a hidden option's help is not shown)
             assert " ".join(param.help.split()) in words.replace("- ", "-"), param.help
 
 
@@ -158,6 +158,24 @@ def test_play_json_notes_and_quiet(tmp_path):
     assert quiet.exit_code == 0 and quiet.output.strip().splitlines() == [
         f"performance written to {tmp_path / 'o.mid'}, report to {tmp_path / 'o.report.json'}"
     ]
+
+
+def test_score_prints_the_first_rows_of_its_per_note_table(tmp_path):
+    from pianobot.cli.commands.score import SCORE_NOTES
+    from pianobot.music.midi_out import write_midi
+    from pianobot.music.piece import Note, Piece
+
+    long = tmp_path / "long.mid"  # more notes than the default shows
+    write_midi(Piece(tuple(Note(0.25 * i, 60 + i % 12, 0.25 * i + 0.2, 64) for i in range(SCORE_NOTES + 15))), long)
+    rows = lambda result: sum(line.startswith("│ C") or line.startswith("│ D") for line in result.output.splitlines())
+    default = run("score", long, long)
+    assert default.exit_code == 0, default.output
+    assert f"the first {SCORE_NOTES} of {SCORE_NOTES + 15} notes; --notes N shows N" in default.output
+    assert 0 < rows(default) <= SCORE_NOTES  # (the rows of C and D among them)
+    every = run("score", long, long, "--notes", str(SCORE_NOTES + 15))
+    assert rows(every) > rows(default) and "--notes N shows N" not in every.output
+    for none in (("--notes", "0"), ("--no-notes",)):  # (--no-notes: older scripts' spelling)
+        assert "per note" not in run("score", long, long, *none).output
 
 
 def test_the_first_screen_explains_a_few_figures_and_all_shows_the_rest(scale_file):

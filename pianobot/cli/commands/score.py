@@ -21,6 +21,9 @@ from pianobot.errors import PianobotError
 from pianobot.files import check_writable
 from pianobot.music.metrics import DEFAULT_ONSET_TOLERANCE
 
+SCORE_NOTES = 20
+"""Rows of the per-note table ``score`` prints unless ``--notes N`` says (every row goes to ``--json``)."""
+
 
 @reads(without=("refinger", "lowest_note", "keys"))
 def score(
@@ -36,7 +39,10 @@ def score(
         None, "--plot", help="Draw both piano rolls with the errors marked to this PNG file."
     ),
     html: Optional[Path] = HtmlReport,
-    notes: bool = typer.Option(True, "--notes/--no-notes", help="Print the per-note table."),
+    notes: int = typer.Option(
+        SCORE_NOTES, "--notes", min=0, metavar="N", help="Print the per-note table's first N rows (0: none)."
+    ),
+    no_notes: bool = typer.Option(False, "--no-notes", hidden=True, help="The same as --notes 0 (older scripts)."),
     every: bool = AllFigures,
     reading: Reading = None,
 ):
@@ -74,7 +80,7 @@ def score(
     report = scores.whole
     if scores.hands:
         console.print(display.hands_scores_table(scores))
-    display.print_all(console, display.report_tables(report, every, None if notes else 0))
+    display.print_all(console, display.report_tables(report, every, 0 if no_notes else notes))
     given = reading.options
     hint = mismatch_hint(reference_piece, played_piece, report.f1, onset_tolerance, given.transpose, given.tempo)
     if hint:
