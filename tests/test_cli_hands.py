@@ -258,13 +258,20 @@ def test_notes_beyond_the_pianos_keys_are_one_line_named_or_not(tmp_path):
     # the octaves it suggests count a transposition already given in
     low = _one_track(tmp_path / "low.mid", (21, 0, 1), (33, 1, 2))
     assert_one_line_error(run("inspect", low, "--transpose", "-12"), "beyond the piano's 88 keys", "--transpose 0")
-    # inspect says the same, whatever keyboard is named: no keyboard widens past the piano
+    # one hand's part that a shift fits is refused so too, not sent to widen a keyboard past the piano
+    line = assert_one_line_error(
+        run("play", named, "--hand", "right", "-o", tmp_path / "out.mid"),
+        "beyond the piano's 88 keys",
+        "--transpose -12",
+    )
+    assert "widen the keyboard" not in line
+    # notes no shift fits (C-1 and G9 lie 127 keys apart) are played the fewest octaves in, said in one line
     lowest_and_highest = _one_track(tmp_path / "ends.mid", (0, 0, 1), (127, 1, 2))
-    for keys in ((), ("--lowest-note", "A0", "--keys", "88")):
-        line = assert_one_line_error(
-            run("inspect", lowest_and_highest, *keys), "beyond the piano's 88 keys", "cut notes"
-        )
-        assert "widen the keyboard" not in line
+    result = run("play", lowest_and_highest, "-o", tmp_path / "out.mid", "--controller", "scripted")
+    assert result.exit_code == 0, result.output
+    said = [line for line in result.stderr.splitlines() if "beyond the piano" in line]
+    assert len(said) == 1 and "C-1 at 0.000 s as C1, G9 at 0.500 s as G7" in said[0], result.stderr
+    assert json.loads((tmp_path / "out.report.json").read_text())["reference_notes"] == 2
 
 
 def test_more_notes_at_once_than_two_hands_have_fingers_are_thinned_in_one_line(tmp_path):

@@ -8,7 +8,7 @@ import pytest
 from conftest import midi_file, off, on
 
 from pianobot.errors import PianobotWarning, SettingError
-from pianobot.music.load import LoadOptions, load_hands
+from pianobot.music.load import LoadOptions, load_hands, load_piece
 from pianobot.music.piece import Note, Piece
 from pianobot.music.pig import write_pig
 from pianobot.pianist.assign import load_two_hands
@@ -42,6 +42,24 @@ def test_notes_beyond_the_pianos_keys_are_refused_with_the_shift_that_fits(tmp_p
         load_hands(path)
     assert e.value.field == "load.transpose"
     assert [n.pitch for n in load_hands(path, LoadOptions(transpose=-12))] == [98, 48]
+
+
+def test_notes_beyond_the_pianos_keys_no_shift_fits_are_played_octaves_in(tmp_path):
+    # A#-1 and G9 lie 116 keys apart: no octave shift brings both on, so each comes the fewest octaves in,
+    # the A#-1 (A#0) dropped where the file's own A#0 already sounds, and the reading says so in one line
+    left, right = _track((10, 0, 1), (22, 0, 2)), _track((60, 0, 1), (127, 1, 2))
+    path = midi_file(tmp_path / "wide.mid", [("Right Hand", right), ("Left Hand", left)])
+    with pytest.warns(PianobotWarning) as said:
+        piece = load_hands(path)
+    assert sorted((n.pitch, n.onset, n.hand) for n in piece) == [
+        (22, 0.0, "left"),
+        (60, 0.0, "right"),
+        (103, 0.5, "right"),
+    ]
+    lines = [str(w.message) for w in said if "beyond the piano" in str(w.message)]
+    assert len(lines) == 1 and "G9 at 0.500 s as G7" in lines[0] and "1 dropped" in lines[0], lines
+    # one hand's reading (load_piece) plays them so too; where a shift fits, nothing is moved and the reading refuses
+    assert sorted(n.pitch for n in load_piece(path)) == [22, 60, 103]
 
 
 def test_hands_that_cross_are_said_in_one_line_and_the_planner_gives_the_hands(tmp_path):

@@ -8,7 +8,7 @@ from pathlib import Path
 
 from pianobot.errors import PianobotError, PianobotWarning, SettingError, quote
 from pianobot.music import midi_io, pig
-from pianobot.music.instrument import HandSpec, beyond_piano
+from pianobot.music.instrument import PIANO, HandSpec, beyond_piano
 from pianobot.music.pedal import Pedal
 from pianobot.music.piece import HANDS, Note, Piece, pitch_name
 
@@ -140,7 +140,13 @@ def _read_hand(path: Path | midi_io.MidiSource, options: LoadOptions, bpm: float
 
 def load_piece(path: str | Path | midi_io.MidiSource, options: LoadOptions = LoadOptions()) -> Piece:
     """Read a .mid file (or a PIG .txt file) with its fingering, then re-time and transpose it
-    (``path`` may be a file already read: :func:`~pianobot.music.midi_io.open_midi`)."""
+    (``path`` may be a file already read: :func:`~pianobot.music.midi_io.open_midi`); notes beyond the
+    piano's keys where no octave shift fits the piece are played octaves in (:func:`fold_into_piano`)."""
+    return fold_into_piano(_read_piece(path, options), midi_io.source_path(path).name)
+
+
+def _read_piece(path: str | Path | midi_io.MidiSource, options: LoadOptions) -> Piece:
+    """:func:`load_piece`'s reading, every note at the pitch the file (and ``options.transpose``) gives it."""
     source, path = path, midi_io.source_path(path)
     if path.suffix.lower() == ".txt":
         if options.tempo is not None:
@@ -185,6 +191,40 @@ def load_piece(path: str | Path | midi_io.MidiSource, options: LoadOptions = Loa
     return piece.transpose(options.transpose)
 
 
+def fold_into_piano(piece: Piece, name: str) -> Piece:
+    """``piece`` with each note beyond the piano's 88 keys played the fewest octaves in, as a pianist
+    plays an arrangement's stray notes, said in one warning; dropped where a note of that key already
+    sounds then. Only where no shift of the whole piece by octaves fits it: where one does, the notes
+    stay, and the reading refuses them naming that shift (:func:`_check_keys`)."""
+    outside = [n for n in piece.notes if n.pitch not in PIANO]
+    low, high = min(n.pitch for n in piece.notes), max(n.pitch for n in piece.notes)
+    if not outside or any(PIANO.lowest <= low + s and high + s <= PIANO.highest for s in range(-120, 121, 12)):
+        return piece
+    kept, moved, dropped = [n for n in piece.notes if n.pitch in PIANO], [], 0
+    for note in outside:
+        pitch = note.pitch
+        while pitch < PIANO.lowest:
+            pitch += 12
+        while pitch > PIANO.highest:
+            pitch -= 12
+        folded = replace(note, pitch=pitch)
+        if any(n.pitch == pitch and n.onset < folded.offset and folded.onset < n.offset for n in kept):
+            dropped += 1
+        else:
+            kept.append(folded)
+            moved.append(f"{note.describe()} as {folded.name}")
+    warnings.warn(
+        PianobotWarning(
+            f"{name}: {len(outside)} note(s) lie beyond the piano's 88 keys {PIANO.describe()}, and no octave shift "
+            f"of the piece brings them all on: played the fewest octaves in ({', '.join(moved[:3])}"
+            + (" ..." if len(moved) > 3 else "")
+            + ")"
+            + (f", {dropped} dropped where that key already sounds" if dropped else "")
+        )
+    )
+    return Piece(tuple(kept), bpm=piece.bpm)
+
+
 def load_part(path: str | Path | midi_io.MidiSource, options: LoadOptions, hand: HandSpec) -> Piece:
     """:func:`load_piece`; with ``options.hand``, also thin chords to what ``hand`` can hold
     (:func:`pianobot.pianist.reduce.load_for_hand` goes on to what it can reach in time); without
@@ -227,8 +267,9 @@ def load_hands(path: str | Path | midi_io.MidiSource, options: LoadOptions = Loa
     the PIG file's), None where nothing says (the fingering planner then gives it one:
     :func:`pianobot.pianist.assign.load_two_hands`).
 
-    Bad input, in one line: notes beyond the piano's 88 keys are refused (:class:`SettingError`
-    naming the setting that helps). Said in one warning each: hands that cross (the robot's two
+    Bad input, in one line: notes beyond the piano's 88 keys that an octave shift of the piece fits are
+    refused (:class:`SettingError` naming the setting that helps; where none fits they are played
+    octaves in: :func:`fold_into_piano`). Said in one warning each: hands that cross (the robot's two
     hands share one rail) are not taken from the file, and the planner gives every note a hand;
     three or more tracks of notes that are not all named for hands are read as one part whose
     notes the planner gives to the hands."""
@@ -249,7 +290,7 @@ def load_hands(path: str | Path | midi_io.MidiSource, options: LoadOptions = Loa
             raise SettingError("load.track needs a MIDI file: a PIG file's channels are its hands", "load.track")
         piece = pig.read_pig(path, hand=None).transpose(options.transpose)
     else:
-        piece = load_piece(source, options)
+        piece = _read_piece(source, options)
         sidecar = options.fingering or pig.sidecar_for(path)
         if any(n.hand is None for n in piece.notes) and (options.fingering is not None or sidecar.exists()):
             with warnings.catch_warnings():
@@ -280,6 +321,7 @@ def load_hands(path: str | Path | midi_io.MidiSource, options: LoadOptions = Loa
                     f"{','.join(str(t.index) for t in keys)}"
                 )
             )
+    piece = fold_into_piano(piece, path.name)
     _check_keys(piece, path, options.transpose)
     crossing = _crossing(piece)
     if crossing:

@@ -42,7 +42,7 @@ from typing import Sequence
 import numpy as np
 
 from pianobot.errors import PianobotWarning, SettingError
-from pianobot.music.instrument import PIANO, HandSpec, KeyboardSpec
+from pianobot.music.instrument import PIANO, HandSpec, KeyboardSpec, beyond_piano
 from pianobot.music.load import LoadOptions, load_part
 from pianobot.music.piece import Note, Piece, pitch_name
 from pianobot.pianist.fingering import Planner, Reach
@@ -130,6 +130,8 @@ def load_for_hand(
     piece = load_part(path, options, hand)
     if options.hand is None:
         return piece
+    if said := beyond_piano(piece, options.transpose):  # (no keyboard named could hold them: a shift does)
+        raise SettingError(f"the {options.hand} hand's part has {said}", "load.transpose")
     low, high = min(n.pitch for n in piece.notes), max(n.pitch for n in piece.notes)
     if fit and high - low >= keyboard.count:  # (no transposition fits it: say what keyboard does)
         lowest = max(low // 12 * 12, PIANO.lowest)
