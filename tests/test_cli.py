@@ -64,13 +64,13 @@ def test_inspect_shows_the_phrase_split_play_uses_and_which_phrases_are_trained(
     assert "3 phrases" in trained.output and trained.output.count("own policy") >= 3
     bare = run("inspect", EXAMPLES / "chord.mid", "--models", tmp_path, "--json", tmp_path / "bare.json")
     assert re.search(r"\b1 phrase\b(?!s)", bare.output)  # nothing trained: the default split
-    assert "general policy (untrained)" in bare.output and "own policy" not in bare.output
+    assert "general policy (phrase not trained)" in bare.output and "own policy" not in bare.output
     # a phrase the store's index gives the general policy (its own policy was set aside) is said so,
     # where inspect called it trained and play played it with the general policy
     (phrase,) = json.loads((tmp_path / "bare.json").read_text())["phrases"]
     (tmp_path / "general-plays.json").write_text(json.dumps({f"{phrase['hash']}-0123456789ab": {"why": "worse"}}))
     judged = run("inspect", EXAMPLES / "chord.mid", "--models", tmp_path)
-    assert "general policy (judged better)" in judged.output and "untrained" not in judged.output
+    assert "general policy (judged better)" in judged.output and "not trained" not in judged.output
 
 
 def test_inspect_with_transpose_tempo_and_keyboard_options(tmp_path):

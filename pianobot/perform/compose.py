@@ -89,7 +89,7 @@ def phrase_players(models: Path, phrases: list[Phrase]) -> dict[int, str]:
     simulator v0: play judges it)' where it was trained on another simulator than this one,
     'general policy (judged better)' where the store's index says the general policy plays it
     (training kept the general policy, or the phrase's own policy made its piece play worse),
-    else 'general policy (untrained)'. A policy of its own is a folder for the phrase, of any configuration."""
+    else 'general policy (phrase not trained)'. A policy of its own is a folder for the phrase, of any configuration."""
     from pianobot.env import VERSION
 
     own, general = store.trained_keys(models), {key.rsplit("-", 1)[0] for key in store.general_plays(models)}
@@ -103,7 +103,7 @@ def phrase_players(models: Path, phrases: list[Phrase]) -> dict[int, str]:
         if p.hash in general
         else own_policy(p)
         if p.hash in own
-        else "general policy (untrained)"
+        else "general policy (phrase not trained)"
         for p in phrases
     }
 
