@@ -287,13 +287,15 @@ def test_the_allegro_hand_s_hold_guard_remembers_no_note_it_let_go():
 
 def test_the_pianist_s_hold_guard_lets_go_before_a_repeat_as_the_packaged_policy_s_teacher_did():
     """Alone, the pianist's scripted pianist strikes a key again from just over where it let its
-    note go (``repeat_rise``), so it holds the note before nearer its end; the hold guard's teacher
-    lets go as the teacher the packaged policy learnt from did, from the ready height, since the
-    policy strikes the repeat: with ``repeat_rise`` it played the corpus's validation excerpts at
-    0.845 against 0.868 (docs/history.md)."""
+    note go (``repeat_rise``), so it holds the note before nearer its end, and holds keys a step longer
+    before a lone strike that needs the wrist elsewhere (``lone_strike_wrist_steps``); the hold guard's
+    teacher lets go as the teacher the packaged policy learnt from did, since the policy strikes those
+    notes: with ``repeat_rise`` it played the corpus's validation excerpts at 0.845 against 0.868, with
+    ``lone_strike_wrist_steps`` 0.879 against 0.885 (docs/history.md)."""
     import math
 
-    assert ScriptedPianist(PIANIST).tuning.repeat_rise < math.inf
+    alone = ScriptedPianist(PIANIST).tuning
+    assert alone.repeat_rise < math.inf and alone.lone_strike_wrist_steps == 1
     guard = HoldGuard(Constant(np.zeros(len(actuated_indices(PIANIST)), np.float32)), PIANIST)
-    assert guard.teacher.tuning.repeat_rise == math.inf
-    assert replace(guard.teacher.tuning, repeat_rise=0.0) == replace(ScriptedPianist(PIANIST).tuning, repeat_rise=0.0)
+    assert guard.teacher.tuning.repeat_rise == math.inf and guard.teacher.tuning.lone_strike_wrist_steps == 0
+    assert replace(guard.teacher.tuning, repeat_rise=0.0) == replace(alone, repeat_rise=0.0, lone_strike_wrist_steps=0)

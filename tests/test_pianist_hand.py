@@ -343,3 +343,31 @@ def test_a_chord_whose_finger_must_move_the_wrist_for_its_own_next_note_is_held_
     now, before = played(0), played(1)
     for pitch in (60, 64, 67):
         assert now[pitch] < 1.0 and now[pitch] - before[pitch] == pytest.approx(0.05, abs=0.01)
+
+
+def test_a_key_held_before_a_lone_strike_that_moves_the_wrist_is_held_a_step_longer():
+    """A4 held by the middle finger, then F4 by the index, a third below: the index reaches F4 from a
+    wrist position that keeps A4 held, but the wrist must slide there first. The pianist's hand lets the
+    strike begin a step before the wrist has arrived (``lone_strike_wrist_steps`` 1: it slides on as the
+    finger goes down), so A4 is held a control step longer than with the wrist there first (0, the
+    Allegro-like hand's), and F4 still sounds on time; likewise each note of an arpeggio C4 E4 G4 C5."""
+    from pianobot.perform.perform import PLAY_CONFIG, perform
+    from pianobot.pianist.scripted import ScriptedPianist
+
+    hand = hand_config(FIVE)
+    config = replace(PLAY_CONFIG, world=replace(PLAY_CONFIG.world, hand=hand))
+    assert tuning_for(hand).lone_strike_wrist_steps == 1 and PianistTuning().lone_strike_wrist_steps == 0
+
+    def played(notes, steps: int) -> dict[int, float]:
+        piece = Piece(tuple(Note(onset, pitch, end, 80, finger) for pitch, onset, end, finger in notes), bpm=60)
+        tuning = replace(tuning_for(hand), lone_strike_wrist_steps=steps)
+        report = perform(piece, lambda env: ScriptedPianist(env.config, tuning), config).report()
+        assert report.f1 == 1.0 and max(abs(r.onset_error) for r in report.rows) < 0.03
+        return {r.reference.pitch: r.played.offset for r in report.rows}
+
+    third = [(69, 0.0, 0.5, 3), (65, 0.5, 1.0, 2)]
+    now, before = played(third, 1), played(third, 0)
+    assert now[69] - before[69] == pytest.approx(0.05, abs=0.01) and now[69] > 0.5 - 0.01
+    arpeggio = [(60, 0.0, 0.4, 1), (64, 0.4, 0.8, 2), (67, 0.8, 1.2, 3), (72, 1.2, 1.6, 5)]
+    now, before = played(arpeggio, 1), played(arpeggio, 0)
+    assert [round(now[p] - before[p], 2) for p in (64, 67)] == [0.05, 0.05]

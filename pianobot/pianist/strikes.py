@@ -369,7 +369,8 @@ class StrikePlanner:
         A holding finger lets go in time for its own next strike, or another finger's on its key. Every holding finger lets go in
         time for a strike (its own or another finger's) that no wrist position keeping the held keys
         in reach (``hold_reach``) lets its finger reach (``strike_reach``), or not soon enough at the
-        speed the wrist slides while holding (``hold_slide``), counting the steps the wrist needs to
+        speed the wrist slides while holding (``hold_slide``; a strike alone at its onset may begin
+        ``lone_strike_wrist_steps`` before the wrist is there), counting the steps the wrist needs to
         get where the finger is straight over its key.
         """
         tuning, layout = self.tuning, self.layout
@@ -406,9 +407,13 @@ class StrikePlanner:
             for f, p in holds.items()
             if p.next_note is not None
         ]
+        starts = [start for _, _, start, _, _ in strikes]
         for finger, key, start, lead, extra in strikes:
             wanted = layout.wrist_for(finger, key)
-            if self._strike_while_holding(wanted, self.strike_reach(key, finger), low, high, start - lead, wrist):
+            late = tuning.lone_strike_wrist_steps if starts.count(start) == 1 else 0  # (a chord's wrist must be there)
+            if self._strike_while_holding(
+                wanted, self.strike_reach(key, finger), low, high, start - lead + late, wrist
+            ):
                 continue
             travel = max(0.0, low - wanted, wanted - high)
             shift_steps = math.ceil(travel / (self.max_wrist_speed * self.dt))

@@ -55,6 +55,12 @@ class PianistTuning:
     fingers hold theirs: the abduction makes up for it, and the held keys are not let go (m)."""
     black_strike_reach: float = 0.018
     """The same for a black key: a slanted fingertip slips off its narrow top sooner (m)."""
+    lone_strike_wrist_steps: int = 0
+    """Control steps a strike alone at its onset (no other finger's strike then) may begin before the
+    wrist, sliding at ``hold_slide`` while fingers hold keys, has come where it keeps the held keys and
+    lets the striking finger reach its key: the held keys are let go that much later for it, and the
+    wrist slides on into place as the finger goes down (0, the default, the Allegro-like hand's: it is
+    there when the strike begins)."""
     repeat_prepare_steps: int = 1
     """Least time a finger needs to let its key rise and be still over it again, before it strikes the
     same key again from the ready height (control steps): no move across, so less than ``prepare_steps``."""

@@ -41,6 +41,7 @@ PIANIST = HandModel(
         ("rise_before_repeat", True),
         ("repeat_rise", 0.001),
         ("lift_steps", 0),
+        ("lone_strike_wrist_steps", 1),
     ),
     passes=frozenset({(1, 2), (1, 3), (1, 4)}),
     written_fingering=True,
