@@ -278,8 +278,9 @@ def test_an_alberti_bass_in_semiquavers_plays_whole_because_the_wrist_waits_for_
     dragged the thumb off its key (its abduction lags a 29 mm step), so the wrist moves at most
     ``strike_slide`` a step while a fingertip is on its way into its key (the Allegro-like hand's
     wrist: unlimited, as before). Since the little finger strikes its repeated G3 from just over where
-    the key let it go (``repeat_rise``), the wrist no longer slides there as the thumb goes down; the
-    slide is shown with the repeats struck from the ready height, as they were."""
+    the key let it go (``repeat_rise``), the wrist no longer slides there as the thumb goes down, nor
+    where a lone strike may begin before the wrist is in place (``lone_strike_wrist_steps``); the slide is
+    shown with the repeats struck from the ready height and the wrist in place first, as they were."""
     from benchmarks.semiquavers import alberti, line, play
 
     assert tuning_for(hand_config(FIVE)).strike_slide == 0.004 and tuning_for(HandConfig()).strike_slide == math.inf
@@ -287,7 +288,7 @@ def test_an_alberti_bass_in_semiquavers_plays_whole_because_the_wrist_waits_for_
     import pianobot.pianist.scripted as scripted
 
     unlimited = scripted.tuning_for
-    as_before = {"repeat_rise": math.inf}
+    as_before = {"repeat_rise": math.inf, "lone_strike_wrist_steps": 0}
     monkeypatch.setattr(scripted, "tuning_for", lambda hand: replace(unlimited(hand), **as_before))
     assert play(line(alberti(), 0.125), FIVE) == (0, 1.0)
     as_before["strike_slide"] = math.inf
