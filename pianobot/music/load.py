@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import bisect
 import warnings
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -200,25 +201,34 @@ def fold_into_piano(piece: Piece, name: str) -> Piece:
     low, high = min(n.pitch for n in piece.notes), max(n.pitch for n in piece.notes)
     if not outside or any(PIANO.lowest <= low + s and high + s <= PIANO.highest for s in range(-120, 121, 12)):
         return piece
-    kept, moved, dropped = [n for n in piece.notes if n.pitch in PIANO], [], 0
+    kept = [n for n in piece.notes if n.pitch in PIANO]
+    # each key's notes as (onset, offset), sorted: they never overlap (the reading ends a note where its key
+    # starts again), so a folded note overlaps one only if the last to start before it ends is still sounding
+    keys: dict[int, list[tuple[float, float]]] = {}
+    for note in kept:
+        keys.setdefault(note.pitch, []).append((note.onset, note.offset))
+    for spans in keys.values():
+        spans.sort()
+    moved, dropped = [], 0
     for note in outside:
         pitch = note.pitch
         while pitch < PIANO.lowest:
             pitch += 12
         while pitch > PIANO.highest:
             pitch -= 12
-        folded = replace(note, pitch=pitch)
-        if any(n.pitch == pitch and n.onset < folded.offset and folded.onset < n.offset for n in kept):
+        spans = keys.setdefault(pitch, [])
+        before = bisect.bisect_left(spans, (note.offset,)) - 1
+        if before >= 0 and spans[before][1] > note.onset:
             dropped += 1
-        else:
-            kept.append(folded)
-            moved.append(f"{note.describe()} as {folded.name}")
+            continue
+        bisect.insort(spans, (note.onset, note.offset))
+        kept.append(folded := replace(note, pitch=pitch))
+        moved.append(f"{note.describe()} as {folded.name}")
+    said = f" ({', '.join(moved[:3])}{' ...' if len(moved) > 3 else ''})" if moved else ""
     warnings.warn(
         PianobotWarning(
             f"{name}: {len(outside)} note(s) lie beyond the piano's 88 keys {PIANO.describe()}, and no octave shift "
-            f"of the piece brings them all on: played the fewest octaves in ({', '.join(moved[:3])}"
-            + (" ..." if len(moved) > 3 else "")
-            + ")"
+            f"of the piece brings them all on: played the fewest octaves in{said}"
             + (f", {dropped} dropped where that key already sounds" if dropped else "")
         )
     )
