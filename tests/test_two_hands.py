@@ -8,7 +8,7 @@ import pytest
 from conftest import midi_file, off, on
 
 from pianobot.errors import PianobotWarning, SettingError
-from pianobot.music.load import LoadOptions, load_hands, load_piece
+from pianobot.music.load import LoadOptions, fold_into_piano, load_hands, load_piece
 from pianobot.music.piece import Note, Piece
 from pianobot.music.pig import write_pig
 from pianobot.pianist.assign import load_two_hands
@@ -58,8 +58,23 @@ def test_notes_beyond_the_pianos_keys_no_shift_fits_are_played_octaves_in(tmp_pa
     ]
     lines = [str(w.message) for w in said if "beyond the piano" in str(w.message)]
     assert len(lines) == 1 and "G9 at 0.500 s as G7" in lines[0] and "1 dropped" in lines[0], lines
-    # one hand's reading (load_piece) plays them so too; where a shift fits, nothing is moved and the reading refuses
+    # one hand's reading (load_piece) plays them so too
     assert sorted(n.pitch for n in load_piece(path)) == [22, 60, 103]
+    # where a shift by octaves fits, nothing is moved: load_piece keeps the notes as written, load_hands refuses them
+    high = midi_file(tmp_path / "high.mid", [("Right Hand", _track((110, 0, 1), (60, 1, 2)))])
+    assert sorted(n.pitch for n in load_piece(high)) == [60, 110]
+    # every folded note dropped (C-1 and C#-1 where the file's C1 and C#1 sound while they would): said so
+    quiet = midi_file(
+        tmp_path / "quiet.mid", [("Piano", _track((24, 1, 3), (25, 0, 4), (0, 0, 2), (1, 1, 2), (127, 0, 1)))]
+    )
+    with pytest.warns(PianobotWarning, match=r"no octave shift .*: played the fewest octaves in \(G9") as said:
+        assert sorted(n.pitch for n in load_piece(quiet)) == [24, 25, 103]
+    line = next(str(w.message) for w in said if "beyond the piano" in str(w.message))
+    assert "2 dropped where a note of that key sounds while it would" in line, line
+    # and where none is left to play, the line says so rather than "played"
+    every = Piece((Note(0, 24, 1), Note(0, 103, 1), Note(0.5, 0, 1), Note(0.5, 127, 1)))
+    with pytest.warns(PianobotWarning, match=r"brings them all on: none played, 2 dropped"):
+        assert fold_into_piano(every, "every.mid") == Piece((Note(0, 24, 1), Note(0, 103, 1)))
 
 
 def test_hands_that_cross_are_said_in_one_line_and_the_planner_gives_the_hands(tmp_path):

@@ -135,6 +135,12 @@ def suggest_transpose(piece: Piece, keyboard: KeyboardSpec) -> int | None:
     return min(octaves or fits, key=abs)
 
 
+def octave_shifts(piece: Piece) -> list[int]:
+    """The shifts by whole octaves (semitones, -120 to 120) that put every note of ``piece`` on the piano's 88 keys."""
+    low, high = min(n.pitch for n in piece.notes), max(n.pitch for n in piece.notes)
+    return [s for s in range(-120, 121, 12) if PIANO.lowest <= low + s and high + s <= PIANO.highest]
+
+
 def beyond_piano(piece: Piece, transposed: int = 0) -> str:
     """'' where every note of ``piece`` lies on the piano's 88 keys, else which lie beyond and what
     to do: 'N note(s) beyond the piano's 88 keys A0-C8 (88 keys): ...; use load.transpose -12'
@@ -143,12 +149,11 @@ def beyond_piano(piece: Piece, transposed: int = 0) -> str:
     if not outside:
         return ""
     names = ", ".join(n.describe() for n in outside[:3]) + (" ..." if len(outside) > 3 else "")
-    low, high = min(n.pitch for n in piece.notes), max(n.pitch for n in piece.notes)
-    shifts = [s for s in range(-120, 121, 12) if PIANO.lowest <= low + s and high + s <= PIANO.highest]
+    shifts = octave_shifts(piece)
     fix = (
         f"use load.transpose {min(shifts, key=abs) + transposed}"
         if shifts
-        else "the piece spans more than the piano: cut notes"
+        else "no octave shift brings them all on: move or cut them"
     )
     return f"{len(outside)} note(s) beyond the piano's 88 keys {PIANO.describe()}: {names}; {fix}"
 

@@ -9,7 +9,7 @@ from pathlib import Path
 
 from pianobot.errors import PianobotError, PianobotWarning, SettingError, quote
 from pianobot.music import midi_io, pig
-from pianobot.music.instrument import PIANO, HandSpec, beyond_piano
+from pianobot.music.instrument import PIANO, HandSpec, beyond_piano, octave_shifts
 from pianobot.music.pedal import Pedal
 from pianobot.music.piece import HANDS, Note, Piece, pitch_name
 
@@ -194,12 +194,13 @@ def _read_piece(path: str | Path | midi_io.MidiSource, options: LoadOptions) -> 
 
 def fold_into_piano(piece: Piece, name: str) -> Piece:
     """``piece`` with each note beyond the piano's 88 keys played the fewest octaves in, as a pianist
-    plays an arrangement's stray notes, said in one warning; dropped where a note of that key already
-    sounds then. Only where no shift of the whole piece by octaves fits it: where one does, the notes
-    stay, and the reading refuses them naming that shift (:func:`_check_keys`)."""
+    plays an arrangement's stray notes, said in one warning (naming the first three); one whose key
+    sounds while it would is dropped. Only where no shift of the piece (or of the one hand's part read)
+    by whole octaves brings every note on: where one does, the notes stay as written, and the reading
+    refuses them naming that shift (:func:`_check_keys`, or the hand's check of its part). Notes on one
+    key must not overlap, as the readers leave them (:func:`~pianobot.music.piece.resolve_overlaps`)."""
     outside = [n for n in piece.notes if n.pitch not in PIANO]
-    low, high = min(n.pitch for n in piece.notes), max(n.pitch for n in piece.notes)
-    if not outside or any(PIANO.lowest <= low + s and high + s <= PIANO.highest for s in range(-120, 121, 12)):
+    if not outside or octave_shifts(piece):
         return piece
     kept = [n for n in piece.notes if n.pitch in PIANO]
     # each key's notes as (onset, offset), sorted: they never overlap (the reading ends a note where its key
@@ -224,12 +225,16 @@ def fold_into_piano(piece: Piece, name: str) -> Piece:
         bisect.insort(spans, (note.onset, note.offset))
         kept.append(folded := replace(note, pitch=pitch))
         moved.append(f"{note.describe()} as {folded.name}")
-    said = f" ({', '.join(moved[:3])}{' ...' if len(moved) > 3 else ''})" if moved else ""
+    played = (
+        f"played the fewest octaves in ({', '.join(moved[:3])}{' ...' if len(moved) > 3 else ''})"
+        if moved
+        else "none played"
+    )
     warnings.warn(
         PianobotWarning(
             f"{name}: {len(outside)} note(s) lie beyond the piano's 88 keys {PIANO.describe()}, and no octave shift "
-            f"of the piece brings them all on: played the fewest octaves in{said}"
-            + (f", {dropped} dropped where that key already sounds" if dropped else "")
+            f"of the piece brings them all on: {played}"
+            + (f", {dropped} dropped where a note of that key sounds while it would" if dropped else "")
         )
     )
     return Piece(tuple(kept), bpm=piece.bpm)
