@@ -47,6 +47,14 @@ def test_the_export_command(tmp_path):
     bad = CliRunner().invoke(app, ["export", str(tmp_path), "-o", str(tmp_path / "q.onnx")])
     assert bad.exit_code == 2 and "holds no manifest.json" in bad.stderr
     assert CliRunner().invoke(app, ["export", str(folder), "-o", str(tmp_path / "p.txt")]).exit_code == 2
+    # a phrase whose training kept its start stores no policy: the line names the start to export instead
+    kept = tmp_path / "kept"
+    kept.mkdir()
+    manifest = {**json.loads((folder / "manifest.json").read_text()), "kept": "start", "start": {"path": "models/x"}}
+    (kept / "manifest.json").write_text(json.dumps(manifest))
+    said = CliRunner().invoke(app, ["export", str(kept), "-o", str(tmp_path / "k.onnx")])
+    assert said.exit_code == 2 and "kept its start policy" in said.stderr
+    assert "pianobot export models/x -o" in said.stderr and len(said.stderr.strip().splitlines()) == 1
 
 
 def test_a_finger_shared_policy_exports_with_the_vector_alone(tmp_path):

@@ -291,11 +291,15 @@ def test_the_pianist_s_hold_guard_lets_go_before_a_repeat_as_the_packaged_policy
     before a lone strike that needs the wrist elsewhere (``lone_strike_wrist_steps``); the hold guard's
     teacher lets go as the teacher the packaged policy learnt from did, since the policy strikes those
     notes: with ``repeat_rise`` it played the corpus's validation excerpts at 0.845 against 0.868, with
-    ``lone_strike_wrist_steps`` 0.879 against 0.885 (docs/history.md)."""
+    ``lone_strike_wrist_steps`` 0.879 against 0.885. It also holds keys at full depth to their notes'
+    ends (``end_rise`` off), as that teacher did (docs/history.md)."""
     import math
 
     alone = ScriptedPianist(PIANIST).tuning
-    assert alone.repeat_rise < math.inf and alone.lone_strike_wrist_steps == 1
+    assert alone.repeat_rise < math.inf and alone.lone_strike_wrist_steps == 1 and alone.end_rise < math.inf
     guard = HoldGuard(Constant(np.zeros(len(actuated_indices(PIANIST)), np.float32)), PIANIST)
-    assert guard.teacher.tuning.repeat_rise == math.inf and guard.teacher.tuning.lone_strike_wrist_steps == 0
-    assert replace(guard.teacher.tuning, repeat_rise=0.0) == replace(alone, repeat_rise=0.0, lone_strike_wrist_steps=0)
+    taught = guard.teacher.tuning
+    assert taught.repeat_rise == math.inf and taught.lone_strike_wrist_steps == 0 and taught.end_rise == math.inf
+    assert replace(taught, repeat_rise=0.0) == replace(
+        alone, repeat_rise=0.0, lone_strike_wrist_steps=0, end_rise=math.inf
+    )

@@ -361,7 +361,7 @@ def test_a_key_held_before_a_lone_strike_that_moves_the_wrist_is_held_a_step_lon
 
     def played(notes, steps: int) -> dict[int, float]:
         piece = Piece(tuple(Note(onset, pitch, end, 80, finger) for pitch, onset, end, finger in notes), bpm=60)
-        tuning = replace(tuning_for(hand), lone_strike_wrist_steps=steps)
+        tuning = replace(tuning_for(hand), lone_strike_wrist_steps=steps, end_rise=math.inf)  # (held to the end)
         report = perform(piece, lambda env: ScriptedPianist(env.config, tuning), config).report()
         assert report.f1 == 1.0 and max(abs(r.onset_error) for r in report.rows) < 0.03
         return {r.reference.pitch: r.played.offset for r in report.rows}
@@ -372,3 +372,36 @@ def test_a_key_held_before_a_lone_strike_that_moves_the_wrist_is_held_a_step_lon
     arpeggio = [(60, 0.0, 0.4, 1), (64, 0.4, 0.8, 2), (67, 0.8, 1.2, 3), (72, 1.2, 1.6, 5)]
     now, before = played(arpeggio, 1), played(arpeggio, 0)
     assert [round(now[p] - before[p], 2) for p in (64, 67)] == [0.05, 0.05]
+
+
+def test_a_held_key_rises_a_little_in_its_note_s_last_step_so_the_note_ends_on_time():
+    """The pianist's hand lets a held key rise to 1 mm under the depth where it lets its note go in the
+    note's last control step (``end_rise``), so that its note ends within the step's rounding of its
+    written end; held at full depth to the end (``math.inf``, the Allegro-like hand's), a note with no
+    note of its finger after it sounded 33 ms past its end. A note whose key is struck again right after
+    it keeps its end: the score's gap before the repeat already lets that key rise."""
+    from pianobot.perform.perform import PLAY_CONFIG, perform
+    from pianobot.pianist.scripted import ScriptedPianist
+
+    hand = hand_config(FIVE)
+    config = replace(PLAY_CONFIG, world=replace(PLAY_CONFIG.world, hand=hand))
+    assert tuning_for(hand).end_rise == 0.001 and PianistTuning().end_rise == math.inf
+
+    def ends(notes, rise: float) -> list[float]:
+        piece = Piece(tuple(Note(onset, pitch, end, velocity, finger) for pitch, onset, end, finger, velocity in notes))
+        tuning = replace(tuning_for(hand), end_rise=rise)
+        report = perform(piece, lambda env: ScriptedPianist(env.config, tuning), config).report()
+        assert report.f1 == 1.0
+        return [r.played.offset - r.reference.offset for r in sorted(report.rows, key=lambda r: r.reference.onset)]
+
+    line = [
+        (60, 0.0, 0.5, 1, 80),
+        (64, 0.5, 1.0, 3, 80),
+        (67, 1.0, 1.5, 5, 40),
+        (65, 1.5, 2.0, 4, 110),
+        (61, 2.0, 2.5, 2, 80),
+    ]
+    now, before = ends(line, 0.001), ends(line, math.inf)
+    assert max(abs(e) for e in now) < 0.025 and before[-1] > 0.025
+    repeat = [(60, 0.0, 0.5, 3, 80), (60, 0.5, 1.0, 3, 80)]
+    assert ends(repeat, 0.001)[0] == pytest.approx(ends(repeat, math.inf)[0], abs=0.002)

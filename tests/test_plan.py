@@ -124,7 +124,11 @@ def test_a_phrase_policy_that_makes_the_piece_worse_is_not_used(tmp_path):
     verdict = settle_piece(piece, phrases, models, general, started={})
     assert verdict.before == tuple(before) and verdict.after == tuple(before)
     assert 1 in verdict.dropped and not verdict.used
-    assert "made the piece play worse" in store.general_plays(models)[still.name]["why"]
+    start, b, w = next((s, b, w) for s, b, w in zip(JUDGE_SEEDS, before, worse) if w < b)
+    assert (
+        f"from hand start {start} the piece played at note F1 {w:.3f} with it, {b:.3f} without"
+        in (store.general_plays(models)[still.name]["why"])
+    )
     after = [play(piece, models=models, seed=s).report().f1 for s in JUDGE_SEEDS]
     assert after == before and play(piece, models=models).plan.performer == "general policy"
 

@@ -117,19 +117,35 @@ def test_skip_if_trained_and_identical_phrases_share_a_policy(tmp_path):
     assert len(other) == 2  # another configuration is another model
 
 
-def test_a_forced_task_run_removes_the_old_policy_first(tmp_path):
-    """Otherwise an interrupted forced run leaves the old policy, and the next plain run skips
-    the task and leaves the new run's checkpoint unused."""
+def test_a_forced_run_keeps_the_old_policy_playing_until_its_own_is_stored(tmp_path):
+    """A forced run that is interrupted leaves what was stored (the piece plays as before it), and the
+    next run, plain or forced, goes on with it from its checkpoint; a forced run given again after an
+    interruption trains only the phrases it had not finished."""
     from pianobot.learn.jobs import task_job
 
     config = small(steps=80, checkpoint_every=40)
     job = task_job("one-note", config, tmp_path)
     train_policy(job.target, config, job.folder)
+    old = (job.folder / store.POLICY_FILE).read_bytes()
     assert plan_jobs([job], force=False) == ([], [job])
-    todo, _ = plan_jobs([job], force=True)
-    assert todo == [job] and not store.is_trained(job.folder)
+    assert plan_jobs([job], force=True) == ([job], []) and store.is_trained(job.folder)
     train_policy(job.target, config, job.folder, stop_after=40)  # the forced run is interrupted
-    assert plan_jobs([job], force=False) == ([job], [])  # the next plain run resumes it
+    assert (job.folder / store.POLICY_FILE).read_bytes() == old and store.replacing(job.folder)
+    assert plan_jobs([job], force=False) == ([job], [])  # the next plain run goes on with it
+    assert plan_jobs([job], force=True) == ([job], [])
+    train_policy(job.target, config, job.folder)  # from its checkpoint, to the end
+    assert not store.replacing(job.folder) and store.is_trained(job.folder)
+    assert not (job.folder / store.CHECKPOINT_DIR).exists()  # (the same seed trains the same weights again)
+    assert plan_jobs([job], force=False) == ([], [job])
+
+    other = task_job("three-note", config, tmp_path)
+    train_policy(other.target, config, other.folder)
+    assert plan_jobs([job, other], force=True) == ([job, other], [])  # both marked
+    store.replaced(job.folder, policy_kept=True)  # the first finished, then the run was interrupted
+    assert plan_jobs([job, other], force=True) == ([other], [job])  # the same command goes on
+    store.replaced(other.folder, policy_kept=False)  # finished, keeping its start: the old policy goes
+    assert not (other.folder / store.POLICY_FILE).exists()
+    assert plan_jobs([job, other], force=True) == ([job, other], [])  # a new forced run: all again
 
 
 def test_corrupt_and_foreign_model_files_are_clear_errors(tmp_path):
@@ -417,7 +433,7 @@ def test_a_run_that_never_beats_its_start_stores_no_copy_of_it_and_keeps_its_log
         assert (folder / LOG_FILE).exists() and (folder / PLOT_FILE).exists() and store.load_checkpoint(folder) is None
         job = PhraseJob("k", PHRASE, folder, [0])
         assert plan_jobs([job], force=False) == ([], [job])  # a second `train` skips it
-        assert plan_jobs([job], force=True) == ([job], []) and not store.kept_start(folder)  # --force trains anew
+        assert plan_jobs([job], force=True) == ([job], []) and store.replacing(folder)  # --force trains anew
     # a run that does beat its start stores its policy
     scores = itertools.chain([0.5, 0.9], itertools.repeat(0.6))
     monkeypatch.setattr(train, "evaluate", lambda *a: {"f1": next(scores), "velocity_mae": 1.0, "return": 0.0})

@@ -93,7 +93,8 @@ app = typer.Typer(
 
 INTERRUPTED = {
     "train": ": run the same command again to go on; a phrase's run resumes from its last checkpoint "
-    f"(every {TrainConfig.checkpoint_every} steps), and one without a checkpoint yet starts again",
+    f"(SAC's every {TrainConfig.checkpoint_every} steps, DAgger's at the end of each round), and one without a "
+    "checkpoint yet starts again; a phrase a --force run had not finished still plays its earlier policy",
 }
 """What an interrupted command adds to the line that says so."""
 

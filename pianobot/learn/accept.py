@@ -110,6 +110,7 @@ def _settle(
     f1s: Callable[[dict[Key, Path]], tuple[float, ...]],
     on_play: Callable[[str], None],
     name: Callable[[Key], str],
+    seeds: tuple[int, ...] = JUDGE_SEEDS,
 ) -> tuple[tuple[float, ...], tuple[float, ...], dict[Key, Path], dict[Key, str]]:
     """Step 2 of the module's: (F1s before, F1s after, policies kept, why each other was dropped).
     ``own``: every phrase's own policy that may play, by phrase; ``f1s(kept)``: the piece's note
@@ -128,9 +129,18 @@ def _settle(
             kept.update(same)
             current = trial
         else:
-            why = f"the piece played at mean note F1 {np.mean(trial):.3f} with it, {np.mean(current):.3f} without"
-            dropped.update(dict.fromkeys(same, why))
+            dropped.update(dict.fromkeys(same, _why_dropped(seeds, trial, current)))
     return before, current, kept, dropped
+
+
+def _why_dropped(seeds: tuple[int, ...], trial: tuple[float, ...], current: tuple[float, ...]) -> str:
+    """Which of the two rules a phrase's own policy failed: no judging start may play worse with it,
+    and together they must play better."""
+    worse = [(seed, t, c) for seed, t, c in zip(seeds, trial, current) if t < c]
+    if worse:
+        seed, t, c = worse[0]
+        return f"from hand start {seed} the piece played at note F1 {t:.3f} with it, {c:.3f} without (no start may play worse)"
+    return f"the piece played no better with it (mean note F1 {np.mean(trial):.3f}, the same without)"
 
 
 def _mark_judged(models: Path, kept: dict, dropped: dict, own: dict, about: Callable[[object], dict]) -> None:
@@ -144,10 +154,7 @@ def _mark_judged(models: Path, kept: dict, dropped: dict, own: dict, about: Call
     store.mark_general_plays(
         models,
         {folder.name: None for folder in kept.values()}
-        | {
-            own[k].name: {"why": f"its own policy made the piece play worse: {why}", **about(k)}
-            for k, why in dropped.items()
-        },
+        | {own[k].name: {"why": f"its own policy is not used: {why}", **about(k)} for k, why in dropped.items()},
     )
 
 
@@ -177,7 +184,7 @@ def settle_piece(
         plan = PerformancePlan(piece, config, stretches_for(phrases, kept, general))
         return tuple(perform_plan(plan, seed).report().f1 for seed in seeds)
 
-    before, after, kept, dropped = _settle(own, f1s, on_play, lambda number: f"phrase {number}")
+    before, after, kept, dropped = _settle(own, f1s, on_play, lambda number: f"phrase {number}", seeds)
     _mark_judged(models, kept, dropped, own, lambda number: about)
     return Verdict(
         before=before,
@@ -247,7 +254,7 @@ def settle_hands(
         hand, number = key.split()
         return f"the {hand} hand's phrase {number}"
 
-    before, after, kept, dropped = _settle(own, f1s, on_play, name)
+    before, after, kept, dropped = _settle(own, f1s, on_play, name, seeds)
     for message in said.values():
         warnings.warn(message)
     _mark_judged(models, kept, dropped, own, lambda key: abouts[key.split()[0]])

@@ -215,21 +215,25 @@ def given_parts(folder: Path, env: EnvConfig, share: float = GIVEN_SHARE) -> Giv
 
 def plan_jobs(jobs: list[PhraseJob], force: bool) -> tuple[list[PhraseJob], list[PhraseJob]]:
     """(jobs to train, jobs already done: a stored policy, a run that kept its start policy, or the
-    store's index says the general policy plays the phrase); ``force`` removes stored policies,
-    manifests and index entries, so that an
-    interrupted forced run is not taken for a finished one (its checkpoint is kept and resumed)."""
+    store's index says the general policy plays the phrase). ``force`` trains every job again: each
+    folder is marked (:func:`~pianobot.agent.store.mark_replacing`) and what it stored stays, and
+    plays, until its new run has finished. A marked folder is an interrupted forced run's: it is
+    trained on (from its checkpoint), and ``force`` given again goes on with the marked jobs alone,
+    so that running the same command again does not train the finished ones once more."""
+    interrupted = force and any(store.replacing(job.folder) for job in jobs)
     todo, done = [], []
     for job in jobs:
         root = job.folder.parent
         finished = store.is_trained(job.folder) or store.kept_start(job.folder)
-        if (finished or job.folder.name in store.general_plays(root)) and not force:
+        if store.replacing(job.folder):
+            todo.append(job)
+        elif (finished or job.folder.name in store.general_plays(root)) and (interrupted or not force):
             done.append(job)
         else:
-            if force and job.folder.exists():
-                for name in (store.POLICY_FILE, store.CRITIC_FILE, store.MANIFEST_FILE):
-                    (job.folder / name).unlink(missing_ok=True)
-            if force and job.folder.name in store.general_plays(root):
-                store.mark_general_plays(root, {job.folder.name: None})
+            if force:
+                store.mark_replacing(job.folder)
+                if job.folder.name in store.general_plays(root):
+                    store.mark_general_plays(root, {job.folder.name: None})
             todo.append(job)
     return todo, done
 

@@ -385,11 +385,17 @@ class Run:
             "evaluations": self.evaluations,
             "config": to_dict(self.config),
         }
+        # what a forced run replaces (store.mark_replacing) stayed, and played, until now
         if not start_kept:
             policy, critic = split_kept(tensors)
             store.save_policy(self.folder, policy, manifest, critic=critic)
+            store.replaced(self.folder, policy_kept=True)
         elif not self.kept_start:  # trained, and kept its start: the manifest alone says the run is done
+            store.replaced(self.folder, policy_kept=False)
             store.save_manifest(self.folder, manifest)
+        elif store.replacing(self.folder):  # (the start played well enough: what was stored goes)
+            store.replaced(self.folder, policy_kept=False)
+            (self.folder / store.MANIFEST_FILE).unlink(missing_ok=True)
         if not self.kept_start:  # (a run that trained keeps its learning curves, also when it kept its start)
             store.drop_checkpoint(self.folder)
             self.log.plot()

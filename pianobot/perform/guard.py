@@ -22,7 +22,10 @@ again from just over where the key let its note go (docs/history.md). Likewise i
 strike alone at its onset once the wrist must begin to slide for it
 (:attr:`~pianobot.pianist.tuning.PianistTuning.lone_strike_wrist_steps` 0), where the scripted pianist
 alone holds them a step longer (through the guard, the packaged policy played the corpus's validation
-excerpts at 0.879 that way, against 0.885). ``pianobot play`` plays a general policy of
+excerpts at 0.879 that way, against 0.885), and it holds a key at full depth to its note's end
+(:attr:`~pianobot.pianist.tuning.PianistTuning.end_rise` off), where the scripted pianist lets it rise a
+little in the last step (through the guard, the packaged policy's per-step F1 and offsets rose with it,
+its note F1 did not, and one two-hand example fell below 0.97: docs/history.md). ``pianobot play`` plays a general policy of
 the families in :data:`HOLD_GUARD_FAMILIES` through it (the packaged left hand's policy), and
 any general policy with ``--hold-guard``; ``--no-hold-guard`` plays each alone. A phrase's own
 policy plays unguarded.
@@ -97,7 +100,9 @@ class HoldGuard:
             )
         self.policy = policy
         # (as the packaged policies' teacher did when they learnt)
-        tuning = replace(tuning or tuning_for(config.world.hand), repeat_rise=math.inf, lone_strike_wrist_steps=0)
+        tuning = replace(
+            tuning or tuning_for(config.world.hand), repeat_rise=math.inf, lone_strike_wrist_steps=0, end_rise=math.inf
+        )
         self.teacher = ScriptedPianist(config, tuning)
         joints = actuated_indices(config)[:-1]  # (then the wrist's, then with the pedal an action the foot's)
         self.wrist_at = len(joints)

@@ -124,6 +124,11 @@ class PianistTuning:
     finger that has just let go of the key rises before it strikes it again, as a piano's key is
     struck again before it is all the way up (m; ``math.inf``, the default: to the ready height over
     the key's top, as every other strike, the Allegro-like hand's)."""
+    end_rise: float = math.inf
+    """How far under the depth at which a key lets its note go (the keyboard's ``release_fraction``) a
+    finger lets the key it holds rise in the note's last control step, so that the key, still sounding,
+    has less to rise once the note's rows end and its note ends sooner after its written end (m;
+    ``math.inf``, the default, the Allegro-like hand's: held at the full depth to the end)."""
     let_up_height: float = math.inf
     """Under the hold guard (:class:`~pianobot.perform.guard.HoldGuard`): a holding finger whose tip has
     risen this far over its key's top let the key up, and its note ended; the guard's teacher leaves the

@@ -42,6 +42,7 @@ PIANIST = HandModel(
         ("repeat_rise", 0.001),
         ("lift_steps", 0),
         ("lone_strike_wrist_steps", 1),
+        ("end_rise", 0.001),
     ),
     passes=frozenset({(1, 2), (1, 3), (1, 4)}),
     written_fingering=True,

@@ -25,5 +25,13 @@ def export(
         raise PianobotError(
             f"{model} is not a folder: give a trained policy's folder in the model store (see `pianobot inspect`)"
         )
+    from pianobot.agent import store
+
+    if store.kept_start(model):
+        start = (store.read_manifest(model).get("start") or {}).get("path", "the general policy's folder")
+        raise PianobotError(
+            f"{model}: its training kept its start policy, so no policy of its own is stored (the general "
+            f"policy plays the phrase): export that one, `pianobot export {start} -o {output}`"
+        )
     export_onnx(model, output)
     out.print(f"policy {model.name} written to {output}")

@@ -71,7 +71,11 @@ def train(
     tactile: bool = o.TACTILE_OPTION,
     joints: str = o.JOINTS_OPTION,
     fingering_gate: bool = o.FINGERING_GATE_OPTION,
-    force: bool = typer.Option(False, "--force", help="Retrain phrases that already have a stored policy."),
+    force: bool = typer.Option(
+        False,
+        "--force",
+        help="Retrain phrases that already have a stored policy (it stays, and plays, until its new run has finished; after an interruption the same command goes on with the phrases not yet retrained).",
+    ),
     models: Path = typer.Option(DEFAULT_STORE, "--models", help="Folder of the model store."),
     cluster: Cluster = o.CLUSTER_OPTION,
     json_path: Optional[Path] = o.JSON_PATH_OPTION,
@@ -259,7 +263,7 @@ def _plan_task(console, task, pieces, config, start, models: Path, general_polic
 
 
 def _say_starts(console, plan, general_policy, models: Path, force: bool, from_general: bool) -> None:
-    """Where each group's phrases start, before any is trained (and before ``force`` removes a policy)."""
+    """Where each group's phrases start, before any is trained."""
     from pianobot.agent import store
 
     every_job = [job for group in plan.groups for job in group.jobs]
@@ -364,10 +368,18 @@ def _judge(console, plan, trained, models: Path, song):
         f"{said(song.name)}: note F1 {before:.3f} with the general polic{'ies' if two else 'y'} alone, "
         f"{after:.3f} as it plays now ({used})"
     )
-    if not verdict.used and after < 1.0 and all(m.get("kept") == "start" for job, m in trained if job in plan.todo):
+    ran = [m for job, m in trained if job in plan.todo]
+    if not verdict.used and after < 1.0 and ran and all(m.get("kept") == "start" for m in ran):
+        if all(not m.get("steps") for m in ran):
+            said_why = "every phrase played well enough from a fresh start, so none was trained"
+        else:  # (trained, but no evaluation beat the start's)
+            said_why = (
+                "no phrase's training played better than its start in the phrase's own evaluation, so the "
+                "general policy plays every phrase (more --steps may help)"
+            )
         console.print(
-            "[yellow]every phrase played well enough from a fresh start, so none was trained; played whole, the "
-            "hand goes on from where each phrase left it, which the phrase-by-phrase evaluation does not see[/yellow]",
+            f"[yellow]{said_why}; played whole, the hand goes on from where each phrase left it, which the "
+            "phrase-by-phrase evaluation does not see[/yellow]",
             soft_wrap=True,
         )
     for number, why in verdict.dropped.items():
