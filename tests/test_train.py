@@ -119,33 +119,49 @@ def test_skip_if_trained_and_identical_phrases_share_a_policy(tmp_path):
 
 def test_a_forced_run_keeps_the_old_policy_playing_until_its_own_is_stored(tmp_path):
     """A forced run that is interrupted leaves what was stored (the piece plays as before it), and the
-    next run, plain or forced, goes on with it from its checkpoint; a forced run given again after an
-    interruption trains only the phrases it had not finished."""
+    next run, plain or forced, goes on with it from its checkpoint; the same forced run given again
+    after an interruption trains only the phrases it had not finished, and a forced run of other
+    phrases, or one after the command has judged the piece, trains every phrase anew."""
+    from pianobot.learn import forced
+    from pianobot.learn.forced import forced_run
     from pianobot.learn.jobs import task_job
+
+    def planned(jobs, force):
+        return plan_jobs(jobs, force, *forced_run([job.folder for job in jobs]))
 
     config = small(steps=80, checkpoint_every=40)
     job = task_job("one-note", config, tmp_path)
     train_policy(job.target, config, job.folder)
     old = (job.folder / store.POLICY_FILE).read_bytes()
-    assert plan_jobs([job], force=False) == ([], [job])
-    assert plan_jobs([job], force=True) == ([job], []) and store.is_trained(job.folder)
+    store.mark_general_plays(tmp_path, {job.folder.name: {"why": "set aside"}})  # (as a piece's judgement does)
+    assert planned([job], False) == ([], [job])
+    assert planned([job], True) == ([job], []) and store.is_trained(job.folder)
+    assert job.folder.name in store.general_plays(tmp_path)  # set aside it stays, while it is trained anew
+    store.mark_general_plays(tmp_path, {job.folder.name: None})
     train_policy(job.target, config, job.folder, stop_after=40)  # the forced run is interrupted
-    assert (job.folder / store.POLICY_FILE).read_bytes() == old and store.replacing(job.folder)
-    assert plan_jobs([job], force=False) == ([job], [])  # the next plain run goes on with it
-    assert plan_jobs([job], force=True) == ([job], [])
+    assert (job.folder / store.POLICY_FILE).read_bytes() == old and not forced.replacing(job.folder)["finished"]
+    assert planned([job], False) == ([job], [])  # the next plain run goes on with it
+    assert planned([job], True) == ([job], [])
+    manifest = job.folder / store.MANIFEST_FILE
+    manifest.write_text(json.dumps({**json.loads(manifest.read_text()), "the old one": True}))
     train_policy(job.target, config, job.folder)  # from its checkpoint, to the end
-    assert not store.replacing(job.folder) and store.is_trained(job.folder)
-    assert not (job.folder / store.CHECKPOINT_DIR).exists()  # (the same seed trains the same weights again)
-    assert plan_jobs([job], force=False) == ([], [job])
+    assert forced.replacing(job.folder)["finished"] and store.is_trained(job.folder)
+    assert "the old one" not in store.read_manifest(job.folder)  # the new run's manifest
+    assert not (job.folder / store.CHECKPOINT_DIR).exists()
+    assert planned([job], True) == ([], [job])  # the interrupted command, given again, goes on
+    assert planned([job], False) == ([], [job])
 
     other = task_job("three-note", config, tmp_path)
     train_policy(other.target, config, other.folder)
-    assert plan_jobs([job, other], force=True) == ([job, other], [])  # both marked
-    store.replaced(job.folder, policy_kept=True)  # the first finished, then the run was interrupted
-    assert plan_jobs([job, other], force=True) == ([other], [job])  # the same command goes on
-    store.replaced(other.folder, policy_kept=False)  # finished, keeping its start: the old policy goes
+    assert planned([job, other], True) == ([job, other], [])  # another forced run: both anew
+    forced.replaced(job.folder, policy_kept=True)  # the first finished, then the run was interrupted
+    assert planned([job, other], True) == ([other], [job])  # the same command goes on
+    assert planned([other], True) == ([other], [])  # a forced run of other phrases: anew
+    forced.replaced(other.folder, policy_kept=False)  # finished, keeping its start: the old policy goes
     assert not (other.folder / store.POLICY_FILE).exists()
-    assert plan_jobs([job, other], force=True) == ([job, other], [])  # a new forced run: all again
+    for folder in (job.folder, other.folder):
+        forced.forget_replacing(folder)  # the command judged the piece
+    assert planned([job, other], True) == ([job, other], [])  # a new forced run: all again
 
 
 def test_corrupt_and_foreign_model_files_are_clear_errors(tmp_path):
@@ -413,6 +429,7 @@ def test_a_run_that_never_beats_its_start_stores_no_copy_of_it_and_keeps_its_log
     steps trained, the log and its curves kept, the checkpoint gone. Both learners."""
     import pianobot.learn.dagger as dagger
     import pianobot.learn.train as train
+    from pianobot.learn import forced
 
     config = small(steps=80)
     train_policy(PHRASE, config, tmp_path / "start")
@@ -433,7 +450,7 @@ def test_a_run_that_never_beats_its_start_stores_no_copy_of_it_and_keeps_its_log
         assert (folder / LOG_FILE).exists() and (folder / PLOT_FILE).exists() and store.load_checkpoint(folder) is None
         job = PhraseJob("k", PHRASE, folder, [0])
         assert plan_jobs([job], force=False) == ([], [job])  # a second `train` skips it
-        assert plan_jobs([job], force=True) == ([job], []) and store.replacing(folder)  # --force trains anew
+        assert plan_jobs([job], force=True) == ([job], []) and forced.replacing(folder) is not None  # --force: anew
     # a run that does beat its start stores its policy
     scores = itertools.chain([0.5, 0.9], itertools.repeat(0.6))
     monkeypatch.setattr(train, "evaluate", lambda *a: {"f1": next(scores), "velocity_mae": 1.0, "return": 0.0})

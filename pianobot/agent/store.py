@@ -74,9 +74,6 @@ CRITIC_FILE = "critic.safetensors"
 MANIFEST_FILE = "manifest.json"
 CHECKPOINT_DIR = "checkpoint"
 LOCK_FILE = ".lock"
-REPLACING_FILE = "replacing"
-"""In a phrase's folder: a forced run (``train --force``) is to replace what is stored there. Until it
-has, what was stored stays and plays; an interrupted forced run goes on with these phrases alone."""
 
 
 def config_hash(config) -> str:
@@ -191,24 +188,6 @@ def save_manifest(folder: Path, manifest: dict) -> None:
 
     manifest = {"format": FORMAT, "simulator": VERSION, **manifest, "saved": saved, "versions": package_versions()}
     atomic_write(folder / MANIFEST_FILE, json.dumps(manifest, indent=2, default=str) + "\n")
-
-
-def mark_replacing(folder: Path) -> None:
-    folder.mkdir(parents=True, exist_ok=True)
-    atomic_write(folder / REPLACING_FILE, "a forced run is to replace what is stored here\n")
-
-
-def replacing(folder: Path) -> bool:
-    return (folder / REPLACING_FILE).exists()
-
-
-def replaced(folder: Path, policy_kept: bool) -> None:
-    """A forced run in ``folder`` has finished: what was stored before goes unless the run stored a
-    policy over it (``policy_kept``), and the folder is no longer marked."""
-    if replacing(folder) and not policy_kept:
-        for name in (POLICY_FILE, CRITIC_FILE):
-            (folder / name).unlink(missing_ok=True)
-    (folder / REPLACING_FILE).unlink(missing_ok=True)
 
 
 def kept_start(folder: Path) -> bool:

@@ -21,6 +21,7 @@ from pianobot.agent.policy import policy_configs
 from pianobot.agent.tasks import GivenParts, Target
 from pianobot.env.piano import EnvConfig
 from pianobot.errors import PianobotError, PianobotWarning, SettingError, quote
+from pianobot.learn import forced
 from pianobot.learn.dagger import dagger_policy
 from pianobot.learn.train import Progress, TrainConfig, train_policy
 from pianobot.music.instrument import check_playable
@@ -213,27 +214,33 @@ def given_parts(folder: Path, env: EnvConfig, share: float = GIVEN_SHARE) -> Giv
     return GivenParts(tuple(parts), share, about)
 
 
-def plan_jobs(jobs: list[PhraseJob], force: bool) -> tuple[list[PhraseJob], list[PhraseJob]]:
+def plan_jobs(
+    jobs: list[PhraseJob], force: bool, run: str = "", resuming: bool = False
+) -> tuple[list[PhraseJob], list[PhraseJob]]:
     """(jobs to train, jobs already done: a stored policy, a run that kept its start policy, or the
-    store's index says the general policy plays the phrase). ``force`` trains every job again: each
-    folder is marked (:func:`~pianobot.agent.store.mark_replacing`) and what it stored stays, and
-    plays, until its new run has finished. A marked folder is an interrupted forced run's: it is
-    trained on (from its checkpoint), and ``force`` given again goes on with the marked jobs alone,
-    so that running the same command again does not train the finished ones once more."""
-    interrupted = force and any(store.replacing(job.folder) for job in jobs)
+    store's index says the general policy plays the phrase).
+
+    ``force`` trains every job again: each folder is marked as replaced by the run ``run``
+    (:func:`~pianobot.learn.forced.mark_replacing`), and what it stored stays, and plays as it did,
+    until the job's new run has finished. ``resuming`` (:func:`~pianobot.learn.forced.forced_run`: the same forced run was
+    interrupted) trains only the jobs that run had not finished. Without ``force``, a job an
+    interrupted forced run had not finished is trained on (from its checkpoint)."""
     todo, done = [], []
     for job in jobs:
         root = job.folder.parent
-        finished = store.is_trained(job.folder) or store.kept_start(job.folder)
-        if store.replacing(job.folder):
+        mark = forced.replacing(job.folder)
+        if force and resuming and mark is not None and mark["run"] == run:
+            (done if mark["finished"] else todo).append(job)
+        elif force:
+            forced.mark_replacing(job.folder, run)
             todo.append(job)
-        elif (finished or job.folder.name in store.general_plays(root)) and (interrupted or not force):
+        elif mark is not None and not mark["finished"]:
+            todo.append(job)
+        elif (
+            store.is_trained(job.folder) or store.kept_start(job.folder) or job.folder.name in store.general_plays(root)
+        ):
             done.append(job)
         else:
-            if force:
-                store.mark_replacing(job.folder)
-                if job.folder.name in store.general_plays(root):
-                    store.mark_general_plays(root, {job.folder.name: None})
             todo.append(job)
     return todo, done
 

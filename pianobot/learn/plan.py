@@ -20,6 +20,7 @@ from typing import Callable
 from pianobot.agent import store
 from pianobot.errors import SettingError
 from pianobot.learn.config import TrainConfig
+from pianobot.learn.forced import forced_run, forget_replacing
 from pianobot.learn.jobs import PhraseJob as Job
 from pianobot.learn.jobs import general_start, phrase_jobs, plan_jobs, run_jobs, run_jobs_on_ray
 from pianobot.learn.log import LOG_FILE, PLOT_FILE
@@ -164,11 +165,19 @@ def plan_training(plan: TrainingPlan, force: bool) -> TrainingPlan:
     """``plan`` with its jobs already trained set aside (all trained again with ``force``,
     :func:`~pianobot.learn.jobs.plan_jobs`)."""
     todo, done = [], []
+    run, resuming = forced_run([job.folder for group in plan.groups for job in group.jobs])
     for group in plan.groups:
-        train, skip = plan_jobs(list(group.jobs), force)
+        train, skip = plan_jobs(list(group.jobs), force, run, resuming)
         todo += train
         done += skip
     return replace(plan, todo=tuple(todo), done=tuple(done))
+
+
+def forget_forced(plan: TrainingPlan) -> None:
+    """The plan's phrases trained and judged: the marks of a forced run (:func:`plan_training`) go."""
+    for group in plan.groups:
+        for job in group.jobs:
+            forget_replacing(job.folder)
 
 
 def train_groups(

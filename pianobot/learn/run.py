@@ -50,6 +50,7 @@ from pianobot.agent.tasks import GivenParts, Target, make_env
 from pianobot.config import to_dict
 from pianobot.env.piano import EnvConfig
 from pianobot.errors import PianobotError
+from pianobot.learn import forced
 from pianobot.learn.config import TrainConfig
 from pianobot.learn.log import LOG_FILE, PLOT_FILE, TENSORBOARD_DIR, TrainingLog
 from pianobot.perform.rollout import rollout
@@ -385,17 +386,16 @@ class Run:
             "evaluations": self.evaluations,
             "config": to_dict(self.config),
         }
-        # what a forced run replaces (store.mark_replacing) stayed, and played, until now
+        # what a forced run replaces (forced.mark_replacing) stayed, and played, until now; its mark
+        # says the phrase is finished only once the new manifest is written
         if not start_kept:
             policy, critic = split_kept(tensors)
             store.save_policy(self.folder, policy, manifest, critic=critic)
-            store.replaced(self.folder, policy_kept=True)
         elif not self.kept_start:  # trained, and kept its start: the manifest alone says the run is done
-            store.replaced(self.folder, policy_kept=False)
             store.save_manifest(self.folder, manifest)
-        elif store.replacing(self.folder):  # (the start played well enough: what was stored goes)
-            store.replaced(self.folder, policy_kept=False)
+        elif forced.replacing(self.folder) is not None:  # (the start played well enough: what was stored goes)
             (self.folder / store.MANIFEST_FILE).unlink(missing_ok=True)
+        forced.replaced(self.folder, policy_kept=not start_kept)
         if not self.kept_start:  # (a run that trained keeps its learning curves, also when it kept its start)
             store.drop_checkpoint(self.folder)
             self.log.plot()

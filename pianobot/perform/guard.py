@@ -25,7 +25,8 @@ alone holds them a step longer (through the guard, the packaged policy played th
 excerpts at 0.879 that way, against 0.885), and it holds a key at full depth to its note's end
 (:attr:`~pianobot.pianist.tuning.PianistTuning.end_rise` off), where the scripted pianist lets it rise a
 little in the last step (through the guard, the packaged policy's per-step F1 and offsets rose with it,
-its note F1 did not, and one two-hand example fell below 0.97: docs/history.md). ``pianobot play`` plays a general policy of
+its note F1 moved by 0.002 or less on the validation sets, and one two-hand example fell below 0.97:
+docs/history.md). ``pianobot play`` plays a general policy of
 the families in :data:`HOLD_GUARD_FAMILIES` through it (the packaged left hand's policy), and
 any general policy with ``--hold-guard``; ``--no-hold-guard`` plays each alone. A phrase's own
 policy plays unguarded.

@@ -298,8 +298,9 @@ class StrikePlanner:
         tip_height = tip.height - self.layout.key_top[key]
         floor = -self.strike_depth(key) - self.tuning.hold_depth_margin
         goal = max(tip_height - self.tip_speed(key, current.velocity) * self.dt, floor)
-        struck_again = score.shape[0] > 2 and score[2, key, NOTE] > 0.5  # after the gap that tells a repeat
-        if current.end == 1 and self.tuning.end_rise < math.inf and not struck_again:  # its last step: rise a little
+        seen = score.shape[0] > 2  # (a window of three rows or more shows the note's end and a repeat after it)
+        struck_again = seen and score[2, key, NOTE] > 0.5  # after the gap that tells a repeat
+        if current.end == 1 and self.tuning.end_rise < math.inf and seen and not struck_again:  # its last step
             goal = max(goal, -self.layout.contact_y(key) * math.tan(self.layout.release_angle) - self.tuning.end_rise)
         if upcoming is None:
             return Plan(key, "hold", goal=goal)

@@ -71,11 +71,7 @@ def train(
     tactile: bool = o.TACTILE_OPTION,
     joints: str = o.JOINTS_OPTION,
     fingering_gate: bool = o.FINGERING_GATE_OPTION,
-    force: bool = typer.Option(
-        False,
-        "--force",
-        help="Retrain phrases that already have a stored policy (it stays, and plays, until its new run has finished; after an interruption the same command goes on with the phrases not yet retrained).",
-    ),
+    force: bool = o.FORCE_OPTION,
     models: Path = typer.Option(DEFAULT_STORE, "--models", help="Folder of the model store."),
     cluster: Cluster = o.CLUSTER_OPTION,
     json_path: Optional[Path] = o.JSON_PATH_OPTION,
@@ -287,6 +283,7 @@ def _say_starts(console, plan, general_policy, models: Path, force: bool, from_g
 def _say_skipped(console, plan, models: Path) -> None:
     """One line per job already trained (or played by the general policy): skipped."""
     from pianobot.agent import store
+    from pianobot.learn import forced
 
     for job in plan.done:
         where = (
@@ -294,9 +291,10 @@ def _say_skipped(console, plan, models: Path) -> None:
             if store.is_trained(job.folder)
             else f"played by the general policy, as {said(models)}'s index ({store.GENERAL_INDEX}) says"
         )
-        console.print(
-            f"phrase {job.key} ({', '.join(map(str, job.phrases))}) {where}: skipped (--force retrains)", soft_wrap=True
-        )
+        why = "skipped (--force retrains)"
+        if forced.replacing(job.folder) is not None:  # (finished by an interrupted forced run: it goes on)
+            where, why = f"trained anew in {said(job.folder)}", "skipped: the interrupted --force run finished it"
+        console.print(f"phrase {job.key} ({', '.join(map(str, job.phrases))}) {where}: {why}", soft_wrap=True)
 
 
 @contextlib.contextmanager
@@ -338,6 +336,15 @@ def _progress(console, todo, steps: int, task: bool, finish: bool = False):
 
 
 def _judge(console, plan, trained, models: Path, song):
+    """:func:`_verdict`, then a forced run's marks go: given again, it trains every phrase anew."""
+    from pianobot.learn import plan as training
+
+    verdict = _verdict(console, plan, trained, models, song)
+    training.forget_forced(plan)
+    return verdict
+
+
+def _verdict(console, plan, trained, models: Path, song):
     """The training table, then the whole piece judged as ``play`` plays it (where phrase
     policies were trained now and a general policy plays beside them), said; the verdict or None."""
     from pianobot.cli import display

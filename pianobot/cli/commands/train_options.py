@@ -146,6 +146,12 @@ FINGERING_GATE_OPTION = typer.Option(
     "--fingering-gate/--no-fingering-gate",
     help="Reward a key only when the score's finger pressed it (the paper's fingering indicator).",
 )
+FORCE_OPTION = typer.Option(
+    False,
+    "--force",
+    help="Retrain phrases that already have a stored policy (it stays, and plays, until its new run has "
+    "finished; interrupted, the same command goes on with the phrases not yet retrained).",
+)
 CLUSTER_OPTION = typer.Option(
     "local",
     "--cluster",
