@@ -502,7 +502,8 @@ def test_the_best_evaluated_policy_is_kept_across_an_interruption(tmp_path, monk
 
 
 def test_training_workers_end_when_their_parent_is_killed(tmp_path):
-    """`kill PID` of `pianobot train --workers N` must not leave its workers training on unseen."""
+    """`kill PID` of `pianobot train --workers N` must not leave its workers training on unseen, nor any
+    other process of its (a multiprocessing manager once stayed behind, idle)."""
     import os
     import signal
     import subprocess
@@ -513,18 +514,23 @@ def test_training_workers_end_when_their_parent_is_killed(tmp_path):
     script.write_text(
         "import multiprocessing, os, time\n"
         "from concurrent.futures import ProcessPoolExecutor\n"
-        "from pianobot.learn.jobs import _exit_with_parent\n"
+        "from pianobot.learn import jobs\n"
         "def nap():\n"
-        "    print(os.getpid(), flush=True)\n"
+        "    jobs._PROGRESS.put(os.getpid())\n"
         "    time.sleep(60)\n"
         "if __name__ == '__main__':\n"
         "    context = multiprocessing.get_context('spawn')\n"
-        "    with ProcessPoolExecutor(2, mp_context=context, initializer=_exit_with_parent, initargs=(os.getpid(),)) as pool:\n"
+        "    queue = context.Queue()\n"
+        "    with jobs.worker_pool(2, context, queue) as pool:\n"
         "        futures = [pool.submit(nap) for _ in range(2)]\n"
+        "        print(queue.get(), queue.get(), flush=True)\n"
         "        time.sleep(60)\n"
     )
     parent = subprocess.Popen([sys.executable, str(script)], stdout=subprocess.PIPE, text=True)
-    workers = [int(parent.stdout.readline()) for _ in range(2)]
+    workers = [int(pid) for pid in parent.stdout.readline().split()]  # (their progress reached the parent)
+    children = [int(p) for p in os.listdir("/proc") if p.isdigit() and _parent_of(int(p)) == parent.pid]
+    assert set(workers) <= set(children)
+    workers = children  # every process the parent started
     os.kill(parent.pid, signal.SIGKILL)
     parent.wait()
 
@@ -539,6 +545,14 @@ def test_training_workers_end_when_their_parent_is_killed(tmp_path):
     while any(alive(p) for p in workers) and time.monotonic() < deadline:
         time.sleep(0.2)
     assert not any(alive(p) for p in workers)
+
+
+def _parent_of(pid: int) -> int | None:
+    try:
+        with open(f"/proc/{pid}/stat") as stat:
+            return int(stat.read().rsplit(")", 1)[1].split()[1])
+    except (FileNotFoundError, ProcessLookupError, IndexError, ValueError):
+        return None
 
 
 def _log_without_time(folder):

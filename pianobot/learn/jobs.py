@@ -66,6 +66,23 @@ def _exit_with_parent(parent: int, every: float = 0.5) -> None:
     threading.Thread(target=watch, daemon=True, name="exit-with-parent").start()
 
 
+_PROGRESS = None
+"""In a worker process of :func:`worker_pool`: the queue its runs report their progress on."""
+
+
+def _start_worker(parent: int, queue) -> None:
+    global _PROGRESS
+    _PROGRESS = queue
+    _exit_with_parent(parent)
+
+
+def worker_pool(workers: int, context, queue) -> ProcessPoolExecutor:
+    """``workers`` processes of ``context`` that end with this one (:func:`_exit_with_parent`) and report
+    progress on ``queue``, a queue of the same context: no manager process, so a parent killed outright
+    leaves nothing running behind it."""
+    return ProcessPoolExecutor(workers, mp_context=context, initializer=_start_worker, initargs=(os.getpid(), queue))
+
+
 def learner(config: TrainConfig) -> Callable[..., dict]:
     """The training loop of ``config.learner``: :func:`~pianobot.learn.train.train_policy` (SAC)
     or :func:`~pianobot.learn.dagger.dagger_policy`; both take the same arguments."""
@@ -77,6 +94,8 @@ def _run_job(
 ) -> dict:
     if threads is not None:
         torch.set_num_threads(threads)
+
+    queue = queue if queue is not None else _PROGRESS
 
     def report(progress: Progress) -> None:
         if queue is not None:
@@ -271,13 +290,10 @@ def run_jobs(
         return results
     import multiprocessing
 
-    manager = multiprocessing.Manager()
-    queue = manager.Queue()
     context = multiprocessing.get_context("spawn")
-    with ProcessPoolExecutor(
-        max_workers=workers, mp_context=context, initializer=_exit_with_parent, initargs=(os.getpid(),)
-    ) as pool:
-        futures = {pool.submit(_run_job, job, config, queue, threads, start): job for job in jobs}
+    queue = context.Queue()
+    with worker_pool(workers, context, queue) as pool:
+        futures = {pool.submit(_run_job, job, config, None, threads, start): job for job in jobs}
         pending = set(futures)
         while pending:
             while not queue.empty():
