@@ -94,7 +94,7 @@ app = typer.Typer(
 INTERRUPTED = {
     "train": ": run the same command again to go on; a phrase's run resumes from its last checkpoint "
     f"(SAC's every {TrainConfig.checkpoint_every} steps, DAgger's at the end of each round), and one without a "
-    "checkpoint yet starts again; a phrase a --force run had not finished still plays its earlier policy",
+    "checkpoint yet starts again; a phrase a --force run had not finished plays as it did before",
 }
 """What an interrupted command adds to the line that says so."""
 

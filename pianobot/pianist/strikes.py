@@ -186,8 +186,11 @@ class StrikePlanner:
         """The lowest ready height (m over ``key``'s top) of a finger striking again the key it has
         just let go of: ``repeat_rise`` over the depth at which the key let its note go, as a piano
         strikes a key again before it is all the way up; at most ``min_ready_height``."""
-        released = self.layout.contact_y(key) * math.tan(self.layout.release_angle)
-        return min(self.tuning.min_ready_height, self.tuning.repeat_rise - released)
+        return min(self.tuning.min_ready_height, self.tuning.repeat_rise - self.release_depth(key))
+
+    def release_depth(self, key: int) -> float:
+        """How deep (m under its top, where the fingertip strikes it) ``key`` is when, rising, it lets its note go."""
+        return self.layout.contact_y(key) * math.tan(self.layout.release_angle)
 
     def ready(self, run: Run, repeat: bool = False) -> tuple[float, int]:
         """(height, lead) of ``run``'s strike: its ready height over the key's top (m) and the
@@ -301,7 +304,7 @@ class StrikePlanner:
         seen = score.shape[0] > 2  # (a window of three rows or more shows the note's end and a repeat after it)
         struck_again = seen and score[2, key, NOTE] > 0.5  # after the gap that tells a repeat
         if current.end == 1 and self.tuning.end_rise < math.inf and seen and not struck_again:  # its last step
-            goal = max(goal, -self.layout.contact_y(key) * math.tan(self.layout.release_angle) - self.tuning.end_rise)
+            goal = max(goal, -self.release_depth(key) - self.tuning.end_rise)
         if upcoming is None:
             return Plan(key, "hold", goal=goal)
         height, lead = self.ready(upcoming, repeat=upcoming.key == key)
