@@ -129,3 +129,21 @@ def test_a_headless_browser_renders_the_roll_and_plays_the_video(played):
     assert seen["roll"][0] > 300 and seen["roll"][1] > 100, seen  # drawn, at a size one can read
     assert "refused" not in seen and seen["time"] > 0, seen  # it plays
     assert seen["size"][0] > 0 and seen["duration"] > 3, seen  # frames decoded; three notes of a second each
+
+
+@pytest.mark.parametrize("model", ["allegro", "pianist"])
+def test_a_one_hand_report_names_the_hand_that_played(model):
+    """The page says which hand played, as the report's JSON does (hand_model, fingers): a
+    performance of the pianist's hand is not taken for the Allegro-like hand's."""
+    import pianobot
+    from pianobot.perform.report import html_report
+    from pianobot.sim.hand import default_fingers
+
+    spec = default_fingers(model)
+    piece = pianobot.load_piece(EXAMPLES / "one-note.mid")
+    performance = pianobot.play(piece, controller="scripted", hand=spec)
+    assert performance.to_dict()["hand_model"] == model
+    page = html_report(performance.report(), "one-note", plan=performance.plan, seed=0)
+    head = page[: page.index("<section id='figures'>")]
+    assert f"with fingers {spec.describe()}" in head
+    assert ("pianist hand" in head) == (model == "pianist")

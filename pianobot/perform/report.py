@@ -339,8 +339,10 @@ def html_report(
             if row.reference is not None and (row.reference.onset, row.reference.pitch) in by_note
         }
     performer = plan.performer if plan is not None else hands.performer if hands is not None else None
+    # (one hand's fingers and hand model, as the report's JSON has them; each hand's are in its table)
+    fingers = f", with fingers {plan.config.world.hand.spec.describe()}" if plan is not None else ""
     who = (
-        f"Played by: {escape(performer)}" + (f", from hand start {seed}" if seed is not None else "")
+        f"Played by: {escape(performer)}{escape(fingers)}" + (f", from hand start {seed}" if seed is not None else "")
         if performer
         else ""
     )
