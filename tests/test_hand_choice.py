@@ -151,3 +151,14 @@ def test_a_general_policy_named_plays_the_hand_it_was_trained_for(tmp_path):
     assert result.exit_code == 0, result.output
     report = json.loads(out.with_suffix(".report.json").read_text())
     assert {h["hand_model"] for h in report["hands"].values()} == {"allegro"} and report["f1"] > 0.5
+
+
+@pytest.mark.parametrize("model", ["allegro", "pianist"])
+def test_inspect_json_of_one_hand_names_its_hand_model(tmp_path, model):
+    """One hand's `inspect --json` records the hand model, as both hands' does and play's report."""
+    result = run(
+        "inspect", ROOT / "examples" / "midi" / "ode-to-joy.mid", "--hand-model", model, "--json", tmp_path / "i.json"
+    )
+    assert result.exit_code == 0, result.output
+    data = json.loads((tmp_path / "i.json").read_text())
+    assert data["hand_model"] == model and data["fingers"] == ([2, 3, 4] if model == "allegro" else [1, 2, 3, 4, 5])

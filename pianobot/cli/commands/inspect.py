@@ -115,6 +115,7 @@ def inspect(
                 **data,
                 "playable": True,
                 "keyboard": keyboard.describe(),
+                "hand_model": hand_spec.model,
                 "fingers": list(hand_spec.fingers),
                 "phrases": [
                     {
