@@ -62,3 +62,16 @@ def test_a_config_with_longer_episodes_warns_with_the_number():
         )
     assert env.spec.max_episode_steps == 65
     env.close()
+
+
+def test_every_id_the_api_page_names_is_registered_with_its_steps():
+    """docs/api.md names ids a user can pass to gymnasium.make, and their max_episode_steps."""
+    import re
+
+    text = (Path(__file__).parent.parent / "docs" / "api.md").read_text()
+    named = re.findall(r"`(?:pianobot/)?([A-Z]\w+-v\d+)`", text)
+    assert {"OneNote-v1", "SixNote-v1", "Piano-v1"} <= set(named)
+    for name in named:
+        assert f"pianobot/{name}" in gymnasium.registry, name
+    for steps, name in re.findall(r"(\d+) (?:steps )?for `(\w+-v\d+)`", text):
+        assert gymnasium.spec(f"pianobot/{name}").max_episode_steps == int(steps), name
