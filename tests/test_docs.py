@@ -87,3 +87,18 @@ def test_the_model_format_page_runs_a_finger_shared_policy_as_pianobot_does(tmp_
             assert ours.shape == (7,) and np.allclose(ours, theirs, atol=1e-6), (ours, theirs)
             observation, *_ = env.step(ours)
         env.close()
+
+
+def test_the_api_page_says_which_hand_plays_both_hands():
+    """`pianobot.play` of a two-hand piece plays the Allegro-like hand unless `hand=` names another,
+    where `pianobot play` gives a two-hand file to the pianist's hands: the page says so, and the call
+    it gives for the pianist's hands plays them."""
+    import pianobot
+    from pianobot.sim.hand import default_fingers
+
+    text = " ".join((ROOT / "docs" / "api.md").read_text().split())
+    assert 'hand=pianobot.sim.hand.default_fingers("pianist")' in text and "Allegro-like hand by default" in text
+    duet = pianobot.load_two_hands(ROOT / "examples" / "midi" / "ode-to-joy-performed.mid")
+    for hand, model in ((None, "allegro"), (default_fingers("pianist"), "pianist")):
+        played = pianobot.play(duet, controller="scripted", hand=hand).to_dict()
+        assert {h["hand_model"] for h in played["hands"].values()} == {model}
