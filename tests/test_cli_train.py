@@ -22,6 +22,7 @@ def test_train_json_to_standard_output_and_a_summary_that_keeps_whole_paths(tmp_
     assert result.exit_code == 0, result.output
     policies = json.loads(result.stdout)["policies"]  # stdout holds the JSON alone; the tables go to stderr
     assert len(policies) == 1 and policies[0]["steps"] == 60 and policies[0]["trained_now"]
+    assert policies[0]["hand"] is None and policies[0]["hand_model"] == "allegro"  # (one hand's piece)
     folder = Path(policies[0]["folder"])
     assert folder.parent == models and (folder / "training.csv").exists() and Path(policies[0]["plot"]).exists()
     assert "…" not in result.stderr  # no path cut short in the summary
@@ -39,6 +40,17 @@ def test_train_json_to_standard_output_and_a_summary_that_keeps_whole_paths(tmp_
     text = " ".join(judged.output.split())
     assert judged.exit_code == 0 and "played by the general policy" in text and "already trained" not in text
     assert "learning curves" not in text
+
+
+def test_train_json_names_the_hand_model_each_policy_plays(tmp_path):
+    result = run(
+        "train", EXAMPLES / "one-note.mid", *QUICK, "--hand-model", "pianist", "--models", tmp_path, "--json", "-"
+    )
+    assert result.exit_code == 0, result.output
+    (policy,) = json.loads(result.stdout)["policies"]
+    assert policy["hand_model"] == "pianist"
+    manifest = json.loads((Path(policy["folder"]) / "manifest.json").read_text())
+    assert manifest["config"]["env"]["world"]["hand"]["spec"]["model"] == "pianist"
 
 
 def test_train_warns_about_more_threads_than_cores_and_workers_with_a_task(tmp_path, monkeypatch):

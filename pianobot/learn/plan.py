@@ -242,10 +242,17 @@ def judge_piece(plan: TrainingPlan, trained: list[tuple[Job, dict]], models: Pat
 
 
 def training_summary(plan: TrainingPlan, trained: list[tuple[Job, dict]], verdict=None) -> dict:
-    """The run's JSON: each policy's figures and files, and the piece's verdict."""
+    """The run's JSON: each policy's figures and files (with the hand, and the hand model, it plays),
+    and the piece's verdict."""
+
+    def group_of(job: Job) -> TrainingGroup:
+        return next(g for g in plan.groups if job in g.jobs)  # (jobs are not hashable)
+
     summary = [
         {
             "key": job.key,
+            "hand": group_of(job).hand,
+            "hand_model": group_of(job).config.env.world.hand.spec.model,
             "phrases": job.phrases,
             "folder": str(job.folder),
             "trained_now": job in plan.todo,
