@@ -245,3 +245,37 @@ def test_a_track_without_notes_and_notes_of_no_time_are_refused_in_one_line(tmp_
     midi_file(tmp_path / "fast.mid", [("Piano", [(0, on(60)), (480, off(60))])], tempo_events=((0, 1),))
     assert_one_line_error(run("play", "fast.mid", "-o", "o.mid"), "every note of fast.mid lasts under 1 ms", "--tempo")
     assert run("play", "fast.mid", "--tempo", "120", "--controller", "scripted", "-o", "o.mid").exit_code == 0
+
+
+def test_sigterm_unwinds_a_command_as_ctrl_c_does_and_leaves_no_temporary_file(tmp_path, capsys):
+    """`kill PID` while a video is written: the command stops with exit code 143 and says so, the
+    user's file is as it was and no temporary file is left beside it (SIGTERM's default would end
+    the process where it stood)."""
+    import os
+    import signal
+
+    import numpy as np
+    import typer
+
+    from pianobot.cli.app import friendly
+    from pianobot.perform.perform import write_video
+
+    target = tmp_path / "out.mp4"
+    target.write_bytes(b"the user's video")
+
+    class Frames(list):
+        def __iter__(self):
+            for i, frame in enumerate(super().__iter__()):
+                if i == 3:
+                    os.kill(os.getpid(), signal.SIGTERM)
+                yield frame
+
+    def play():
+        write_video(Frames([np.zeros((32, 32, 3), np.uint8)] * 8), target, fps=20)
+
+    before = signal.getsignal(signal.SIGTERM)
+    with pytest.raises(typer.Exit) as stopped:
+        friendly(play)()
+    assert stopped.value.exit_code == 143 and capsys.readouterr().err.strip().startswith("terminated")
+    assert target.read_bytes() == b"the user's video" and sorted(p.name for p in tmp_path.iterdir()) == ["out.mp4"]
+    assert signal.getsignal(signal.SIGTERM) == before  # (the handler is the command's alone)

@@ -11,6 +11,8 @@ from __future__ import annotations
 import contextlib
 import functools
 import re
+import signal
+import threading
 import warnings
 
 import typer
@@ -99,12 +101,35 @@ INTERRUPTED = {
 """What an interrupted command adds to the line that says so."""
 
 
+class Terminated(KeyboardInterrupt):
+    """SIGTERM (``kill``, a job scheduler's stop) raised in the main thread, so that it unwinds as
+    Ctrl-C does: every ``finally`` runs and a file being written is left whole or not at all."""
+
+
+def _terminate(signum, frame):
+    raise Terminated
+
+
+@contextlib.contextmanager
+def _sigterm_unwinds():
+    """While in the block, SIGTERM raises :class:`Terminated` (only the main thread may set handlers)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGTERM, _terminate)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
 def friendly(command):
     """Turn PianobotError into one red line + exit 2, and show warnings in yellow; either names
     the settings it mentions by their options (:func:`pianobot.cli.flags.phrase`).
 
     An OSError that escaped the library (the file system failed us where no one expected it)
-    gets the same one line, never a traceback.
+    gets the same one line, never a traceback. Ctrl-C and SIGTERM unwind the command (its files
+    left whole or not written) and say so: exit code 130 and 143.
     """
 
     @functools.wraps(command)
@@ -113,14 +138,16 @@ def friendly(command):
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", PianobotWarning)
             try:
-                return command(*args, **kwargs)
+                with _sigterm_unwinds():
+                    return command(*args, **kwargs)
             except PianobotError as e:
                 error, code = phrase(e), EXIT_BAD_INPUT
             except OSError as e:
                 error, code = (f"{e.filename}: " if e.filename else "") + why(e), EXIT_BAD_INPUT
-            except KeyboardInterrupt:
-                error, code = None, 130
-                err.print(f"[yellow]interrupted[/yellow]{INTERRUPTED.get(command.__name__, '')}")
+            except KeyboardInterrupt as e:
+                error, code = None, 143 if isinstance(e, Terminated) else 130
+                stopped = "terminated" if isinstance(e, Terminated) else "interrupted"
+                err.print(f"[yellow]{stopped}[/yellow]{INTERRUPTED.get(command.__name__, '')}")
             finally:
                 lines = dict.fromkeys(  # (a file read twice warns twice: each line is said once)
                     phrase(w.message) for w in caught if issubclass(w.category, PianobotWarning)

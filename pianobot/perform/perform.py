@@ -7,7 +7,6 @@
 
 from __future__ import annotations
 
-import contextlib
 import errno
 import os
 import shutil
@@ -18,7 +17,7 @@ import numpy as np
 
 from pianobot.env.piano import EnvConfig, PianoEnv
 from pianobot.errors import one_line
-from pianobot.files import check_writable, move_into_place, not_written, temporary_beside
+from pianobot.files import check_writable, move_into_place, not_written
 from pianobot.music.pedal import Pedal
 from pianobot.music.piece import Piece
 from pianobot.perform.controllers import make_controller
@@ -54,31 +53,36 @@ def perform(
 
 def write_video(frames: list[np.ndarray], path: str | Path, fps: float, audio: Path | None = None) -> Path:
     """Encode frames to an MP4 file (imageio with its ffmpeg plugin), written atomically; with
-    ``audio`` (a WAV file starting with the first frame), the video carries it as an AAC track."""
+    ``audio`` (a WAV file starting with the first frame), the video carries it as an AAC track.
+
+    ffmpeg writes into a temporary folder beside ``path``, removed however the writing ends: ffmpeg
+    may still finish a file after an interruption (SIGTERM) has stopped the frames, and in a removed
+    folder it can leave none."""
+    import tempfile
+
     import imageio.v2 as imageio  # only needed for videos
 
     path = check_writable(path)
-    tmp = None
+    folder = None
     try:
-        tmp = temporary_beside(path)
+        folder = Path(tempfile.mkdtemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent))
+        tmp = folder / f"video{path.suffix}"
         with imageio.get_writer(
             tmp, format="FFMPEG", fps=fps, codec="libx264", quality=7, macro_block_size=16, ffmpeg_log_level="quiet"
         ) as writer:
             for frame in frames:
                 writer.append_data(frame)
-        if frames and not _complete_mp4(Path(tmp)):  # ffmpeg may stop short (a full disk) without an error
+        if frames and not _complete_mp4(tmp):  # ffmpeg may stop short (a full disk) without an error
             full = shutil.disk_usage(path.parent).free < 1_000_000
             raise OSError(errno.ENOSPC if full else errno.EIO, "the encoder stopped before the video was complete")
         if audio is not None:
-            _add_audio(Path(tmp), audio)
+            _add_audio(tmp, audio)
         move_into_place(tmp, path)
-    except BaseException as e:
-        if tmp is not None:
-            with contextlib.suppress(OSError):
-                Path(tmp).unlink(missing_ok=True)
-        if isinstance(e, (OSError, RuntimeError)):  # imageio-ffmpeg raises these when ffmpeg or the disk fails
-            raise not_written(path, e if isinstance(e, OSError) else OSError(None, str(e))) from None
-        raise
+    except (OSError, RuntimeError) as e:  # imageio-ffmpeg raises these when ffmpeg or the disk fails
+        raise not_written(path, e if isinstance(e, OSError) else OSError(None, str(e))) from None
+    finally:
+        if folder is not None:
+            shutil.rmtree(folder, ignore_errors=True)
     return path
 
 
