@@ -501,6 +501,51 @@ def test_the_best_evaluated_policy_is_kept_across_an_interruption(tmp_path, monk
     assert all(torch.equal(kept[k], stored[k]) for k in stored)
 
 
+def test_training_workers_end_at_once_when_their_parent_is_terminated(tmp_path):
+    """`kill PID` (SIGTERM) of `pianobot train --workers N` unwinds the command as Ctrl-C does, and its
+    workers end with it at once; the pool once waited for their runs to finish (an hour's training)."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    script = tmp_path / "parent.py"
+    script.write_text(
+        "import multiprocessing, os, time\n"
+        "from pianobot.cli.app import _sigterm_unwinds\n"
+        "from pianobot.learn import jobs\n"
+        "def nap():\n"
+        "    jobs._PROGRESS.put(os.getpid())\n"
+        "    time.sleep(120)\n"
+        "if __name__ == '__main__':\n"
+        "    context = multiprocessing.get_context('spawn')\n"
+        "    queue = context.Queue()\n"
+        "    with _sigterm_unwinds(), jobs.worker_pool(2, context, queue) as pool:\n"
+        "        futures = [pool.submit(nap) for _ in range(2)]\n"
+        "        print(queue.get(), queue.get(), flush=True)\n"
+        "        time.sleep(120)\n"
+    )
+    parent = subprocess.Popen([sys.executable, str(script)], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    workers = [int(pid) for pid in parent.stdout.readline().split()]
+    started = time.monotonic()
+    os.kill(parent.pid, signal.SIGTERM)
+    parent.wait(timeout=60)
+    assert time.monotonic() - started < 30 and "Terminated" in parent.stderr.read()
+    deadline = time.monotonic() + 20
+    while any(_alive(p) for p in workers) and time.monotonic() < deadline:
+        time.sleep(0.2)
+    assert not any(_alive(p) for p in workers)
+
+
+def _alive(pid: int) -> bool:
+    try:
+        with open(f"/proc/{pid}/stat") as stat:
+            return stat.read().rsplit(")", 1)[1].split()[0] != "Z"  # a zombie has ended
+    except FileNotFoundError:
+        return False
+
+
 def test_training_workers_end_when_their_parent_is_killed(tmp_path):
     """`kill PID` of `pianobot train --workers N` must not leave its workers training on unseen, nor any
     other process of its (a multiprocessing manager once stayed behind, idle)."""
@@ -534,17 +579,10 @@ def test_training_workers_end_when_their_parent_is_killed(tmp_path):
     os.kill(parent.pid, signal.SIGKILL)
     parent.wait()
 
-    def alive(pid: int) -> bool:
-        try:
-            with open(f"/proc/{pid}/stat") as stat:
-                return stat.read().rsplit(")", 1)[1].split()[0] != "Z"  # a zombie has ended
-        except FileNotFoundError:
-            return False
-
     deadline = time.monotonic() + 20
-    while any(alive(p) for p in workers) and time.monotonic() < deadline:
+    while any(_alive(p) for p in workers) and time.monotonic() < deadline:
         time.sleep(0.2)
-    assert not any(alive(p) for p in workers)
+    assert not any(_alive(p) for p in workers)
 
 
 def _parent_of(pid: int) -> int | None:

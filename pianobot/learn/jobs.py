@@ -8,7 +8,9 @@ import os
 import threading
 import time
 import warnings
+from collections.abc import Iterator
 from concurrent.futures import ProcessPoolExecutor
+from contextlib import contextmanager
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Callable
@@ -50,8 +52,9 @@ class PhraseJob:
         )
 
 
-def _exit_with_parent(parent: int, every: float = 0.5) -> None:
-    """Worker initializer: end this process when the process that started it is gone.
+def _exit_with_parent(parent: int, stop=None, every: float = 0.5) -> None:
+    """Worker initializer: end this process when the process that started it is gone, or sets ``stop``
+    (an event of its multiprocessing context).
 
     Ctrl-C reaches every process in the terminal's group, but a parent killed on its own
     (``kill PID``, a closed session) would leave its workers training on unseen. Checkpoints
@@ -59,7 +62,7 @@ def _exit_with_parent(parent: int, every: float = 0.5) -> None:
     last checkpoint, which the same command trains again."""
 
     def watch() -> None:
-        while os.getppid() == parent:
+        while os.getppid() == parent and not (stop is not None and stop.is_set()):
             time.sleep(every)
         os._exit(1)
 
@@ -70,17 +73,26 @@ _PROGRESS = None
 """In a worker process of :func:`worker_pool`: the queue its runs report their progress on."""
 
 
-def _start_worker(parent: int, queue) -> None:
+def _start_worker(parent: int, queue, stop) -> None:
     global _PROGRESS
     _PROGRESS = queue
-    _exit_with_parent(parent)
+    _exit_with_parent(parent, stop)
 
 
-def worker_pool(workers: int, context, queue) -> ProcessPoolExecutor:
+@contextmanager
+def worker_pool(workers: int, context, queue) -> Iterator[ProcessPoolExecutor]:
     """``workers`` processes of ``context`` that end with this one (:func:`_exit_with_parent`) and report
     progress on ``queue``, a queue of the same context: no manager process, so a parent killed outright
-    leaves nothing running behind it."""
-    return ProcessPoolExecutor(workers, mp_context=context, initializer=_start_worker, initargs=(os.getpid(), queue))
+    leaves nothing running behind it. An exception that leaves the block (Ctrl-C, or SIGTERM, which
+    reaches this process alone) ends the workers at once, rather than waiting for their runs to finish."""
+    stop = context.Event()
+    initargs = (os.getpid(), queue, stop)
+    with ProcessPoolExecutor(workers, mp_context=context, initializer=_start_worker, initargs=initargs) as pool:
+        try:
+            yield pool
+        except BaseException:
+            stop.set()
+            raise
 
 
 def learner(config: TrainConfig) -> Callable[..., dict]:
