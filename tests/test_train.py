@@ -527,10 +527,13 @@ def test_training_workers_end_at_once_when_their_parent_is_terminated(tmp_path):
         "        time.sleep(120)\n"
     )
     parent = subprocess.Popen([sys.executable, str(script)], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    workers = [int(pid) for pid in parent.stdout.readline().split()]
-    started = time.monotonic()
-    os.kill(parent.pid, signal.SIGTERM)
-    parent.wait(timeout=60)
+    try:
+        workers = [int(pid) for pid in parent.stdout.readline().split()]
+        started = time.monotonic()
+        os.kill(parent.pid, signal.SIGTERM)
+        parent.wait(timeout=60)
+    finally:  # (a parent that did not stop is not left behind by the failing test)
+        parent.kill()
     assert time.monotonic() - started < 30 and "Terminated" in parent.stderr.read()
     deadline = time.monotonic() + 20
     while any(_alive(p) for p in workers) and time.monotonic() < deadline:
