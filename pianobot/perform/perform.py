@@ -10,6 +10,7 @@ from __future__ import annotations
 import errno
 import os
 import shutil
+import tempfile
 from pathlib import Path
 from typing import Callable
 
@@ -58,8 +59,6 @@ def write_video(frames: list[np.ndarray], path: str | Path, fps: float, audio: P
     ffmpeg writes into a temporary folder beside ``path``, removed however the writing ends: ffmpeg
     may still finish a file after an interruption (SIGTERM) has stopped the frames, and in a removed
     folder it can leave none."""
-    import tempfile
-
     import imageio.v2 as imageio  # only needed for videos
 
     path = check_writable(path)
