@@ -2,7 +2,7 @@
 scores, written to MIDI files and played as ``pianobot play`` plays them, against each file.
 
     pip install -e ".[corpus]"      # music21, which carries its corpus
-    python -m benchmarks.corpus [--set test|validation|more] [--out out/corpus] [--json out.json] [--only NAME ...]
+    python -m benchmarks.corpus [--set test|validation|more|reductions] [--out out/corpus] [--json out.json] [--only NAME ...]
                                 [--hold-guard | --no-hold-guard]
 
 Each excerpt is a piece's first measures (from :data:`EXCERPTS`' first measure), as many as keep
@@ -16,7 +16,8 @@ validation`` plays twelve other excerpts (:data:`VALIDATION`: three more of Clar
 polonaises, her trio's piano part, two songs' accompaniments, six chorales), which no figure of
 the test set comes from: a setting is chosen on them, and the test set then says how it plays.
 ``--set more`` plays a second, larger test set added later (:data:`MORE`: 30 more chorales and
-five pieces of other kinds), which chose nothing either.
+five pieces of other kinds), which chose nothing either, and ``--set reductions`` a third
+(:data:`REDUCTIONS`: vocal scores and a string quartet, every part, reduced for two hands).
 
     python -m benchmarks.corpus --write-training out/chorales [--count 160]
 
@@ -113,7 +114,29 @@ that come next by corpus path after the 160 :func:`write_training` writes (bwv26
 five pieces of other kinds: a song's piano staves (Schumann), an aria's piano reduction (Verdi), a
 concertino's piano reduction (Weber), a four-part hymn (Johnson) and a trio sonata's three parts
 (Corelli), which the hands play reduced."""
-SETS = {"test": EXCERPTS, "validation": VALIDATION, "more": MORE}
+REDUCTIONS = (
+    ("monteverdi-3-1", "monteverdi/madrigal.3.1", None, 1),
+    ("monteverdi-3-5", "monteverdi/madrigal.3.5", None, 1),
+    ("monteverdi-4-1", "monteverdi/madrigal.4.1", None, 1),
+    ("monteverdi-4-5", "monteverdi/madrigal.4.5", None, 1),
+    ("monteverdi-5-1", "monteverdi/madrigal.5.1", None, 1),
+    ("palestrina-agnus-00", "palestrina/Agnus_00", None, 1),
+    ("palestrina-credo-76", "palestrina/Credo_76", None, 1),
+    ("palestrina-kyrie-10", "palestrina/Kyrie_10", None, 1),
+    ("luca-gloria", "luca/gloria", None, 1),
+    ("trecento-fava", "trecento/Fava_Dicant_nunc_iudei", None, 1),
+    ("schumann-op41-1-1", "schumann_robert/opus41no1/movement1", None, 1),
+    ("schumann-op41-1-2", "schumann_robert/opus41no1/movement2", None, 1),
+)
+"""A third test set, added 2026-12-08, that chose nothing: vocal scores and a string quartet, every
+part, which two hands play reduced (as a pianist plays from a vocal score or a quartet's score):
+five-voice madrigals (Monteverdi), four- to six-voice mass movements (Palestrina), two medieval
+pieces (a Gloria by Luca, a motet by Fava) and the first two movements of Robert Schumann's string
+quartet op. 41 no. 1 (the second a presto scherzo, quavers at 207 bpm). None of their composers is
+among the training pieces' (:func:`write_training`: Bach chorales and the quartets of
+:data:`QUARTETS`). Left out: the corpus's Webern (music21 cannot time it: it has no tempo) and
+Ciconia (its excerpt is one voice, a one-hand file)."""
+SETS = {"test": EXCERPTS, "validation": VALIDATION, "more": MORE, "reductions": REDUCTIONS}
 TRAINING_COUNT = 160
 """Chorales :func:`write_training` writes by default: those the packaged thumb's policy was trained on."""
 MAX_NOTES = 150
@@ -177,7 +200,7 @@ def write_training(out: Path, count: int = TRAINING_COUNT, quartets: bool = Fals
     cannot excerpt is passed over (said)."""
     from music21 import corpus
 
-    used = {path for _, path, *_ in EXCERPTS + VALIDATION + MORE} | {"bach/bwv846"}
+    used = {path for _, path, *_ in EXCERPTS + VALIDATION + MORE + REDUCTIONS} | {"bach/bwv846"}
     scores = [str(p).split("corpus/")[-1] for p in corpus.getComposer("bach")]
     found = {p.rsplit(".", 1)[0] for p in scores if p.endswith(".mxl")}
     chorales = [p for p in sorted(found) if p not in used]
@@ -322,7 +345,8 @@ def main() -> None:
         "--set",
         choices=tuple(SETS),
         default="test",
-        help="the test excerpts, the validation ones, or the larger second test set",
+        help="the test excerpts, the validation ones, the larger second test set, or the third (vocal scores "
+        "and a quartet, every part)",
     )
     parser.add_argument(
         "--out", type=Path, help="folder the excerpts are written to (default out/corpus, or out/corpus-SET)"

@@ -182,6 +182,14 @@ def test_the_corpus_options_reach_the_players(monkeypatch, tmp_path):
     paths = {path for _, path, *_ in corpus.MORE}
     assert len(paths) == len(corpus.MORE) == 35  # (a second test set: none of the others' pieces)
     assert not paths & {path for _, path, *_ in corpus.EXCERPTS + corpus.VALIDATION}
+    monkeypatch.setattr(sys, "argv", ["corpus", "--set", "reductions"])
+    corpus.main()
+    assert asked["excerpts"] == corpus.REDUCTIONS and asked["folder"] == Path("out/corpus-reductions")
+    third = {path for _, path, *_ in corpus.REDUCTIONS}
+    assert len(third) == len(corpus.REDUCTIONS) == 12
+    assert not third & {path for _, path, *_ in corpus.EXCERPTS + corpus.VALIDATION + corpus.MORE}
+    # (a test set of music the policies never learnt from: none of the training pieces' composers)
+    assert not {path.split("/")[0] for path in third} & {"bach", *corpus.QUARTETS}
 
 
 def test_the_corpus_plays_the_general_policy_alone_with_no_hold_guard(monkeypatch, tmp_path):
