@@ -247,6 +247,22 @@ def test_thin_chords_ends_held_notes_that_a_new_chord_needs():
     assert sorted((n.pitch, n.offset) for n in thinned.notes)[0] == (60, 1.0)  # the oldest held note ends
 
 
+def test_a_chord_spread_wider_than_the_onset_window_keeps_every_note_within_it():
+    """Notes started within CHORD_SPREAD (60 ms) of each other form one chord struck at one onset; where
+    they spread wider than the metrics' onset window (50 ms), that onset is the earliest within the
+    window of every note (the first note's onset put the last one 58 ms early: a note played as given
+    counted as missed)."""
+    spread = Piece((Note(1.0, 60, 2.0), Note(1.03, 64, 2.0), Note(1.058, 67, 2.0), Note(2.0, 72, 2.5)))
+    thinned, _ = thin_chords(spread, 5)
+    written = {n.pitch: n.onset for n in spread.notes}
+    chord = [n for n in thinned.notes if n.pitch != 72]
+    assert len({n.onset for n in chord}) == 1 and chord[0].onset == pytest.approx(1.008)
+    assert all(abs(n.onset - written[n.pitch]) <= 0.05 + 1e-9 for n in thinned.notes)
+    assert compare(spread, thinned).f1 == 1.0
+    close = Piece((Note(1.0, 60, 2.0), Note(1.04, 64, 2.0)))  # within the window: the first note's onset, as before
+    assert {n.onset for n in thin_chords(close, 5)[0].notes} == {1.0}
+
+
 def test_finger_command_writes_a_fingered_file_and_inspect_explains_a_recording(tmp_path):
     runner = CliRunner()
     song = write_midi(melody("C4 D4 E4 F4 G4 A4 G4 F4 E4 D4 C4"), tmp_path / "plain.mid")

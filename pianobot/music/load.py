@@ -10,6 +10,7 @@ from pathlib import Path
 from pianobot.errors import PianobotError, PianobotWarning, SettingError, quote
 from pianobot.music import midi_io, pig
 from pianobot.music.instrument import PIANO, HandSpec, beyond_piano, octave_shifts
+from pianobot.music.metrics import DEFAULT_ONSET_TOLERANCE
 from pianobot.music.pedal import Pedal
 from pianobot.music.piece import HANDS, Note, Piece, pitch_name
 
@@ -57,15 +58,25 @@ LEGATO_OVERLAP = 0.1
 
 def gather_chords(piece: Piece, spread: float = CHORD_SPREAD) -> list[tuple[Note, ...]]:
     """Notes grouped into chords as :meth:`Piece.chords` does, but with a human player's spread:
-    each note joins the chord that started at most ``spread`` seconds before it, and takes its onset."""
+    each note joins the chord that started at most ``spread`` seconds before it. The chord's notes
+    take its onset: its first note's, or, where a later one started more than the onset tolerance
+    after it (``spread`` is wider), the earliest onset within that tolerance of every note, so a
+    chord played at its onset plays each of its notes on time."""
     groups: list[list[Note]] = []
     for note in piece.notes:
         if groups and note.onset - groups[-1][0].onset <= spread and note.pitch not in {n.pitch for n in groups[-1]}:
-            start = groups[-1][0].onset
-            groups[-1].append(replace(note, onset=start, offset=max(note.offset, start + 0.001)))
+            groups[-1].append(note)
         else:
             groups.append([note])
-    return [tuple(g) for g in groups]
+    chords = []
+    for group in groups:
+        start = max(group[0].onset, max(n.onset for n in group) - DEFAULT_ONSET_TOLERANCE)
+        chords.append(
+            tuple(
+                n if n.onset == start else replace(n, onset=start, offset=max(n.offset, start + 0.001)) for n in group
+            )
+        )
+    return chords
 
 
 def thin_chords(piece: Piece, fingers: int) -> tuple[Piece, int]:
