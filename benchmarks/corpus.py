@@ -194,7 +194,7 @@ two hands play reduced, as in a quartet's piano reduction."""
 def write_training(out: Path, count: int = TRAINING_COUNT, quartets: bool = False) -> list[Path]:
     """Write excerpts of the first ``count`` Bach chorales of music21's corpus (its MusicXML files, by path, each
     from its first measure within the limits, as the test chorales are) to ``out``, none of the
-    test, validation or second test set's pieces, nor the Well-Tempered Clavier's prelude: training pieces for
+    test sets' or validation set's pieces, nor the Well-Tempered Clavier's prelude: training pieces for
     ``pianobot train --task parts --pieces``; ``quartets``: then an excerpt of every movement of the
     string quartets of :data:`QUARTETS` (MusicXML), all four parts, from measure 1. A piece music21
     cannot excerpt is passed over (said)."""

@@ -59,9 +59,11 @@ LEGATO_OVERLAP = 0.1
 def gather_chords(piece: Piece, spread: float = CHORD_SPREAD) -> list[tuple[Note, ...]]:
     """Notes grouped into chords as :meth:`Piece.chords` does, but with a human player's spread:
     each note joins the chord that started at most ``spread`` seconds before it. The chord's notes
-    take its onset: its first note's, or, where a later one started more than the onset tolerance
-    after it (``spread`` is wider), the earliest onset within that tolerance of every note, so a
-    chord played at its onset plays each of its notes on time."""
+    take its onset: its first note's, or, where a later one started more than the metrics' default
+    onset tolerance (50 ms) after it, the earliest onset within that tolerance of every note (one
+    exists while ``spread`` is at most twice the tolerance; the default's 60 ms moves a chord at
+    most 10 ms), so a chord played at its onset plays each of its notes on time. (Chords so moved
+    may start less than ``spread`` apart: gathered again, they may join.)"""
     groups: list[list[Note]] = []
     for note in piece.notes:
         if groups and note.onset - groups[-1][0].onset <= spread and note.pitch not in {n.pitch for n in groups[-1]}:
